@@ -1,0 +1,86 @@
+//! The coefficient-lookup trait and the per-channel coefficient pair.
+
+use bssrdf_core::Rgb;
+
+/// Absorption and scattering coefficients per colour channel, in 1/length.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Coefficients {
+    /// σa per channel.
+    pub sigma_a: Rgb,
+    /// σs per channel.
+    pub sigma_s: Rgb,
+}
+
+impl Coefficients {
+    /// The same σa and σs in every channel.
+    pub const fn grey(sigma_a: f64, sigma_s: f64) -> Self {
+        Self {
+            sigma_a: Rgb::splat(sigma_a),
+            sigma_s: Rgb::splat(sigma_s),
+        }
+    }
+    /// Channel-wise minimum.
+    pub fn min(self, o: Self) -> Self {
+        Self {
+            sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::min),
+            sigma_s: self.sigma_s.zip_map(o.sigma_s, f64::min),
+        }
+    }
+    /// Channel-wise maximum.
+    pub fn max(self, o: Self) -> Self {
+        Self {
+            sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::max),
+            sigma_s: self.sigma_s.zip_map(o.sigma_s, f64::max),
+        }
+    }
+    /// True when every value is finite and non-negative.
+    pub fn is_valid(&self) -> bool {
+        self.sigma_a.is_finite()
+            && self.sigma_s.is_finite()
+            && self.sigma_a.min_component() >= 0.0
+            && self.sigma_s.min_component() >= 0.0
+    }
+}
+
+/// Channel-wise bounds of a field over the whole object.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldBounds {
+    /// Smallest value of each coefficient and channel.
+    pub min: Coefficients,
+    /// Largest value of each coefficient and channel.
+    pub max: Coefficients,
+}
+
+impl FieldBounds {
+    /// Bounds of a constant field.
+    pub const fn constant(c: Coefficients) -> Self {
+        Self { min: c, max: c }
+    }
+    /// True when the field cannot vary (min == max): averaging it is pointless.
+    pub fn is_constant(&self) -> bool {
+        self.min == self.max
+    }
+}
+
+/// σa and σs over the surface of the object being shaded.
+pub trait CoefficientField<P> {
+    /// The coefficients at surface point `p`. Must be finite and non-negative.
+    fn coefficients(&self, p: &P) -> Coefficients;
+
+    /// Bounds over the whole object, if known. A constant field returns
+    /// `Some(FieldBounds::constant(c))`, which lets every estimator skip averaging so that a
+    /// homogeneous material costs no more than a point lookup. The default, `None`, means
+    /// "unknown: average".
+    fn bounds(&self) -> Option<FieldBounds> {
+        None
+    }
+}
+
+impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
+    fn coefficients(&self, p: &P) -> Coefficients {
+        (**self).coefficients(p)
+    }
+    fn bounds(&self) -> Option<FieldBounds> {
+        (**self).bounds()
+    }
+}

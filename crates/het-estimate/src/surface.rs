@@ -1,0 +1,33 @@
+//! The surface-query trait: what the estimators need to know about the geometry.
+
+use glam::DVec3;
+
+/// A point on the surface of the object being shaded.
+pub trait SurfacePoint {
+    /// Position in scene units.
+    fn position(&self) -> DVec3;
+    /// Unit shading normal, pointing out of the medium.
+    fn normal(&self) -> DVec3;
+}
+
+/// Geometric queries restricted to the object being shaded.
+///
+/// Implementations trace against their own acceleration structure; the estimators call
+/// [`SurfaceQuery::project`] once per averaging sample and never allocate.
+pub trait SurfaceQuery {
+    /// The renderer's surface-point type (it may carry triangle ids, UVs, …, for the
+    /// coefficient lookup).
+    type Point: SurfacePoint;
+
+    /// Traces two rays from `origin`, one along `+dir` and one along `-dir` (`dir` is a unit
+    /// vector: the normal of the averaging plane), and returns the nearer hit on the object
+    /// being shaded; `None` when neither ray hits it (paper §3.2, Figure 3).
+    fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point>;
+}
+
+impl<S: SurfaceQuery + ?Sized> SurfaceQuery for &S {
+    type Point = S::Point;
+    fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point> {
+        (**self).project(origin, dir)
+    }
+}

@@ -1,0 +1,6 @@
+//! The het-bssrdf CPU tracer: one BVH-backed tracer through which both the reference
+//! volumetric path tracer and the BSSRDF renderer run, so that every reported error compares
+//! like with like (same geometry, textures, camera, lights and film).
+#![deny(missing_docs)]
+
+pub mod rng;
