@@ -1,9 +1,43 @@
 //! `het-bssrdf`: the command-line front end. Thin: parses arguments, calls the library
 //! crates, prints results, maps errors to exit codes.
+//!
+//! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
+//! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap).
+
+mod profile;
 
 use std::process::ExitCode;
 
+use clap::{Parser, Subcommand};
+
+/// Render heterogeneous translucent materials with homogeneous BSSRDFs, and measure them
+/// against a reference volumetric path tracer.
+#[derive(Debug, Parser)]
+#[command(name = "het-bssrdf", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print a homogeneous radial profile R(r) as CSV, or its total diffuse reflectance.
+    Profile(profile::Args),
+}
+
+fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Profile(args) => profile::run(args),
+    }
+}
+
 fn main() -> ExitCode {
-    eprintln!("het-bssrdf: not yet implemented");
-    ExitCode::from(2)
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::from(1)
+        }
+    }
 }

@@ -10,6 +10,7 @@
 #![deny(missing_docs)]
 
 pub mod field;
+pub mod pattern;
 pub mod sampler;
 pub mod surface;
 

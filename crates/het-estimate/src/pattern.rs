@@ -1,0 +1,103 @@
+//! Procedural two-valued and linear patterns over a plane, shared by the analytic test plane of
+//! this crate and the tracer's procedural textures ("same definitions, same code").
+//!
+//! Coordinates `(x, y)` are in scene units in the pattern's own plane. Definitions:
+//! * stripe: `u = x cos θ + y sin θ`, `k = floor(u / w + 1/2)`, value = `values[k mod 2]`
+//!   (with `k mod 2 ∈ {0, 1}` for negative `k` too), so the band containing the origin
+//!   (`|u| < w/2`) has `values[0]`;
+//! * check: `k = floor(x / w + 1/2) + floor(y / w + 1/2)`, value = `values[k mod 2]`, so the
+//!   cell containing the origin has `values[0]`;
+//! * ramp: `v0 + gx·x + gy·y`, clamped below at 0 by users that need non-negative
+//!   coefficients.
+
+/// A pattern that selects one of two values at each point of its plane.
+pub trait BinaryPattern {
+    /// 0 or 1: which of the two values applies at `(x, y)`.
+    fn select(&self, x: f64, y: f64) -> usize;
+}
+
+#[inline]
+fn parity(k: f64) -> usize {
+    // rem_euclid keeps the parity in {0, 1} for negative k.
+    (k.rem_euclid(2.0) as usize) & 1
+}
+
+/// Parallel bands of width `width`, running along the direction `angle + 90°`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stripe {
+    /// Band width w (scene units, > 0).
+    pub width: f64,
+    /// θ in radians: bands vary along the direction (cos θ, sin θ).
+    pub angle: f64,
+}
+
+impl Stripe {
+    /// The stripe coordinate `u = x cos θ + y sin θ`.
+    #[inline]
+    pub fn u(&self, x: f64, y: f64) -> f64 {
+        x * self.angle.cos() + y * self.angle.sin()
+    }
+}
+
+impl BinaryPattern for Stripe {
+    #[inline]
+    fn select(&self, x: f64, y: f64) -> usize {
+        parity((self.u(x, y) / self.width + 0.5).floor())
+    }
+}
+
+/// A checkerboard of square cells of side `width`, aligned with the axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Check {
+    /// Cell side w (scene units, > 0).
+    pub width: f64,
+}
+
+impl BinaryPattern for Check {
+    #[inline]
+    fn select(&self, x: f64, y: f64) -> usize {
+        parity((x / self.width + 0.5).floor() + (y / self.width + 0.5).floor())
+    }
+}
+
+/// A linear function `v0 + gx·x + gy·y`: its average over any centrally symmetric region equals
+/// its value at the region's centre, which makes exact tests of averaging estimators possible.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ramp {
+    /// Value at the origin.
+    pub v0: f64,
+    /// Gradient (∂v/∂x, ∂v/∂y).
+    pub gradient: [f64; 2],
+}
+
+impl Ramp {
+    /// The ramp's value at `(x, y)` (may be negative away from the origin).
+    #[inline]
+    pub fn value(&self, x: f64, y: f64) -> f64 {
+        self.v0 + self.gradient[0] * x + self.gradient[1] * y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn origin_cell_has_value_zero_and_parity_alternates() {
+        let s = Stripe {
+            width: 4.0,
+            angle: std::f64::consts::FRAC_PI_4,
+        };
+        assert_eq!(s.select(0.0, 0.0), 0);
+        assert_eq!(s.select(3.0, 0.0), 1); // u = 2.12 > 2
+        assert_eq!(s.select(-3.0, 0.0), 1); // negative k: k = -1 -> parity 1
+        assert_eq!(s.select(-6.0, 0.0), 1); // u = -4.24: k = floor(-0.56) = -1
+        assert_eq!(s.select(-9.0, 0.0), 0); // u = -6.36: k = floor(-1.09) = -2
+        let c = Check { width: 4.0 };
+        assert_eq!(c.select(0.0, 0.0), 0);
+        assert_eq!(c.select(2.5, 0.0), 1);
+        assert_eq!(c.select(2.5, 2.5), 0);
+        assert_eq!(c.select(-2.5, 0.0), 1);
+        assert_eq!(c.select(-2.5, -2.5), 0);
+    }
+}
