@@ -27,3 +27,7 @@ pub mod rgb;
 pub use error::ParamError;
 pub use medium::MediumParams;
 pub use rgb::Rgb;
+pub mod directional_dipole;
+pub mod model;
+
+pub use model::{ProfileModel, Scattering, UnknownName};
