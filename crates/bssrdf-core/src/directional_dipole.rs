@@ -19,7 +19,7 @@ pub fn modified_normal(n_i: DVec3, x_i: DVec3, x_o: DVec3) -> DVec3 {
         .max_element()
         .max(x_o.abs().max_element())
         .max(1.0);
-    if !(len > 1e-12 * scale) {
+    if len.is_nan() || len <= 1e-12 * scale {
         return n;
     }
     let xh = chord / len;
