@@ -3,6 +3,6 @@
 //! like with like (same geometry, textures, camera, lights and film).
 #![deny(missing_docs)]
 
-pub mod error;
-pub mod geometry;
+pub mod render;
 pub mod rng;
+pub mod volume;
