@@ -15,19 +15,56 @@
 //!   with both pointing the way light travels, so forward scattering (`g > 0`) favours
 //!   `cos θ > 0`.
 //!
+//! # Using the profiles (renderer side)
+//! ```
+//! use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Scattering};
+//! // Once per material:
+//! let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.3)?;
+//! let table = ProfileTable::new(family);
+//! // Per (x_i, x_o) pair, with the estimated coefficients:
+//! let profile = family.profile(0.01, 1.0)?;
+//! let value = profile.eval(0.7); // 1/length²
+//! // Per shading point, radius sampling at x_o's coefficients:
+//! let sampler = table.sampler(0.01, 1.0)?;
+//! if let Some(r) = sampler.sample_r(0.3) {
+//!     let pdf = sampler.pdf_r(r);
+//!     assert!(pdf > 0.0 && value > 0.0);
+//! }
+//! let probe_len = sampler.radius_for_fraction(0.999);
+//! assert!(probe_len > 0.0);
+//! # Ok::<(), bssrdf_core::ParamError>(())
+//! ```
+//!
 //! References are keyed as in `docs/references.md` (JMLH01, HCJ13, dEI11, dE12, FHK14, …).
 #![deny(missing_docs)]
 
+pub mod beam_diffusion;
+pub mod better_dipole;
+pub mod dipole;
+mod dipole_pair;
+pub mod directional_dipole;
 pub mod error;
+pub mod family;
 pub mod fresnel;
 pub mod hg;
 pub mod medium;
+pub mod model;
+pub mod profile;
+mod quadrature;
 pub mod rgb;
+pub mod single_scattering;
+pub mod table;
 
 pub use error::ParamError;
+pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
+pub use fresnel::{DiffuseFresnel, FresnelMoments};
 pub use medium::MediumParams;
-pub use rgb::Rgb;
-pub mod directional_dipole;
-pub mod model;
-
 pub use model::{ProfileModel, Scattering, UnknownName};
+pub use profile::RadialProfile;
+pub use rgb::Rgb;
+pub use table::{ProfileTable, TableSampler};
+
+#[cfg(test)]
+mod known_answers;
+#[cfg(test)]
+mod test_util;
