@@ -3,6 +3,12 @@
 //! like with like (same geometry, textures, camera, lights and film).
 #![deny(missing_docs)]
 
+pub mod camera;
+pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod light;
+pub mod output;
 pub mod render;
 pub mod rng;
 pub mod volume;

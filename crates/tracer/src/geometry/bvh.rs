@@ -1,0 +1,511 @@
+//! [`Geometry`]: one obvhs CWBVH per object, triangles copied into BVH leaf order, the
+//! watertight triangle test in the traversal closure.
+//!
+//! One BVH per object makes the per-object queries of the BSSRDF methods
+//! ([`Geometry::intersect_object`], [`Geometry::for_each_object_hit`]) traverse only that
+//! object; the all-object queries loop over the objects (few in our scenes) after a bounding
+//! box test, shrinking the ray as hits are found.
+
+use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::time::Duration;
+
+use glam::{DVec2, DVec3, Vec3A};
+use obvhs::BvhBuildParams;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::ray::{Ray as BvhRay, RayHit};
+use obvhs::triangle::Triangle;
+
+use super::watertight::{LeafTri, ShearedRay, refine_f64};
+use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
+
+/// Target extent of an object in the BVH's scaled space (see the module docs of
+/// [`crate::geometry`]): 2¹².
+const SCALED_EXTENT_LOG2: i32 = 12;
+/// Largest coordinate magnitude allowed in scaled space: 2³².
+const SCALED_COORD_LOG2: i32 = 32;
+
+/// One object's acceleration structure.
+#[derive(Debug)]
+struct ObjectAccel {
+    bvh: Option<CwBvh>,
+    /// Triangles in BVH leaf order, scaled by `scale`.
+    tris: Vec<LeafTri>,
+    /// Leaf index → triangle index in the object's mesh.
+    prims: Vec<u32>,
+    /// Power of two mapping world to scaled coordinates.
+    scale: f64,
+    inv_scale: f64,
+    /// World-space bounds.
+    lo: DVec3,
+    hi: DVec3,
+}
+
+/// Scene geometry: triangle meshes (object id = index) with their BVHs, and the ray queries.
+///
+/// `Send + Sync`; every query takes `&self` and keeps its state on the stack (no allocation
+/// except in [`Geometry::for_each_object_hit`] beyond 32 crossings).
+#[derive(Debug)]
+pub struct Geometry {
+    objects: Vec<ObjectAccel>,
+    meshes: Vec<TriangleMesh>,
+    triangles: usize,
+    counter: RayCounter,
+}
+
+/// A relaxed, striped counter: each thread adds to its own cache line.
+#[derive(Debug)]
+struct RayCounter {
+    stripes: Box<[Padded]>,
+}
+
+#[derive(Debug, Default)]
+#[repr(align(64))]
+struct Padded(AtomicU64);
+
+const STRIPES: usize = 16;
+static NEXT_STRIPE: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    static STRIPE: Cell<usize> = const { Cell::new(usize::MAX) };
+}
+
+impl RayCounter {
+    fn new() -> Self {
+        Self {
+            stripes: (0..STRIPES).map(|_| Padded::default()).collect(),
+        }
+    }
+    #[inline]
+    fn add(&self, n: u64) {
+        let i = STRIPE.with(|s| {
+            let mut i = s.get();
+            if i == usize::MAX {
+                i = NEXT_STRIPE.fetch_add(1, Ordering::Relaxed) % STRIPES;
+                s.set(i);
+            }
+            i
+        });
+        self.stripes[i].0.fetch_add(n, Ordering::Relaxed);
+    }
+    fn total(&self) -> u64 {
+        self.stripes
+            .iter()
+            .map(|s| s.0.load(Ordering::Relaxed))
+            .sum()
+    }
+}
+
+/// `1/x` for the BVH node test, finite and with the sign convention of obvhs's octant test
+/// (`x < 0` ⇔ negative inverse; `±0` → `+1e30`).
+#[inline]
+fn safe_inv(x: f32) -> f32 {
+    if x == 0.0 {
+        1e30
+    } else {
+        (1.0 / x).clamp(-1e30, 1e30)
+    }
+}
+
+/// The `f32` ray of one object's scaled space.
+#[derive(Clone, Copy)]
+struct ScaledRay {
+    bvh: BvhRay,
+    sheared: ShearedRay,
+}
+
+impl ObjectAccel {
+    fn build(mesh: &TriangleMesh) -> Self {
+        let (lo, hi) = mesh.bounds();
+        let extent = (hi - lo).max_element();
+        let magnitude = lo.abs().max(hi.abs()).max_element();
+        let scale = if extent > 0.0 && extent.is_finite() {
+            let e = SCALED_EXTENT_LOG2 - extent.log2().ceil() as i32;
+            let e_max = if magnitude > 0.0 {
+                SCALED_COORD_LOG2 - magnitude.log2().ceil() as i32
+            } else {
+                e
+            };
+            2f64.powi(e.min(e_max).clamp(-120, 120))
+        } else {
+            1.0
+        };
+        if mesh.triangles.is_empty() {
+            return Self {
+                bvh: None,
+                tris: Vec::new(),
+                prims: Vec::new(),
+                scale,
+                inv_scale: 1.0 / scale,
+                lo,
+                hi,
+            };
+        }
+        let scaled: Vec<Triangle> = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let v = t.map(|k| {
+                    Vec3A::from((mesh.positions[k as usize].as_dvec3() * scale).as_vec3())
+                });
+                Triangle {
+                    v0: v[0],
+                    v1: v[1],
+                    v2: v[2],
+                }
+            })
+            .collect();
+        let bvh = build_cwbvh_from_tris(
+            &scaled,
+            BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let tris = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| {
+                let t = &scaled[i as usize];
+                LeafTri::new(t.v0.into(), t.v1.into(), t.v2.into())
+            })
+            .collect();
+        let prims = bvh.primitive_indices.clone();
+        Self {
+            bvh: Some(bvh),
+            tris,
+            prims,
+            scale,
+            inv_scale: 1.0 / scale,
+            lo,
+            hi,
+        }
+    }
+
+    #[inline]
+    fn scaled_ray(&self, ray: &Ray, t_min: f64, t_max: f64) -> ScaledRay {
+        let o = (ray.origin * self.scale).as_vec3();
+        let d = ray.dir.as_vec3();
+        let bvh = BvhRay {
+            origin: o.into(),
+            direction: d.into(),
+            inv_direction: Vec3A::new(safe_inv(d.x), safe_inv(d.y), safe_inv(d.z)),
+            tmin: (t_min * self.scale) as f32,
+            tmax: (t_max * self.scale) as f32,
+        };
+        ScaledRay {
+            bvh,
+            sheared: ShearedRay::new(o.to_array(), d.to_array()),
+        }
+    }
+
+    /// Slab test of the world bounds against `[t_min, t_max]` (conservative: padded).
+    #[inline]
+    fn may_hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> bool {
+        let pad = 1e-6 * (self.hi - self.lo).max_element() + 1e-30;
+        let inv = DVec3::ONE / ray.dir;
+        let t0 = (self.lo - pad - ray.origin) * inv;
+        let t1 = (self.hi + pad - ray.origin) * inv;
+        let near = t0.min(t1);
+        let far = t0.max(t1);
+        // NaN (0 · inf) components are ignored by max/min of f64 (they return the other).
+        let enter = near.max_element().max(t_min);
+        let exit = far.min_element().min(t_max);
+        enter <= exit
+    }
+
+    /// Closest hit in `[t_min, t_max]` (world units): `(leaf, t_world)`.
+    #[inline]
+    fn closest(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(u32, f64)> {
+        let bvh = self.bvh.as_ref()?;
+        let r = self.scaled_ray(ray, t_min, t_max);
+        let mut hit = RayHit::none();
+        let tris = &self.tris;
+        let sheared = r.sheared;
+        if bvh.ray_traverse(r.bvh, &mut hit, |br, id| {
+            match sheared.intersect(&tris[id], br.tmin, br.tmax) {
+                Some(h) => h.t,
+                None => f32::INFINITY,
+            }
+        }) {
+            Some((hit.primitive_id, hit.t as f64 * self.inv_scale))
+        } else {
+            None
+        }
+    }
+
+    #[inline]
+    fn any(&self, ray: &Ray) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let r = self.scaled_ray(ray, ray.t_min, ray.t_max);
+        let tris = &self.tris;
+        let sheared = r.sheared;
+        !bvh.ray_traverse_miss(r.bvh, |br, id| {
+            match sheared.intersect(&tris[id], br.tmin, br.tmax) {
+                Some(h) => h.t,
+                None => f32::INFINITY,
+            }
+        })
+    }
+}
+
+impl Geometry {
+    /// Builds one BVH per mesh; object `i` is `meshes[i]`. Meshes should have been validated
+    /// ([`TriangleMesh::prepare`]); an empty mesh gives an object that is never hit.
+    pub fn build(meshes: Vec<TriangleMesh>) -> Geometry {
+        let objects = meshes.iter().map(ObjectAccel::build).collect();
+        let triangles = meshes.iter().map(|m| m.triangles.len()).sum();
+        Geometry {
+            objects,
+            meshes,
+            triangles,
+            counter: RayCounter::new(),
+        }
+    }
+
+    /// Number of objects.
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Total number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles
+    }
+
+    /// The mesh of `object`.
+    pub fn mesh(&self, object: u32) -> &TriangleMesh {
+        &self.meshes[object as usize]
+    }
+
+    /// World-space bounds `(min, max)` of `object`.
+    pub fn object_bounds(&self, object: u32) -> (DVec3, DVec3) {
+        let o = &self.objects[object as usize];
+        (o.lo, o.hi)
+    }
+
+    /// Bounds of every object together.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.objects.iter().filter(|o| o.bvh.is_some()).fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), o| (lo.min(o.lo), hi.max(o.hi)),
+        )
+    }
+
+    /// Rays traced so far by every query of this geometry (each call of `intersect`,
+    /// `intersect_object`, `occluded`, `for_each_object_hit` counts one; `project` counts
+    /// two). Relaxed, per-thread striped atomics: cheap, exact once the threads are joined.
+    pub fn rays_traced(&self) -> u64 {
+        self.counter.total()
+    }
+
+    /// The closest intersection over all objects in `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.counter.add(1);
+        let mut best: Option<(u32, u32, f64)> = None;
+        let mut t_max = ray.t_max;
+        for (k, obj) in self.objects.iter().enumerate() {
+            if !obj.may_hit(ray, ray.t_min, t_max) {
+                continue;
+            }
+            if let Some((leaf, t)) = obj.closest(ray, ray.t_min, t_max) {
+                t_max = t;
+                best = Some((k as u32, leaf, t));
+            }
+        }
+        best.map(|(k, leaf, t)| self.make_hit(k, leaf, ray, t))
+    }
+
+    /// The closest intersection with `object`'s triangles in `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn intersect_object(&self, object: u32, ray: &Ray) -> Option<Hit> {
+        self.counter.add(1);
+        let obj = &self.objects[object as usize];
+        obj.closest(ray, ray.t_min, ray.t_max)
+            .map(|(leaf, t)| self.make_hit(object, leaf, ray, t))
+    }
+
+    /// True when any object is hit in `[ray.t_min, ray.t_max]` (stops at the first hit). For
+    /// a shadow ray toward a point use [`Ray::between`].
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.counter.add(1);
+        self.objects
+            .iter()
+            .any(|o| o.may_hit(ray, ray.t_min, ray.t_max) && o.any(ray))
+    }
+
+    /// Calls `f` for every crossing of the ray with `object` in `[ray.t_min, ray.t_max]`, in
+    /// increasing `t`. A ray through a shared edge or vertex is reported once (duplicates with
+    /// the same facing within a few `f32` ulps of each other are merged). No allocation up
+    /// to 32 crossings.
+    pub fn for_each_object_hit(&self, object: u32, ray: &Ray, mut f: impl FnMut(&Hit)) {
+        self.counter.add(1);
+        let obj = &self.objects[object as usize];
+        let Some(bvh) = obj.bvh.as_ref() else {
+            return;
+        };
+        let r = obj.scaled_ray(ray, ray.t_min, ray.t_max);
+        let mut buf = CrossingBuf::new();
+        let tris = &obj.tris;
+        let sheared = r.sheared;
+        bvh.ray_traverse_anyhit(r.bvh, |br, id| {
+            if let Some(h) = sheared.intersect(&tris[id], br.tmin, br.tmax) {
+                buf.push(Crossing {
+                    t: h.t,
+                    leaf: id as u32,
+                    front: h.det > 0.0,
+                });
+            }
+        });
+        let crossings = buf.sorted();
+        let o_mag = r.bvh.origin.abs().max_element();
+        let mut last: Option<Crossing> = None;
+        for c in crossings.iter() {
+            if let Some(l) = last {
+                let tol = 32.0 * f32::EPSILON * (c.t.abs() + o_mag);
+                if l.front == c.front && c.t - l.t <= tol {
+                    continue;
+                }
+            }
+            last = Some(*c);
+            let hit = self.make_hit(object, c.leaf, ray, c.t as f64 * obj.inv_scale);
+            f(&hit);
+        }
+    }
+
+    /// Builds the full hit record for leaf `leaf` of `object`: barycentrics and distance
+    /// refined in `f64`, position from the vertices, normals, texture coordinates.
+    #[inline]
+    fn make_hit(&self, object: u32, leaf: u32, ray: &Ray, t_approx: f64) -> Hit {
+        let obj = &self.objects[object as usize];
+        let tri = &obj.tris[leaf as usize];
+        let prim = obj.prims[leaf as usize];
+        let s = obj.inv_scale;
+        let v = [
+            tri.vertex_f64(0) * s,
+            tri.vertex_f64(1) * s,
+            tri.vertex_f64(2) * s,
+        ];
+        let (t, b) = refine_f64(ray.origin, ray.dir, v).unwrap_or((t_approx, [1.0 / 3.0; 3]));
+        let p = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        let mesh = &self.meshes[object as usize];
+        let (mut ns, mut uv) = (ng, DVec2::ZERO);
+        if mesh.normals.is_some() || mesh.uvs.is_some() {
+            let idx = mesh.triangles[prim as usize];
+            if let Some(normals) = &mesh.normals {
+                let n = b[0] * normals[idx[0] as usize].as_dvec3()
+                    + b[1] * normals[idx[1] as usize].as_dvec3()
+                    + b[2] * normals[idx[2] as usize].as_dvec3();
+                let n = n.normalize_or_zero();
+                if n != DVec3::ZERO {
+                    ns = if n.dot(ng) < 0.0 { -n } else { n };
+                }
+            }
+            if let Some(uvs) = &mesh.uvs {
+                uv = b[0] * uvs[idx[0] as usize].as_dvec2()
+                    + b[1] * uvs[idx[1] as usize].as_dvec2()
+                    + b[2] * uvs[idx[2] as usize].as_dvec2();
+            }
+        }
+        let lo = v[0].min(v[1]).min(v[2]);
+        let hi = v[0].max(v[1]).max(v[2]);
+        let p_error = OFFSET_REL * (p.abs().max_element() + (hi - lo).max_element());
+        Hit {
+            t,
+            p,
+            ng,
+            ns,
+            uv,
+            object,
+            prim,
+            bary: DVec2::new(b[1], b[2]),
+            p_error,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Crossing {
+    t: f32,
+    leaf: u32,
+    front: bool,
+}
+
+/// Up to 32 crossings on the stack, then a heap vector.
+struct CrossingBuf {
+    inline: [Crossing; 32],
+    n: usize,
+    heap: Vec<Crossing>,
+}
+
+impl CrossingBuf {
+    fn new() -> Self {
+        Self {
+            inline: [Crossing {
+                t: 0.0,
+                leaf: 0,
+                front: false,
+            }; 32],
+            n: 0,
+            heap: Vec::new(),
+        }
+    }
+    #[inline]
+    fn push(&mut self, c: Crossing) {
+        if self.n < self.inline.len() {
+            self.inline[self.n] = c;
+            self.n += 1;
+        } else {
+            if self.heap.is_empty() {
+                self.heap.extend_from_slice(&self.inline);
+            }
+            self.heap.push(c);
+        }
+    }
+    fn sorted(&mut self) -> &[Crossing] {
+        let s: &mut [Crossing] = if self.heap.is_empty() {
+            &mut self.inline[..self.n]
+        } else {
+            &mut self.heap
+        };
+        s.sort_unstable_by(|a, b| a.t.total_cmp(&b.t));
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::primitives;
+
+    #[test]
+    fn simple_queries() {
+        let g = Geometry::build(vec![
+            primitives::cuboid(DVec3::splat(-1.0), DVec3::splat(1.0)),
+            primitives::icosphere(DVec3::new(0.0, 0.0, 5.0), 1.0, 3),
+        ]);
+        assert_eq!(g.object_count(), 2);
+        let r = Ray::new(DVec3::new(0.1, 0.2, 10.0), DVec3::NEG_Z);
+        let h = g.intersect(&r).unwrap();
+        assert_eq!(h.object, 1, "{h:?}");
+        assert!(
+            (h.p.z - 6.0).abs() < 0.05 && (h.t - (10.0 - h.p.z)).abs() < 1e-12,
+            "{h:?}"
+        );
+        assert!(h.ng.z > 0.9 && h.ns.z > 0.9);
+        let h0 = g.intersect_object(0, &r).unwrap();
+        assert_eq!(h0.object, 0);
+        assert!((h0.p.z - 1.0).abs() < 1e-12 && (h0.t - 9.0).abs() < 1e-12);
+        assert!(h0.ng.abs_diff_eq(DVec3::Z, 1e-12));
+        assert!(g.occluded(&r));
+        assert!(!g.occluded(&Ray::segment(r.origin, r.dir, 3.0)));
+        let mut ts = Vec::new();
+        g.for_each_object_hit(0, &r, |h| ts.push(h.t));
+        assert_eq!(ts.len(), 2);
+        assert!((ts[0] - 9.0).abs() < 1e-12 && (ts[1] - 11.0).abs() < 1e-12);
+        assert!(g.rays_traced() >= 5);
+    }
+}

@@ -1,0 +1,52 @@
+//! Wavefront OBJ loading through tobj (feature `obj`).
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::TriangleMesh;
+use crate::error::MeshError;
+
+/// Loads every object and group of an OBJ file into one mesh (faces triangulated, one index
+/// per vertex; materials are ignored). Normals are kept only when every part has them;
+/// texture coordinates when any part has them (see [`TriangleMesh::append`]). The mesh is not
+/// validated here: call [`TriangleMesh::prepare`].
+pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
+    let file = path.display().to_string();
+    let (models, _materials) =
+        tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| MeshError::Load {
+            file: file.clone(),
+            message: e.to_string(),
+        })?;
+    let mut mesh = TriangleMesh::default();
+    for m in &models {
+        let m = &m.mesh;
+        let n = m.positions.len() / 3;
+        let part = TriangleMesh {
+            positions: m
+                .positions
+                .chunks_exact(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect(),
+            normals: (m.normals.len() == 3 * n && n > 0).then(|| {
+                m.normals
+                    .chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]))
+                    .collect()
+            }),
+            uvs: (m.texcoords.len() == 2 * n && n > 0).then(|| {
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|c| Vec2::new(c[0], c[1]))
+                    .collect()
+            }),
+            triangles: m
+                .indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+        };
+        mesh.append(&part);
+    }
+    Ok(mesh)
+}
