@@ -2,6 +2,8 @@
 
 use bssrdf_core::Rgb;
 
+use crate::ellipse::PlanarEllipse;
+
 /// Absorption and scattering coefficients per colour channel, in 1/length.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Coefficients {
@@ -74,6 +76,18 @@ pub trait CoefficientField<P> {
     fn bounds(&self) -> Option<FieldBounds> {
         None
     }
+
+    /// Optional capability: the exact (or prefiltered) area average of Eq. (3) of the paper
+    /// over `region`, i.e. the mean of the coefficients at the projections of the ellipse's
+    /// points onto the surface along `±region.normal`, uniformly weighted by area in the
+    /// ellipse's plane. Fields that can answer in constant time (summed-area tables, EWA over
+    /// a texture, closed forms) override this; the Sone estimator then asks it before sampling
+    /// (see `SoneParams::use_field_average`). The default, `None`, means "not supported:
+    /// sample it", and costs nothing.
+    fn ellipse_average(&self, region: &PlanarEllipse) -> Option<Coefficients> {
+        let _ = region;
+        None
+    }
 }
 
 impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
@@ -82,5 +96,8 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn bounds(&self) -> Option<FieldBounds> {
         (**self).bounds()
+    }
+    fn ellipse_average(&self, region: &PlanarEllipse) -> Option<Coefficients> {
+        (**self).ellipse_average(region)
     }
 }

@@ -1,20 +1,88 @@
 //! Estimate the homogeneous BSSRDF parameters that stand in for a heterogeneous medium
 //! between an incident point `x_i` and an exitant point `x_o` (Sone, Hachisuka & Koike,
-//! "Parameter Estimation of BSSRDF for Heterogeneous Materials").
+//! "Parameter Estimation of BSSRDF for Heterogeneous Materials"; key `Sone` in
+//! `docs/references.md`).
 //!
-//! The crate knows nothing about meshes, BVHs or images. A renderer implements two traits:
-//! * [`SurfaceQuery`]: project a point of the averaging plane onto the object being shaded by
-//!   tracing two rays along ± the plane normal (the paper's Figure 3);
-//! * [`CoefficientField`]: look up σa and σs (per colour channel) at a surface point, and say
-//!   cheaply whether the field is constant or bounded.
+//! # Use
+//! ```
+//! use het_estimate::analytic::{Plane, PlanePoint, StripeField};
+//! use het_estimate::pattern::Stripe;
+//! use het_estimate::{Coefficients, Estimator, SplitMix64};
+//!
+//! // Once per material: pick an estimator (e.g. parsed from the CLI) and resolve ⟨θ²⟩ for g.
+//! let prepared = "sone".parse::<Estimator>().unwrap().prepare(0.0).unwrap();
+//! // Per (x_i, x_o) pair, with the renderer's surface, field, points and random stream.
+//! let field = StripeField {
+//!     pattern: Stripe { width: 4.0, angle: std::f64::consts::FRAC_PI_4 },
+//!     values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+//! };
+//! let mut rng = SplitMix64::new(1);
+//! let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(5.0, 1.0));
+//! let est = prepared.estimate(&Plane, &field, &x_i, &x_o, &mut rng);
+//! let c = est.coefficients; // feed c.sigma_a, c.sigma_s to the homogeneous profile at r = d
+//! assert!(c.is_valid() && c.sigma_s[0] == 1.0); // σs is constant here: taken from the bounds
+//! ```
+//!
+//! # Design
+//! * **Two traits, implemented by the renderer.** The crate knows nothing about meshes, BVHs
+//!   or images (it sits between `bssrdf-core` and the tracer, like pbrt's BSSRDF layer).
+//!   [`SurfaceQuery`] projects a point of the averaging plane onto the object being shaded by
+//!   two rays along ± the plane normal (the paper's Figure 3); [`CoefficientField`] looks up
+//!   σa, σs per colour channel at a surface point and may report bounds (so constant fields
+//!   cost nothing) or an exact/prefiltered ellipse average (so summed-area tables or EWA can
+//!   replace sampling). Geometry and texturing are separate because they vary separately
+//!   (one mesh, many textures; one procedural field, many shapes), and because tests and
+//!   benchmarks substitute analytic versions of each ([`analytic`]). The point type is the
+//!   renderer's (`SurfaceQuery::Point`), so a lookup can use triangle ids and UVs.
+//! * **A closed set, resolved once.** [`Estimator`] is an enum (names `jensen-in`,
+//!   `jensen-out`, `endpoints`, `segment`, `sone`); [`Estimator::prepare`] validates it and
+//!   computes the per-material constants (the exact ⟨θ²⟩ is a ~1 µs quadrature) into a
+//!   [`PreparedEstimator`], whose [`PreparedEstimator::estimate`] dispatches once per pair to
+//!   a generic loop over the samples (no allocation, no dynamic dispatch inside).
+//! * **Caller-provided randomness** ([`UniformSource`]) keeps renders deterministic per seed.
+//!   Region estimators use randomly shifted low-discrepancy points ([`sampling`]).
+//! * **Always a usable answer.** Coefficients are finite and ≥ 0; invalid field values are a
+//!   caller bug (debug assertion) and are sanitised in release builds; misses, degenerate
+//!   chords and degenerate widths have explicit, documented limits; [`Diagnostics`] reports
+//!   what happened (samples, projections, misses, short-circuits, fallbacks, the width).
+//!
+//! # Conventions
+//! Lengths in scene units, coefficients in 1/length, f64 throughout. Normals point out of the
+//! medium. Colour is linear RGB ([`Rgb`]), each channel estimated separately (sharing samples).
+//! Estimates are symmetric in x_i ↔ x_o whenever both points have the same normal
+//! (canonical chord orientation; see the Sone docs for n_i ≠ n_o).
 #![deny(missing_docs)]
 
+#[macro_use]
+pub mod names;
+
+pub mod analytic;
+pub mod budget;
+mod chord;
+pub mod ellipse;
+pub mod estimate;
+pub mod estimator;
 pub mod field;
+mod known;
+pub mod path_integral;
 pub mod pattern;
+mod point_lookup;
+mod region_average;
 pub mod sampler;
+pub mod sampling;
+pub mod segment;
+pub mod sone;
 pub mod surface;
 
 pub use bssrdf_core::Rgb;
+pub use budget::{MissPolicy, SampleBudget};
+pub use ellipse::PlanarEllipse;
+pub use estimate::{Diagnostics, Estimate, Region};
+pub use estimator::{Estimator, PreparedEstimator};
 pub use field::{CoefficientField, Coefficients, FieldBounds};
-pub use sampler::UniformSource;
+pub use names::Named;
+pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
+pub use sampler::{SplitMix64, UniformSource};
+pub use segment::SegmentParams;
+pub use sone::SoneParams;
 pub use surface::{SurfacePoint, SurfaceQuery};

@@ -1,0 +1,160 @@
+//! The chord x_i–x_o and the averaging plane through it (paper §3.1, Figure 3).
+
+use bssrdf_core::directional_dipole::modified_normal;
+use glam::DVec3;
+
+use crate::ellipse::PlanarEllipse;
+
+/// Chords shorter than this fraction of the coordinates' magnitude are treated as d = 0
+/// (their direction is rounding noise).
+const DEGENERATE_CHORD: f64 = 1e-12;
+/// A plane normal whose cosine with the chord exceeds this is not perpendicular to it.
+const NOT_PERPENDICULAR: f64 = 1e-6;
+
+/// The chord and its averaging frame.
+///
+/// Orientation is canonical: the chord direction x̂ is ±(x_o − x_i)/d with the sign chosen so
+/// that x̂ is lexicographically positive, and all points are built from the midpoint m. So
+/// swapping x_i and x_o gives bit-identical sample points whenever the plane normal is the same
+/// (on a plane, or n_i = n_o), which makes every estimator exactly symmetric there
+/// (reciprocity), with the same random numbers.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Chord {
+    /// Midpoint m = (x_i + x_o)/2.
+    pub mid: DVec3,
+    /// Half the chord length, d/2.
+    pub half_len: f64,
+    /// Unit chord direction x̂ (canonical sign).
+    pub x_hat: DVec3,
+    /// Unit normal of the averaging plane: FHK14's modified normal n_i*, ⟂ x̂.
+    pub normal: DVec3,
+    /// Unit in-plane direction n_i* × x̂ of the minor axis.
+    pub minor_dir: DVec3,
+    /// n_i* was undefined (n_i ∥ x̂) and a fallback was used.
+    pub normal_fallback: bool,
+}
+
+impl Chord {
+    /// The chord and frame for (x_i, n_i) → (x_o, n_o); `None` when d is 0 (or below
+    /// rounding noise, or the positions are not finite), where the region estimators reduce
+    /// to point lookups.
+    ///
+    /// Plane normal: n_i* = `modified_normal(n_i, x_i, x_o)` (FHK14, as the paper says).
+    /// When n_i ∥ x̂ it is undefined; we then try n_o's modified normal, and failing that any
+    /// unit vector ⟂ x̂ (the averaging plane must contain the chord).
+    pub fn new(x_i: DVec3, n_i: DVec3, x_o: DVec3, n_o: DVec3) -> Option<Self> {
+        let diff = x_o - x_i;
+        let d = diff.length();
+        let scale = x_i.abs().max_element().max(x_o.abs().max_element());
+        if !(d.is_finite() && scale.is_finite()) || d == 0.0 || d <= DEGENERATE_CHORD * scale {
+            return None;
+        }
+        let mut x_hat = diff / d;
+        if x_hat.x < 0.0 || (x_hat.x == 0.0 && (x_hat.y < 0.0 || (x_hat.y == 0.0 && x_hat.z < 0.0)))
+        {
+            x_hat = -x_hat;
+        }
+        let perpendicular = |n: DVec3| n.is_finite() && n.dot(x_hat).abs() <= NOT_PERPENDICULAR;
+        let mut normal = modified_normal(n_i, x_i, x_o);
+        let mut normal_fallback = false;
+        if !perpendicular(normal) {
+            normal_fallback = true;
+            normal = modified_normal(n_o, x_i, x_o);
+            if !perpendicular(normal) {
+                normal = x_hat.any_orthonormal_vector();
+            }
+        }
+        let minor_dir = normal.cross(x_hat).normalize();
+        Some(Self {
+            mid: 0.5 * (x_i + x_o),
+            half_len: 0.5 * d,
+            x_hat,
+            normal,
+            minor_dir,
+            normal_fallback,
+        })
+    }
+
+    /// Chord length d.
+    pub fn length(&self) -> f64 {
+        2.0 * self.half_len
+    }
+
+    /// The point of the chord at parameter `t` ∈ [0, 1] (t = ½ is the midpoint).
+    #[inline]
+    pub fn point(&self, t: f64) -> DVec3 {
+        self.mid + ((2.0 * t - 1.0) * self.half_len) * self.x_hat
+    }
+
+    /// The ellipse in the averaging plane with semi-major axis d/2 along x̂ and semi-minor
+    /// axis `b` along n_i* × x̂, centred at m (b = d/2 gives the step-1 disk).
+    pub fn ellipse(&self, b: f64) -> PlanarEllipse {
+        PlanarEllipse {
+            center: self.mid,
+            semi_major: self.half_len * self.x_hat,
+            semi_minor: b * self.minor_dir,
+            normal: self.normal,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal_and_contains_the_chord() {
+        let x_i = DVec3::new(0.3, -1.0, 0.2);
+        let x_o = DVec3::new(-2.0, 0.5, 0.9);
+        let n_i = DVec3::new(0.1, 0.2, 1.0).normalize();
+        let c = Chord::new(x_i, n_i, x_o, DVec3::Z).unwrap();
+        assert!(!c.normal_fallback);
+        for (a, b) in [
+            (c.x_hat, c.normal),
+            (c.x_hat, c.minor_dir),
+            (c.normal, c.minor_dir),
+        ] {
+            assert!(a.dot(b).abs() < 1e-12);
+        }
+        for v in [c.x_hat, c.normal, c.minor_dir] {
+            assert!((v.length() - 1.0).abs() < 1e-12);
+        }
+        // The endpoints are the chord's ends (in some order).
+        let (p0, p1) = (c.point(0.0), c.point(1.0));
+        let ok = |p: DVec3, q: DVec3| (p - q).length() < 1e-12;
+        assert!((ok(p0, x_i) && ok(p1, x_o)) || (ok(p0, x_o) && ok(p1, x_i)));
+        // The plane through m with normal n_i* contains x_i and x_o.
+        assert!((x_i - c.mid).dot(c.normal).abs() < 1e-12);
+        assert!((x_o - c.mid).dot(c.normal).abs() < 1e-12);
+    }
+
+    #[test]
+    fn swapping_the_endpoints_gives_the_same_frame() {
+        let x_i = DVec3::new(0.3, -1.0, 0.0);
+        let x_o = DVec3::new(-2.0, 0.5, 0.0);
+        let a = Chord::new(x_i, DVec3::Z, x_o, DVec3::Z).unwrap();
+        let b = Chord::new(x_o, DVec3::Z, x_i, DVec3::Z).unwrap();
+        assert_eq!(a.mid, b.mid);
+        assert_eq!(a.x_hat, b.x_hat);
+        assert_eq!(a.normal, b.normal);
+        assert_eq!(a.minor_dir, b.minor_dir);
+    }
+
+    #[test]
+    fn degenerate_cases() {
+        let p = DVec3::new(1.0, 2.0, 3.0);
+        assert!(Chord::new(p, DVec3::Z, p, DVec3::Z).is_none());
+        assert!(Chord::new(p, DVec3::Z, p + DVec3::splat(1e-14), DVec3::Z).is_none());
+        assert!(Chord::new(p, DVec3::Z, DVec3::splat(f64::NAN), DVec3::Z).is_none());
+        // n_i ∥ chord and n_o ∥ chord: any perpendicular normal.
+        let c = Chord::new(DVec3::ZERO, DVec3::Z, DVec3::new(0.0, 0.0, -2.0), -DVec3::Z).unwrap();
+        assert!(c.normal_fallback);
+        assert!(c.normal.dot(c.x_hat).abs() < 1e-12);
+        assert!((c.minor_dir.length() - 1.0).abs() < 1e-12);
+        // n_i ∥ chord but n_o usable.
+        let n_o = DVec3::new(1.0, 0.0, 1.0).normalize();
+        let c = Chord::new(DVec3::ZERO, DVec3::Z, DVec3::new(0.0, 0.0, 1.0), n_o).unwrap();
+        assert!(c.normal_fallback);
+        assert!((c.normal - DVec3::X).length() < 1e-12);
+    }
+}

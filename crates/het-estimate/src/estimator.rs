@@ -1,0 +1,169 @@
+//! The closed set of estimators, resolved once per material ([`Estimator::prepare`]) and then
+//! run per (x_i, x_o) pair ([`PreparedEstimator::estimate`]).
+
+use bssrdf_core::ParamError;
+
+use crate::estimate::{Estimate, Region};
+use crate::field::CoefficientField;
+use crate::known::Known;
+use crate::names::Named;
+use crate::point_lookup;
+use crate::region_average::Probe;
+use crate::sampler::UniformSource;
+use crate::segment::{self, SegmentParams};
+use crate::sone::{self, SoneParams};
+use crate::surface::SurfaceQuery;
+
+/// How the homogeneous parameters for a pair (x_i, x_o) are estimated.
+///
+/// Names (`Display`/`FromStr`, used by the CLI and scene files): `jensen-in`, `jensen-out`,
+/// `endpoints`, `segment`, `sone`. Parsing a name gives the variant with default parameters.
+///
+/// New methods (a diffusion-theory averaging kernel, prefiltered constant-time averaging, …)
+/// are one more variant each, with their parameters in their own module.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Estimator {
+    /// Jensen et al. (JMLH01): the coefficients at the incident point x_i.
+    JensenIn,
+    /// Jensen et al. evaluated at the exitant point x_o, as in the paper's Figure 4.
+    JensenOut,
+    /// d'Eon & Irving (dEI11) as the paper describes it, in its literal reading:
+    /// ½(σ(x_i) + σ(x_o)). The paper's baseline.
+    Endpoints,
+    /// Mean along the chord x_i–x_o projected onto the surface (the other reading of the
+    /// paper's description of dEI11; not attributed to dEI11).
+    Segment(SegmentParams),
+    /// Sone, Hachisuka & Koike (paper §3): averages over the path-integral ellipse.
+    Sone(SoneParams),
+}
+
+impl Named for Estimator {
+    const WHAT: &'static str = "estimator";
+    const ALL: &'static [Self] = &[
+        Estimator::JensenIn,
+        Estimator::JensenOut,
+        Estimator::Endpoints,
+        Estimator::Segment(SegmentParams::new()),
+        Estimator::Sone(SoneParams::paper()),
+    ];
+    fn name(self) -> &'static str {
+        match self {
+            Estimator::JensenIn => "jensen-in",
+            Estimator::JensenOut => "jensen-out",
+            Estimator::Endpoints => "endpoints",
+            Estimator::Segment(_) => "segment",
+            Estimator::Sone(_) => "sone",
+        }
+    }
+}
+
+named_display_fromstr!(Estimator);
+
+impl Estimator {
+    /// The name used on the command line and in scene files.
+    pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
+
+    /// Validates the parameters and resolves the per-material constants (⟨θ²⟩ for Sone:
+    /// the exact value costs ~1 µs, so do this once per material, outside the pixel loop).
+    ///
+    /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1). Errors: `g` not
+    /// finite or out of range; a `SampleBudget::TargetRelError` with a non-positive or
+    /// non-finite target.
+    pub fn prepare(self, g: f64) -> Result<PreparedEstimator, ParamError> {
+        // Validate g for every estimator, so that a bad material fails early whatever is chosen.
+        let theta2_of = |m: crate::path_integral::MeanSquareAngle| m.evaluate(g);
+        let theta2 = match self {
+            Estimator::JensenIn | Estimator::JensenOut | Estimator::Endpoints => {
+                theta2_of(Default::default())?;
+                0.0
+            }
+            Estimator::Segment(p) => {
+                theta2_of(Default::default())?;
+                p.samples.validate()?;
+                0.0
+            }
+            Estimator::Sone(p) => {
+                p.disk.validate()?;
+                p.ellipse.validate()?;
+                theta2_of(p.mean_square_angle)?
+            }
+        };
+        Ok(PreparedEstimator {
+            estimator: self,
+            theta2,
+        })
+    }
+}
+
+/// An estimator with its per-material constants resolved. Cheap to copy and share between
+/// threads; [`PreparedEstimator::estimate`] takes `&self`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedEstimator {
+    estimator: Estimator,
+    theta2: f64,
+}
+
+impl PreparedEstimator {
+    /// The estimator this was prepared from.
+    pub fn estimator(&self) -> Estimator {
+        self.estimator
+    }
+
+    /// ⟨θ²⟩ (rad²) used in Eq. (2), for the Sone estimator.
+    pub fn mean_square_angle(&self) -> Option<f64> {
+        matches!(self.estimator, Estimator::Sone(_)).then_some(self.theta2)
+    }
+
+    /// Estimates the homogeneous σa and σs (per channel) for the pair (`x_i`, `x_o`) of
+    /// surface points of the object that `surface` and `field` describe.
+    ///
+    /// * `x_i`, `x_o`: incident and exitant points as the renderer's point type (their
+    ///   normals orient the averaging plane; their own coefficients are looked up directly).
+    /// * `rng`: the caller's uniform stream; fixed budgets draw 2 numbers per averaging stage
+    ///   (1 for `segment`), point lookups none.
+    ///
+    /// Never allocates, never panics on valid input; the coefficients are always finite and
+    /// ≥ 0. If `field.bounds()` says the field is constant, the constant is returned without
+    /// any lookup or projection ([`crate::Diagnostics::short_circuit`]); components that the
+    /// bounds show to be constant are not averaged.
+    pub fn estimate<S, F, U>(
+        &self,
+        surface: &S,
+        field: &F,
+        x_i: &S::Point,
+        x_o: &S::Point,
+        rng: &mut U,
+    ) -> Estimate
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+        U: UniformSource + ?Sized,
+    {
+        let known = Known::new(field.bounds());
+        let mut probe = Probe::new(surface, field, x_i, x_o);
+        if let Some(c) = known.constant_field() {
+            probe.diag.short_circuit = true;
+            probe.diag.region = Region::Constant;
+            probe.diag.constant_components = 6;
+            return Estimate {
+                coefficients: c,
+                diagnostics: probe.diag,
+            };
+        }
+        probe.diag.constant_components = known.constant_components();
+        let raw = match &self.estimator {
+            Estimator::JensenIn => point_lookup::single_point(&mut probe, true),
+            Estimator::JensenOut => point_lookup::single_point(&mut probe, false),
+            Estimator::Endpoints => point_lookup::endpoints(&mut probe),
+            Estimator::Segment(p) => segment::estimate(p, &mut probe, &known, rng),
+            Estimator::Sone(p) => sone::estimate(p, self.theta2, &mut probe, &known, rng),
+        };
+        Estimate {
+            coefficients: known.finish(raw),
+            diagnostics: probe.diag,
+        }
+    }
+}

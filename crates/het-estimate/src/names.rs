@@ -1,0 +1,61 @@
+//! Closed sets of options with stable names (the CLI and scene files use these names), and the
+//! shared parameter checks.
+
+use bssrdf_core::{ParamError, UnknownName};
+
+/// A closed set of named choices (estimators and their options). `Display`/`FromStr` of
+/// these types use exactly [`Named::name`]; [`Named::ALL`] lists the choices, e.g. for CLI help.
+pub trait Named: Copy + 'static {
+    /// What is being named, for error messages ("estimator", …).
+    const WHAT: &'static str;
+    /// Every choice, in documentation order.
+    const ALL: &'static [Self];
+    /// The stable name of this choice.
+    fn name(self) -> &'static str;
+}
+
+/// Parses one of `T::ALL` by exact name.
+pub(crate) fn parse_named<T: Named>(s: &str) -> Result<T, UnknownName> {
+    T::ALL
+        .iter()
+        .copied()
+        .find(|v| v.name() == s)
+        .ok_or_else(|| UnknownName {
+            what: T::WHAT,
+            given: s.to_string(),
+            expected: T::ALL
+                .iter()
+                .map(|v| v.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+/// Checks that `value` is finite and `>= 0`.
+pub(crate) fn check_non_negative(name: &'static str, value: f64) -> Result<f64, ParamError> {
+    if !value.is_finite() {
+        return Err(ParamError::NotFinite { name, value });
+    }
+    if value < 0.0 {
+        return Err(ParamError::Negative { name, value });
+    }
+    Ok(value)
+}
+
+/// Implements `Display` (the name) and `FromStr` (exact name, error `UnknownName`) for types
+/// implementing [`Named`].
+macro_rules! named_display_fromstr {
+    ($($t:ty),* $(,)?) => {$(
+        impl ::std::fmt::Display for $t {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
+                f.write_str($crate::names::Named::name(*self))
+            }
+        }
+        impl ::std::str::FromStr for $t {
+            type Err = ::bssrdf_core::UnknownName;
+            fn from_str(s: &str) -> Result<Self, Self::Err> {
+                $crate::names::parse_named(s)
+            }
+        }
+    )*};
+}
