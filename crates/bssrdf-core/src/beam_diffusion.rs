@@ -45,8 +45,8 @@ use crate::better_dipole::BetterDipole;
 use crate::dipole_pair::DipolePair;
 use crate::fresnel::FresnelMoments;
 use crate::profile::{
-    Exponential, RadialProfile, TWO_PI, clean_f, clean_r, clean_u, numeric_radius_for_fraction,
-    numeric_total,
+    Exponential, RadialProfile, TWO_PI, clean_f, clean_u, numeric_radius_for_fraction,
+    numeric_total, optical,
 };
 use crate::quadrature::{gl8, laguerre16};
 use std::f64::consts::PI;
@@ -165,7 +165,7 @@ impl BeamDiffusionMs {
 
 impl RadialProfile for BeamDiffusionMs {
     fn eval(&self, r: f64) -> f64 {
-        self.scale * self.scale * self.eval_optical(clean_r(r) * self.scale)
+        self.scale * self.scale * self.eval_optical(optical(r, self.scale))
     }
     fn total(&self) -> f64 {
         numeric_total(|x| TWO_PI * x * self.eval_optical(x))
@@ -180,7 +180,7 @@ impl RadialProfile for BeamDiffusionMs {
         Some(x / self.scale)
     }
     fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.proposal_pdf(clean_r(r) * self.scale)
+        self.scale * self.proposal_pdf(optical(r, self.scale))
     }
     fn radius_for_fraction(&self, f: f64) -> f64 {
         let f = clean_f(f);

@@ -34,7 +34,7 @@
 
 use crate::dipole_pair::DipolePair;
 use crate::fresnel::FresnelMoments;
-use crate::profile::{RadialProfile, clean_f, clean_r, clean_u};
+use crate::profile::{RadialProfile, clean_f, clean_u, optical};
 
 /// The better-dipole profile for one set of coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,7 +76,7 @@ impl BetterDipole {
 
 impl RadialProfile for BetterDipole {
     fn eval(&self, r: f64) -> f64 {
-        let x = clean_r(r) * self.scale;
+        let x = optical(r, self.scale);
         self.scale * self.scale * self.pair.eval(x)
     }
     fn total(&self) -> f64 {
@@ -87,7 +87,7 @@ impl RadialProfile for BetterDipole {
         (self.pair.total() > 0.0).then(|| self.pair.quantile(u) / self.scale)
     }
     fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.pair.pdf(clean_r(r) * self.scale)
+        self.scale * self.pair.pdf(optical(r, self.scale))
     }
     fn radius_for_fraction(&self, f: f64) -> f64 {
         self.pair.quantile(clean_f(f)) / self.scale

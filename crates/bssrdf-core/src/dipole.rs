@@ -27,7 +27,7 @@
 //! Radius sampling inverts the closed-form CDF, so `pdf_r = 2πr R_d / R_d,tot` exactly.
 
 use crate::dipole_pair::DipolePair;
-use crate::profile::{RadialProfile, clean_f, clean_r, clean_u};
+use crate::profile::{RadialProfile, clean_f, clean_u, optical};
 
 /// The classical dipole profile for one set of coefficients (construct through
 /// [`crate::family::ProfileFamily::profile`], or [`Dipole::new`]).
@@ -72,7 +72,7 @@ impl Dipole {
 
 impl RadialProfile for Dipole {
     fn eval(&self, r: f64) -> f64 {
-        let x = clean_r(r) * self.scale;
+        let x = optical(r, self.scale);
         self.scale * self.scale * self.pair.eval(x)
     }
     fn total(&self) -> f64 {
@@ -83,7 +83,7 @@ impl RadialProfile for Dipole {
         (self.pair.total() > 0.0).then(|| self.pair.quantile(u) / self.scale)
     }
     fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.pair.pdf(clean_r(r) * self.scale)
+        self.scale * self.pair.pdf(optical(r, self.scale))
     }
     fn radius_for_fraction(&self, f: f64) -> f64 {
         self.pair.quantile(clean_f(f)) / self.scale

@@ -67,4 +67,8 @@ pub use table::{ProfileTable, TableSampler};
 #[cfg(test)]
 mod known_answers;
 #[cfg(test)]
+mod sampling_tests;
+#[cfg(test)]
+mod stability_tests;
+#[cfg(test)]
 mod test_util;

@@ -42,6 +42,13 @@ pub(crate) fn clean_r(r: f64) -> f64 {
     if r > 0.0 { r } else { 0.0 }
 }
 
+/// Optical radius `x = k·r` of a sanitised `r`, capped at 1e100 (every profile is 0 to f64
+/// precision long before; the cap keeps `x²` finite so that no `inf·0` can arise).
+#[inline]
+pub(crate) fn optical(r: f64, k: f64) -> f64 {
+    (clean_r(r) * k).min(1e100)
+}
+
 /// Sanitises a uniform number to `[0, 1)`; `None` for NaN.
 #[inline]
 pub(crate) fn clean_u(u: f64) -> Option<f64> {

@@ -38,7 +38,7 @@ use crate::beam_diffusion::{X_FLOOR, depth_integral};
 use crate::fresnel::dielectric;
 use crate::hg;
 use crate::profile::{
-    Exponential, RadialProfile, TWO_PI, clean_f, clean_r, clean_u, numeric_radius_for_fraction,
+    Exponential, RadialProfile, TWO_PI, clean_f, clean_u, numeric_radius_for_fraction, optical,
 };
 use crate::quadrature::{gl32, integrate};
 
@@ -125,7 +125,7 @@ impl SingleScattering {
 
 impl RadialProfile for SingleScattering {
     fn eval(&self, r: f64) -> f64 {
-        self.scale * self.scale * self.eval_optical(clean_r(r) * self.scale)
+        self.scale * self.scale * self.eval_optical(optical(r, self.scale))
     }
     fn total(&self) -> f64 {
         let mu_c = self.tan_c * self.inv_eta; // √(η²−1)/η = √(1 − 1/η²)
@@ -143,7 +143,7 @@ impl RadialProfile for SingleScattering {
         Some(self.proposal().sample(u) / self.scale)
     }
     fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.proposal().pdf(clean_r(r) * self.scale)
+        self.scale * self.proposal().pdf(optical(r, self.scale))
     }
     fn radius_for_fraction(&self, f: f64) -> f64 {
         let f = clean_f(f);

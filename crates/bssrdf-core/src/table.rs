@@ -28,7 +28,7 @@
 
 use crate::error::ParamError;
 use crate::family::{ProfileFamily, SIGMA_EPSILON, validate_sigmas};
-use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_r, clean_u};
+use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_r, clean_u, optical};
 
 const ROWS: usize = 48;
 const COLS: usize = 128;
@@ -387,7 +387,7 @@ impl RadialProfile for TableSampler<'_> {
         if self.is_zero() {
             return 0.0;
         }
-        let x = clean_r(r) * self.scale;
+        let x = optical(r, self.scale);
         let mut v = 0.0;
         for (i, w) in self.rows() {
             if w > 0.0 {
