@@ -2,10 +2,14 @@
 //! and `η` (and computes the Fresnel moments once); [`ProfileFamily::profile`] then builds the
 //! [`Profile`] for any `(σa, σs)` in a few nanoseconds (no quadrature, no allocation), which is
 //! what the renderer does for every `(x_i, x_o)` pair.
+//!
+//! Costs (release build, see `benches/profiles.rs`): `ProfileFamily::new` ≈ 3 µs (three
+//! Fresnel moments by quadrature); `profile()` a few ns.
 
 use crate::beam_diffusion::BeamDiffusionMs;
 use crate::better_dipole::BetterDipole;
 use crate::dipole::Dipole;
+use crate::directional_dipole::DirectionalDipole;
 use crate::error::{ParamError, check_non_negative};
 use crate::fresnel::{DiffuseFresnel, FresnelMoments};
 use crate::model::{ProfileModel, Scattering};
@@ -48,6 +52,8 @@ pub struct ProfileFamily {
     moments: FresnelMoments,
     /// JMLH01's `A = (1 + F_dr)/(1 − F_dr)` for the dipole.
     a_dipole: f64,
+    /// External first moment `C₁(1/η)` (directional dipole normalisation).
+    c1_external: f64,
 }
 
 impl ProfileFamily {
@@ -106,6 +112,7 @@ impl ProfileFamily {
             options,
             moments,
             a_dipole: (1.0 + f_dr) / (1.0 - f_dr),
+            c1_external: FresnelMoments::new(1.0 / eta)?.c1,
         })
     }
 
@@ -136,6 +143,16 @@ impl ProfileFamily {
     /// The classical dipole's boundary coefficient `A` under the chosen `F_dr`.
     pub fn a_dipole(&self) -> f64 {
         self.a_dipole
+    }
+
+    /// The directional dipole (FHK14) for `(σa, σs)` with this family's `g` and `η` (the
+    /// family's model choice does not apply: FHK14 is not radially symmetric). No quadrature.
+    pub fn directional_dipole(
+        &self,
+        sigma_a: f64,
+        sigma_s: f64,
+    ) -> Result<DirectionalDipole, ParamError> {
+        DirectionalDipole::with_moments(sigma_a, sigma_s, self.g, &self.moments, self.c1_external)
     }
 
     /// The profile for absorption `sigma_a` and scattering `sigma_s` (1/length, finite,
