@@ -12,7 +12,7 @@
 //! the profile's normalisation (the `α'²` prefactor). One discrepancy between the sources:
 //! appleseed evaluates the exponential decay with the classical `σtr = √(3σaσt')` while its
 //! own total uses Grosjean's; we use Grosjean's `σtr = √(σa/D_G)` consistently (as the second
-//! implementation and the total do). Treat as [U] until checked against the note.
+//! implementation and the total do). Treat as unverified (notes tag \[U\]) until checked against the note.
 //!
 //! # Model (optical units `x = σt' r`, lengths in 1/σt')
 //! Grosjean's diffusion coefficient `D = (2σa + σs')/(3σt'²)`, `σtr = √(σa/D)`; modified

@@ -11,7 +11,7 @@
 //! `R_d(r) = (α'/4π)·[z_r(1+σtr d_r)e^{−σtr d_r}/d_r³ + z_v(1+σtr d_v)e^{−σtr d_v}/d_v³]`,
 //! `d_{r,v} = √(r² + z_{r,v}²)`.
 //!
-//! Total diffuse reflectance (closed form, notes §1 [D], also Jensen & Buhler 2002):
+//! Total diffuse reflectance (closed form, notes §1 \[D\], also Jensen & Buhler 2002):
 //! `R_d,tot = (α'/2)·e^{−√(3(1−α'))}·(1 + e^{−(4/3)A√(3(1−α'))})`.
 //!
 //! # Units and scaling

@@ -5,7 +5,7 @@
 //! # Source and status
 //! Implemented from the authors' sample code as carried by `RoaldFre/mitsuba`
 //! `src/subsurface/dirpole.cpp` (physics notes §3); the paper's own notation was not checked
-//! ([U]). Differences from the sample code: the Fresnel moments are exact (quadrature) instead
+//! (\[U\]). Differences from the sample code: the Fresnel moments are exact (quadrature) instead
 //! of the polynomial fits, and the degenerate modified normal falls back to `n_i`.
 //!
 //! # Model (all lengths in scene units)

@@ -21,6 +21,9 @@ use crate::single_scattering::SingleScattering;
 pub const SIGMA_EPSILON: f64 = 1e-12;
 /// Largest accepted coefficient (1/length); larger values are rejected as out of range.
 pub const SIGMA_MAX: f64 = 1e12;
+/// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
+/// |g| = 1 and `σs' = (1 − g)σs` degenerates; notes §7).
+pub const G_MAX: f64 = 1.0 - 1e-6;
 /// Validated range of the relative index of refraction.
 pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
 
@@ -57,8 +60,8 @@ pub struct ProfileFamily {
 }
 
 impl ProfileFamily {
-    /// Prepares a family with default options. `g ∈ (−1, 1)`, `η ∈ [1, 3]`; otherwise a typed
-    /// error naming the parameter. Cost ≈ 2 µs (two Fresnel moments by quadrature).
+    /// Prepares a family with default options. `g ∈ (−1, 1)` (clamped to `±G_MAX`),
+    /// `η ∈ [1, 3]`; otherwise a typed error naming the parameter. Cost ≈ 2 µs (two Fresnel moments by quadrature).
     pub fn new(
         model: ProfileModel,
         scattering: Scattering,
@@ -102,6 +105,8 @@ impl ProfileFamily {
                 value: eta,
             });
         }
+        // HG and the reduced coefficients degenerate at |g| = 1 (notes §7): clamp.
+        let g = g.clamp(-G_MAX, G_MAX);
         let moments = FresnelMoments::new(eta)?;
         let f_dr = options.diffuse_fresnel.f_dr(&moments);
         Ok(Self {
@@ -124,7 +129,7 @@ impl ProfileFamily {
     pub fn scattering(&self) -> Scattering {
         self.scattering
     }
-    /// HG mean cosine.
+    /// HG mean cosine (after clamping to `±G_MAX`).
     pub fn g(&self) -> f64 {
         self.g
     }
@@ -241,17 +246,7 @@ impl MultipleTerm {
             MultipleTerm::Dipole(m) => m.total(),
             MultipleTerm::BetterDipole(m) => m.total(),
             // The better dipole with the same constants is within tens of % of PBD.
-            MultipleTerm::Pbd(m) => BetterDipole::new(
-                m.alpha_p(),
-                1.0,
-                &crate::fresnel::FresnelMoments {
-                    eta: 1.0,
-                    c1: 0.0,
-                    c2: 0.0,
-                },
-            )
-            .total()
-            .max(1e-3 * m.alpha_p()),
+            MultipleTerm::Pbd(m) => m.proposal_total(),
         }
     }
 }

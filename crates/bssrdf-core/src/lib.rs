@@ -15,6 +15,22 @@
 //!   with both pointing the way light travels, so forward scattering (`g > 0`) favours
 //!   `cos θ > 0`.
 //!
+//! # Models
+//! | module | model | source | sampling (`pdf_r`) |
+//! |---|---|---|---|
+//! | [`dipole`] | classical dipole | JMLH01 | exact, closed-form CDF |
+//! | [`better_dipole`] | better dipole | dE12 (via secondary sources, see module) | exact, closed-form CDF |
+//! | [`beam_diffusion`] | photon beam diffusion, multiple scattering | HCJ13 / pbrt | closed-form proposal |
+//! | [`single_scattering`] | single scattering (any model, via [`Scattering`]) | HCJ13 / pbrt | exponential proposal |
+//! | [`directional_dipole`] | directional dipole `S_d(x_i, ω_i, n_i; x_o, n_o)` | FHK14 sample code | — |
+//!
+//! [`fresnel`] provides the exact Fresnel moments `C₁`, `C₂` (quadrature, valid for η ∈ [1, 3]
+//! and beyond) and the optional Egan–Hilgeman fit ([`DiffuseFresnel`]); [`family`] prepares a
+//! material once and builds per-pair [`Profile`]s cheaply; [`table`] holds the per-material
+//! radius-sampling table. All profile functions return finite, non-negative values for every
+//! valid input (σa = 0, σs = 0, vacuum, σt from 1e-6 to 1e6, r = 0 … 1e9, |g| < 1, η ∈ [1, 3]);
+//! invalid input is a [`ParamError`].
+//!
 //! # Using the profiles (renderer side)
 //! ```
 //! use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Scattering};

@@ -132,7 +132,7 @@ pub(crate) const X_INTEGRATION_MIN: f64 = 1e-7;
 /// Upper end (optical units) of the logarithmic radial grid.
 pub(crate) const X_INTEGRATION_MAX: f64 = 1e8;
 /// Panel width in `ln x`.
-const LN_PANEL: f64 = 0.5;
+const LN_PANEL: f64 = 1.0;
 
 /// Cumulative integral of `f(x) = 2πx R₁(x)` (optical units) on the logarithmic panel grid:
 /// calls `visit(x_right, cumulative)` after each panel and stops early when `visit` returns

@@ -71,9 +71,10 @@ impl ProfileTable {
             let s = i as f64 / (ROWS - 1) as f64;
             let alpha_p = 1.0 - s * s;
             // σt' = 1: σa = 1 − α', σs = α'/(1 − g).
+            // Always valid (|g| ≤ G_MAX keeps σs ≤ 1e6); a zero row is repaired below.
             let prof = family
                 .profile(1.0 - alpha_p, alpha_p / (1.0 - g))
-                .expect("table coefficients are valid");
+                .unwrap_or(crate::family::Profile::ZERO);
             total[i] = prof.total();
             let row = &mut p[i * COLS..(i + 1) * COLS];
             row[0] = TWO_PI * X0_EVAL * prof.eval(X0_EVAL);
