@@ -1,0 +1,102 @@
+//! Criterion benchmarks of the homogeneous profile models (bssrdf-core): per-evaluation cost of
+//! each model, per-pair construction, table build and table sampling.
+//!
+//! Run: `cargo bench --bench profiles` (add `-- --quick` for a fast pass).
+use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Scattering};
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::DVec3;
+use std::hint::black_box;
+
+fn eval(c: &mut Criterion) {
+    let mut g = c.benchmark_group("eval");
+    for (model, sc) in [
+        (ProfileModel::Dipole, Scattering::Multiple),
+        (ProfileModel::BetterDipole, Scattering::Multiple),
+        (ProfileModel::Pbd, Scattering::Multiple),
+        (ProfileModel::Pbd, Scattering::Single),
+    ] {
+        let p = ProfileFamily::new(model, sc, 0.0, 1.33)
+            .unwrap()
+            .profile(0.01, 1.0)
+            .unwrap();
+        for r in [0.01, 1.0] {
+            g.bench_function(format!("{model} {sc} r={r}"), |b| {
+                b.iter(|| black_box(&p).eval(black_box(r)))
+            });
+        }
+    }
+    let fam = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.33).unwrap();
+    let fhk = fam.directional_dipole(0.01, 1.0).unwrap();
+    let n = DVec3::Z;
+    let w = DVec3::new(0.3, 0.0, 0.95).normalize();
+    g.bench_function("directional-dipole S_d r=1", |b| {
+        b.iter(|| black_box(&fhk).s_d(DVec3::ZERO, w, n, black_box(DVec3::new(1.0, 0.2, 0.0)), n))
+    });
+    g.finish();
+}
+
+fn construction(c: &mut Criterion) {
+    let mut g = c.benchmark_group("construction");
+    g.bench_function("ProfileFamily::new pbd eta=1.33", |b| {
+        b.iter(|| {
+            ProfileFamily::new(
+                ProfileModel::Pbd,
+                Scattering::Multiple,
+                0.0,
+                black_box(1.33),
+            )
+            .unwrap()
+        })
+    });
+    for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
+        let fam = ProfileFamily::new(model, Scattering::All, 0.0, 1.33).unwrap();
+        g.bench_function(format!("family.profile {model} all"), |b| {
+            b.iter(|| fam.profile(black_box(0.01), black_box(1.0)).unwrap())
+        });
+    }
+    g.sample_size(10);
+    for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
+        let fam = ProfileFamily::new(model, Scattering::Multiple, 0.0, 1.33).unwrap();
+        g.bench_function(format!("ProfileTable::new {model}"), |b| {
+            b.iter(|| ProfileTable::new(black_box(fam)))
+        });
+    }
+    g.finish();
+}
+
+fn sampling(c: &mut Criterion) {
+    let mut g = c.benchmark_group("sampling");
+    let fam = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.33).unwrap();
+    let table = ProfileTable::new(fam);
+    let mut u = 0.1234_f64;
+    g.bench_function("table sampler+sample_r+pdf_r pbd", |b| {
+        b.iter(|| {
+            u = (u + 0.618_033_988_749_895) % 1.0;
+            let s = table.sampler(black_box(0.013), black_box(1.0)).unwrap();
+            let r = s.sample_r(u).unwrap();
+            s.pdf_r(r)
+        })
+    });
+    g.bench_function("table radius_for_fraction 0.999", |b| {
+        b.iter(|| {
+            table
+                .sampler(black_box(0.013), black_box(1.0))
+                .unwrap()
+                .radius_for_fraction(0.999)
+        })
+    });
+    let p = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.33)
+        .unwrap()
+        .profile(0.01, 1.0)
+        .unwrap();
+    g.bench_function("dipole exact sample_r (closed-form CDF, Newton)", |b| {
+        b.iter(|| {
+            u = (u + 0.618_033_988_749_895) % 1.0;
+            p.sample_r(black_box(u))
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, eval, construction, sampling);
+criterion_main!(benches);
