@@ -304,3 +304,54 @@ fn pbd_ms_small_radius_matches_brute_force() {
         }
     }
 }
+
+#[test]
+fn single_scattering_matches_brute_force_at_small_and_large_radii() {
+    // Independent brute force of notes §2's SS integral (σt = 1), Simpson in ln(τ − τ_c).
+    fn brute(x: f64, omega: f64, g: f64, eta: f64) -> f64 {
+        let tc = x * (eta * eta - 1.0f64).sqrt();
+        let f = |y: f64| {
+            let t = tc + y;
+            let d = (x * x + t * t).sqrt();
+            let mu = t / d;
+            let fr = crate::fresnel::dielectric(mu, 1.0 / eta);
+            omega * (-(t + d)).exp() / (d * d) * crate::hg::phase(-mu, g) * (1.0 - fr) * mu
+        };
+        crate::test_util::simpson_log(f, 1e-12, 80.0, 60_000)
+    }
+    for (g, eta) in [(0.0, 1.0), (0.6, 1.0), (-0.4, 1.5), (0.3, 2.5)] {
+        let fam = ProfileFamily::new(ProfileModel::Pbd, Scattering::Single, g, eta).unwrap();
+        let p = fam.profile(0.2, 0.8).unwrap();
+        for x in [0.001, 0.01, 0.1, 1.0, 4.0] {
+            let want = brute(x, 0.8, g, eta);
+            let tol = if x >= 0.01 { 1e-5 } else { 1e-4 };
+            assert!(
+                rel(p.eval(x), want) < tol,
+                "g={g} η={eta} x={x}: {} vs {want}",
+                p.eval(x)
+            );
+        }
+    }
+}
+
+#[test]
+fn profiles_obey_the_scaling_law() {
+    // Notes §0: R(r; kσa, kσs) = k² R(kr; σa, σs), and totals are scale-invariant.
+    for m in [
+        ProfileModel::Dipole,
+        ProfileModel::BetterDipole,
+        ProfileModel::Pbd,
+    ] {
+        let fam = ProfileFamily::new(m, Scattering::All, 0.4, 1.4).unwrap();
+        let base = fam.profile(0.03, 1.2).unwrap();
+        for k in [1e-4, 0.3, 7.0, 1e5] {
+            let scaled = fam.profile(0.03 * k, 1.2 * k).unwrap();
+            for r in [0.05, 0.8, 6.0] {
+                let (a, b) = (scaled.eval(r / k), k * k * base.eval(r));
+                assert!(rel(a, b) < 1e-10, "{m} k={k} r={r}: {a} vs {b}");
+                let (pa, pb) = (scaled.pdf_r(r / k), k * base.pdf_r(r));
+                assert!(rel(pa, pb) < 1e-10, "{m} pdf k={k} r={r}");
+            }
+        }
+    }
+}
