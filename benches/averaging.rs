@@ -1,9 +1,189 @@
-//! Criterion benchmarks of averaging cost (filled in by the het-estimate work).
-use criterion::{Criterion, criterion_group, criterion_main};
+//! Cost of one (x_i, x_o) estimate for every estimator, by sample count, and the standard
+//! deviation of the averaged coefficient versus the sample count (printed before the timings,
+//! so that a user can pick N).
+//!
+//! Run: `cargo bench --bench averaging` (add `-- sone` to filter). Benchmark ids are
+//! `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. Compare the
+//! estimators with the point-lookup estimator `jensen-out` of the same scene (and with
+//! `field-lookup`, one bare `CoefficientField::coefficients` call): absolute times depend on
+//! the machine. Each iteration estimates one pair and keeps only the coefficients, as a
+//! renderer does (the diagnostics are left for the optimiser to drop).
+//!
+//! Scenes (each is a surface, a coefficient field and a fixed list of (x_i, x_o) pairs):
+//! * `plane-stripe`: the analytic plane with the Figure 4 stripe preset (width 4, 45°,
+//!   σa 0.005 / 0.1, σs 1), x_i at the origin and x_o uniform in the paper's plot region
+//!   [−15, 15]² (the beam experiment);
+//! * `plane-constant`: the same pairs over a constant field (the short-circuit: every estimator
+//!   should cost about the same as a point lookup, or less).
+//!
+//! To add a scene (e.g. the tracer's BVH mesh once it exists), build its surface, field and
+//! pairs and call [`bench_scene`] and [`print_std_table`] with them; nothing else changes.
 
-fn placeholder(c: &mut Criterion) {
-    c.bench_function("noop", |b| b.iter(|| 1 + 1));
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use het_bssrdf::het_estimate::analytic::{ConstantField, Plane, PlanePoint, StripeField};
+use het_bssrdf::het_estimate::pattern::Stripe;
+use het_bssrdf::het_estimate::{
+    CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams, SplitMix64,
+    SurfaceQuery, UniformSource,
+};
+
+/// Sample counts benchmarked (per averaging stage: Sone uses N for the disk and N for the
+/// ellipse).
+const SAMPLE_COUNTS: [u32; 5] = [1, 4, 16, 64, 256];
+/// HG g of the benchmarked material (isotropic, as in the paper's Figure 4).
+const G: f64 = 0.0;
+
+/// Every estimator at every benchmarked sample count, with its benchmark label.
+fn estimators() -> Vec<(String, Estimator)> {
+    let mut v = vec![
+        ("jensen-in".to_string(), Estimator::JensenIn),
+        ("jensen-out".to_string(), Estimator::JensenOut),
+        ("endpoints".to_string(), Estimator::Endpoints),
+    ];
+    for n in SAMPLE_COUNTS {
+        let budget = SampleBudget::fixed(n);
+        v.push((
+            format!("segment samples={n}"),
+            Estimator::Segment(SegmentParams::new().with_samples(budget)),
+        ));
+    }
+    for n in SAMPLE_COUNTS {
+        let budget = SampleBudget::fixed(n);
+        v.push((
+            format!("sone samples={n}"),
+            Estimator::Sone(SoneParams::paper().with_samples(budget)),
+        ));
+    }
+    v
 }
 
-criterion_group!(benches, placeholder);
+/// The Figure 4 stripe preset.
+fn stripe_preset() -> StripeField {
+    StripeField {
+        pattern: Stripe {
+            width: 4.0,
+            angle: std::f64::consts::FRAC_PI_4,
+        },
+        values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+    }
+}
+
+/// Beam-experiment pairs on the plane: x_i at the origin, x_o uniform in [−15, 15]².
+fn beam_pairs(n: usize, seed: u64) -> Vec<(PlanePoint, PlanePoint)> {
+    let mut rng = SplitMix64::new(seed);
+    (0..n)
+        .map(|_| {
+            let x = 30.0 * rng.next_f64() - 15.0;
+            let y = 30.0 * rng.next_f64() - 15.0;
+            (PlanePoint::new(0.0, 0.0), PlanePoint::new(x, y))
+        })
+        .collect()
+}
+
+/// Times one estimate per iteration, cycling through `pairs`, for every estimator.
+fn bench_scene<S, F>(
+    c: &mut Criterion,
+    scene: &str,
+    surface: &S,
+    field: &F,
+    pairs: &[(S::Point, S::Point)],
+) where
+    S: SurfaceQuery,
+    F: CoefficientField<S::Point>,
+{
+    let mut group = c.benchmark_group(format!("averaging/{scene}"));
+    group
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(30);
+    let mut i = 0usize;
+    group.bench_function("field-lookup", |b| {
+        b.iter(|| {
+            let (_, x_o) = &pairs[i % pairs.len()];
+            i = i.wrapping_add(1);
+            black_box(field.coefficients(black_box(x_o)))
+        })
+    });
+    for (label, estimator) in estimators() {
+        let prepared = estimator.prepare(G).expect("valid benchmark parameters");
+        let mut rng = SplitMix64::new(7);
+        let mut i = 0usize;
+        group.bench_function(&label, |b| {
+            b.iter(|| {
+                let (x_i, x_o) = &pairs[i % pairs.len()];
+                i = i.wrapping_add(1);
+                let est =
+                    prepared.estimate(surface, field, black_box(x_i), black_box(x_o), &mut rng);
+                black_box(est.coefficients)
+            })
+        });
+    }
+    group.finish();
+}
+
+/// Prints, for each region estimator and N, the standard deviation of the averaged σa (red
+/// channel) over `seeds` random streams, as the RMS over `pairs` (absolute, and relative to
+/// the pair's mean estimate), so that N can be chosen for a target noise level.
+fn print_std_table<S, F>(
+    scene: &str,
+    surface: &S,
+    field: &F,
+    pairs: &[(S::Point, S::Point)],
+    seeds: u64,
+) where
+    S: SurfaceQuery,
+    F: CoefficientField<S::Point>,
+{
+    println!(
+        "\nstandard deviation of the averaged sigma_a over {seeds} seeds, RMS over {} pairs ({scene}, g = {G})",
+        pairs.len()
+    );
+    println!("{:<22} {:>14} {:>14}", "estimator", "sd", "sd / mean");
+    for (label, estimator) in estimators() {
+        if matches!(
+            estimator,
+            Estimator::JensenIn | Estimator::JensenOut | Estimator::Endpoints
+        ) {
+            continue; // deterministic
+        }
+        let prepared = estimator.prepare(G).expect("valid parameters");
+        let (mut sum_var, mut sum_rel_var) = (0.0, 0.0);
+        for (p, (x_i, x_o)) in pairs.iter().enumerate() {
+            let vals: Vec<f64> = (0..seeds)
+                .map(|s| {
+                    let mut rng = SplitMix64::new(0x9e37 ^ ((p as u64) << 20) ^ s);
+                    prepared
+                        .estimate(surface, field, x_i, x_o, &mut rng)
+                        .coefficients
+                        .sigma_a[0]
+                })
+                .collect();
+            let mean = vals.iter().sum::<f64>() / seeds as f64;
+            let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (seeds - 1) as f64;
+            sum_var += var;
+            sum_rel_var += if mean > 0.0 { var / (mean * mean) } else { 0.0 };
+        }
+        let n = pairs.len() as f64;
+        println!(
+            "{label:<22} {:>14.3e} {:>14.3e}",
+            (sum_var / n).sqrt(),
+            (sum_rel_var / n).sqrt()
+        );
+    }
+    println!();
+}
+
+fn averaging(c: &mut Criterion) {
+    let pairs = beam_pairs(1024, 1);
+    let stripe = stripe_preset();
+    print_std_table("plane-stripe", &Plane, &stripe, &pairs[..64], 64);
+    bench_scene(c, "plane-stripe", &Plane, &stripe, &pairs);
+    let constant = ConstantField(Coefficients::grey(0.05, 1.0));
+    bench_scene(c, "plane-constant", &Plane, &constant, &pairs);
+}
+
+criterion_group!(benches, averaging);
 criterion_main!(benches);

@@ -32,9 +32,11 @@ impl PlanePoint {
 }
 
 impl SurfacePoint for PlanePoint {
+    #[inline]
     fn position(&self) -> DVec3 {
         DVec3::new(self.x, self.y, 0.0)
     }
+    #[inline]
     fn normal(&self) -> DVec3 {
         DVec3::Z
     }
@@ -62,9 +64,11 @@ impl SurfaceQuery for Plane {
 pub struct ConstantField(pub Coefficients);
 
 impl CoefficientField<PlanePoint> for ConstantField {
+    #[inline]
     fn coefficients(&self, _: &PlanePoint) -> Coefficients {
         self.0
     }
+    #[inline]
     fn bounds(&self) -> Option<FieldBounds> {
         Some(FieldBounds::constant(self.0))
     }
@@ -93,6 +97,7 @@ impl<P: BinaryPattern> CoefficientField<PlanePoint> for PatternField<P> {
     fn coefficients(&self, p: &PlanePoint) -> Coefficients {
         self.values[self.pattern.select(p.x, p.y)]
     }
+    #[inline]
     fn bounds(&self) -> Option<FieldBounds> {
         Some(FieldBounds {
             min: self.values[0].min(self.values[1]),
@@ -157,6 +162,7 @@ impl CoefficientField<PlanePoint> for RampField {
         }
     }
 
+    #[inline]
     fn bounds(&self) -> Option<FieldBounds> {
         let range = |q: &Ramp| {
             if q.gradient == [0.0, 0.0] {

@@ -64,10 +64,9 @@ pub struct Diagnostics {
     pub field_averages: u8,
     /// Sone: the step-1 disk means ⟨σa⟩, ⟨σs⟩ that entered Eq. (2).
     pub disk_mean: Option<Coefficients>,
-    /// Sone: the width w of Eq. (2) per channel (scene units).
+    /// Sone: the width w of Eq. (2) per channel (scene units); the ellipse's semi-minor axis
+    /// is `SoneParams::semi_minor.from_width(w)`.
     pub width: Option<Rgb>,
-    /// Sone: the ellipse's semi-minor axis b per channel (w/2 or w, per `SemiMinorAxis`).
-    pub semi_minor: Option<Rgb>,
     /// With `SampleBudget::TargetRelError`: the largest estimated relative standard error
     /// over the averaged channels (and, for Sone, over both stages).
     pub rel_std_error: Option<f64>,

@@ -22,6 +22,7 @@ impl Coefficients {
         }
     }
     /// Channel-wise minimum.
+    #[inline]
     pub fn min(self, o: Self) -> Self {
         Self {
             sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::min),
@@ -29,6 +30,7 @@ impl Coefficients {
         }
     }
     /// Channel-wise maximum.
+    #[inline]
     pub fn max(self, o: Self) -> Self {
         Self {
             sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::max),
@@ -36,6 +38,7 @@ impl Coefficients {
         }
     }
     /// True when every value is finite and non-negative.
+    #[inline]
     pub fn is_valid(&self) -> bool {
         self.sigma_a.is_finite()
             && self.sigma_s.is_finite()
@@ -59,6 +62,7 @@ impl FieldBounds {
         Self { min: c, max: c }
     }
     /// True when the field cannot vary (min == max): averaging it is pointless.
+    #[inline]
     pub fn is_constant(&self) -> bool {
         self.min == self.max
     }

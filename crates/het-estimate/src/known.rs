@@ -42,6 +42,7 @@ impl Mask {
         sigma_s: Rgb::ZERO,
     };
 
+    #[inline]
     fn count(&self) -> u8 {
         (self.sigma_a.0.iter().sum::<f64>() + self.sigma_s.0.iter().sum::<f64>()) as u8
     }
@@ -55,6 +56,7 @@ pub(crate) struct Known {
 }
 
 impl Known {
+    #[inline]
     pub fn new(bounds: Option<FieldBounds>) -> Self {
         let constant = match bounds {
             None => Mask::NONE,
@@ -70,18 +72,21 @@ impl Known {
     }
 
     /// The whole field is constant: its value, if so.
+    #[inline]
     pub fn constant_field(&self) -> Option<Coefficients> {
         let b = self.bounds?;
         b.is_constant().then(|| sanitise_bound(b.min))
     }
 
     /// How many (coefficient, channel) values are constant.
+    #[inline]
     pub fn constant_components(&self) -> u8 {
         self.constant.count()
     }
 
     /// 1 where a (coefficient, channel) value must be averaged (it is not known constant):
     /// `(σa channels, σs channels)`.
+    #[inline]
     pub fn varying(&self) -> (Rgb, Rgb) {
         (
             Rgb::ONE - self.constant.sigma_a,
@@ -90,12 +95,14 @@ impl Known {
     }
 
     /// Channel `c` needs no averaging at all (both its σa and σs are constant).
+    #[inline]
     pub fn channel_constant(&self, c: usize) -> bool {
         self.constant.sigma_a[c] == 1.0 && self.constant.sigma_s[c] == 1.0
     }
 
     /// Replaces constant components by their value, clamps to the bounds and sanitises: the
     /// final step of every estimator. The result is finite and ≥ 0.
+    #[inline]
     pub fn finish(&self, c: Coefficients) -> Coefficients {
         let mut c = Coefficients {
             sigma_a: c.sigma_a.map(clamp_coefficient),
@@ -123,6 +130,7 @@ impl Known {
 }
 
 /// Sanitises a bound used as a value (bounds come from the caller too).
+#[inline]
 fn sanitise_bound(c: Coefficients) -> Coefficients {
     let fix = |v: f64| {
         if v.is_finite() {

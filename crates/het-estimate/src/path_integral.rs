@@ -13,7 +13,7 @@
 //! Limits: small d, `w ≈ √(⟨θ²⟩ σs d³ / 192)`; large d with σa > 0, `w² → d / (4σa)`;
 //! σa = 0, `w² = ⟨θ²⟩ σs h³ / 24` (which exceeds (d/2)² once d > 48/(⟨θ²⟩σs)).
 //! Under the Gaussian small-angle path model the numerator is exactly the mean square
-//! (2-D radial) distance of paths from the chord at its midpoint (notes §5, [D]): w is an RMS
+//! (2-D radial) distance of paths from the chord at its midpoint (physics notes §5, derived there): w is an RMS
 //! radius.
 //!
 //! # Reading choices (options, with the defaults the paper's text supports best)

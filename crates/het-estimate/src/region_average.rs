@@ -16,26 +16,34 @@ use crate::surface::{SurfacePoint, SurfaceQuery};
 pub(crate) type Channels = Rgb;
 
 /// Running weighted sums of σa and σs per channel.
+///
+/// Plain arrays rather than `Rgb` arithmetic: `Rgb`'s operators live in another crate without
+/// `#[inline]`, and this is the innermost loop.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Accumulator {
-    sigma_a: Rgb,
-    sigma_s: Rgb,
-    weight: Rgb,
+    sigma_a: [f64; 3],
+    sigma_s: [f64; 3],
+    weight: [f64; 3],
 }
 
 impl Accumulator {
     /// Adds `c` to the channels selected by `channels` (0/1 per channel).
     #[inline]
     pub fn add(&mut self, c: &Coefficients, channels: Channels) {
-        self.sigma_a += c.sigma_a * channels;
-        self.sigma_s += c.sigma_s * channels;
-        self.weight += channels;
+        for k in 0..3 {
+            let w = channels.0[k];
+            self.sigma_a[k] += c.sigma_a.0[k] * w;
+            self.sigma_s[k] += c.sigma_s.0[k] * w;
+            self.weight[k] += w;
+        }
     }
 
     pub fn merge(&mut self, o: &Accumulator) {
-        self.sigma_a += o.sigma_a;
-        self.sigma_s += o.sigma_s;
-        self.weight += o.weight;
+        for k in 0..3 {
+            self.sigma_a[k] += o.sigma_a[k];
+            self.sigma_s[k] += o.sigma_s[k];
+            self.weight[k] += o.weight[k];
+        }
     }
 
     /// Per-channel means; channels without samples are `None`.

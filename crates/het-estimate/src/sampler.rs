@@ -13,7 +13,7 @@ impl<U: UniformSource + ?Sized> UniformSource for &mut U {
     }
 }
 
-/// SplitMix64 (Steele, Lea & Flood 2014, "Fast splittable pseudorandom number generators"): a
+/// SplitMix64 (SLF14: Steele, Lea & Flood 2014): a
 /// tiny seeded [`UniformSource`] for tests, examples and benchmarks. Renderers pass their own
 /// per-pixel stream instead.
 #[derive(Debug, Clone)]

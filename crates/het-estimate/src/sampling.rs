@@ -3,7 +3,7 @@
 //! demand.
 //!
 //! * Unit square: the R2 sequence (Roberts 2018, "The unreasonable effectiveness of
-//!   quasirandom sequences"; key R2): the Kronecker sequence `frac(k·α)` with
+//!   quasirandom sequences"; key Rob18): the Kronecker sequence `frac(k·α)` with
 //!   `α = (1/ρ, 1/ρ²)`, ρ the plastic number (the real root of `x³ = x + 1`). Unlike a rank-1
 //!   lattice it is extensible (good for every N, and points can be appended, which the
 //!   replicate-based error control relies on).

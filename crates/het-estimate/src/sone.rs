@@ -240,7 +240,6 @@ where
     };
     probe.diag.disk_mean = Some(disk_mean);
     probe.diag.width = Some(w);
-    probe.diag.semi_minor = Some(b);
     probe.diag.rel_std_error = rel_se;
     mean
 }
