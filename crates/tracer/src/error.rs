@@ -231,7 +231,7 @@ pub enum SceneError {
         /// 1-based line of the key, when known.
         line: Option<usize>,
         /// What is wrong with the mesh (names the mesh file).
-        source: MeshError,
+        source: Box<MeshError>,
     },
     /// A texture is unusable.
     #[error("{}: {source}", Loc(file, key, line))]
@@ -243,7 +243,7 @@ pub enum SceneError {
         /// 1-based line of the key, when known.
         line: Option<usize>,
         /// What is wrong with the texture (names the image file).
-        source: TextureError,
+        source: Box<TextureError>,
     },
     /// A value is out of range or inconsistent (|g| ≥ 1, negative coefficient, unknown
     /// material name, duplicate name, open mesh where a closed one is required…).

@@ -5,10 +5,12 @@
 
 pub mod camera;
 pub mod error;
+pub mod field;
 pub mod film;
 pub mod geometry;
 pub mod light;
 pub mod output;
 pub mod render;
 pub mod rng;
+pub mod scene;
 pub mod volume;

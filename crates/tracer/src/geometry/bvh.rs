@@ -11,11 +11,11 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Duration;
 
 use glam::{DVec2, DVec3, Vec3A};
-use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::ray::{Ray as BvhRay, RayHit};
-use obvhs::triangle::Triangle;
+use obvhs::{Boundable, BvhBuildParams};
 
 use super::watertight::{LeafTri, ShearedRay, refine_f64};
 use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
@@ -25,6 +25,23 @@ use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
 const SCALED_EXTENT_LOG2: i32 = 12;
 /// Largest coordinate magnitude allowed in scaled space: 2³².
 const SCALED_COORD_LOG2: i32 = 32;
+/// Triangle bounding boxes are padded by this fraction of the object's extent (2⁻¹⁶) before
+/// the BVH is built. obvhs's slab test is not conservative: a ray through a triangle edge that
+/// lies on its node's boundary (every edge of an axis-aligned box) can be culled by a one-ulp
+/// difference between the entry and exit distances. The slab test's rounding error grows
+/// with the distance from the ray origin to the node (≈ 3 ulps of it); the padding (≈ 128
+/// ulps of the object's extent) covers rays starting within about 40 extents of the object,
+/// which includes every ray of a random walk inside it.
+const BOX_PAD_REL: f32 = 1.0 / 65536.0;
+
+/// A triangle's padded bounding box, what the BVH is built on.
+struct PaddedBox(Aabb);
+
+impl Boundable for PaddedBox {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
 
 /// One object's acceleration structure.
 #[derive(Debug)]
@@ -141,22 +158,23 @@ impl ObjectAccel {
                 hi,
             };
         }
-        let scaled: Vec<Triangle> = mesh
+        let scaled: Vec<[Vec3A; 3]> = mesh
             .triangles
             .iter()
             .map(|t| {
-                let v = t.map(|k| {
-                    Vec3A::from((mesh.positions[k as usize].as_dvec3() * scale).as_vec3())
-                });
-                Triangle {
-                    v0: v[0],
-                    v1: v[1],
-                    v2: v[2],
-                }
+                t.map(|k| Vec3A::from((mesh.positions[k as usize].as_dvec3() * scale).as_vec3()))
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &scaled,
+        let pad = Vec3A::splat(BOX_PAD_REL * (extent * scale) as f32);
+        let boxes: Vec<PaddedBox> = scaled
+            .iter()
+            .map(|v| {
+                let aabb = Aabb::from_points(v);
+                PaddedBox(Aabb::new(aabb.min - pad, aabb.max + pad))
+            })
+            .collect();
+        let bvh = build_cwbvh(
+            &boxes,
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
@@ -164,8 +182,8 @@ impl ObjectAccel {
             .primitive_indices
             .iter()
             .map(|&i| {
-                let t = &scaled[i as usize];
-                LeafTri::new(t.v0.into(), t.v1.into(), t.v2.into())
+                let v = &scaled[i as usize];
+                LeafTri::new(v[0].into(), v[1].into(), v[2].into())
             })
             .collect();
         let prims = bvh.primitive_indices.clone();

@@ -154,16 +154,20 @@ impl het_estimate::SurfacePoint for Hit {
     }
 }
 
-/// Relative origin offset: `2⁻¹⁷ ≈ 7.6e-6`, i.e. 64 `f32` ulps of the coordinate magnitude.
+/// Relative origin offset: `2⁻¹⁸ ≈ 3.8e-6`, i.e. 32 `f32` ulps of the coordinate scale.
 ///
-/// Why this value: the vertices and the triangle test are `f32`. Rounding the new origin to
-/// `f32` moves it by up to half an ulp per coordinate (≈ 0.9·ε·|p|_∞ along the normal, with
-/// ε = 2⁻²³), and the watertight test evaluates the plane with a few more roundings of
-/// magnitude ε·(triangle extent). 1e-6 relative (≈ 8 ulps) left measurable self-hits in the
-/// offset test (`tests/tracer/offset.rs`), 64 ulps none; it is still small: 7.6e-6 of the
-/// coordinate scale, far below any mean free path a scene should use (a slab of unit size with
-/// σt = 1e4 has a mean free path of 1e-4 = 13 offsets).
-pub const OFFSET_REL: f64 = 1.0 / 131_072.0;
+/// Why this value: vertices and the triangle test are `f32`. Rounding the new origin to `f32`
+/// moves it by up to half an ulp per coordinate (≈ 0.9·ε·|p|_∞ along the normal, with
+/// ε = 2⁻²³), and the watertight test evaluates the triangle's plane from vertex − origin
+/// differences, with rounding errors of a few ε·(triangle extent). So the offset must scale with
+/// `|p|_∞ + extent`, not with `|p|` alone: near the origin of a ground plane made of two huge
+/// triangles, an offset of 1e-6·|p| is far too small. Measured (`offset_scale_survey` in the
+/// integration tests, 480,000 spawned rays over six convex meshes from a 1e-3 sphere to a
+/// 2e3 slab): no offset → 50–75 % self-hits; 1/32 of this value (1 ulp of `|p| + extent`) → 2
+/// self-hits, 1/16 → 1; 1/8 and above → none. 32 ulps leaves a factor 8 of margin and stays small: for a
+/// unit-size object, 4e-6, far below any mean free path a scene should use (a 1e-4 thick slab
+/// is crossed correctly, tested).
+pub const OFFSET_REL: f64 = 1.0 / 262_144.0;
 
 /// Moves `p` off the surface with geometric normal `ng` by `OFFSET_REL · |p|_∞` along `±ng`,
 /// on the side `dir` points to, so that a ray from the result along `dir` does not re-hit

@@ -1,0 +1,510 @@
+//! Coefficient fields: σa or σs as linear RGB over an object (1/scene-unit), and
+//! [`MediumField`], the pair a translucent material is made of.
+//!
+//! A [`Field`] is one of a closed set, matched once per lookup (a predictable branch):
+//! * constant (grey or RGB);
+//! * a procedural two-valued pattern (stripe or check, the very definitions and code of
+//!   [`het_estimate::pattern`]) through a [`PlanarProjection`];
+//! * an image texture through a planar projection (defined in the volume, constant along the
+//!   axis) or through the mesh's texture coordinates (defined on the surface only: usable by
+//!   the BSSRDF methods, not by the volumetric path tracer).
+//!
+//! Image placement for the planar projection: the image covers `s ∈ [−W/2, W/2]`,
+//! `t ∈ [−H/2, H/2]` (`size = [W, H]`, scene units) centred on the projection origin; image
+//! columns run along `+s`, rows run along `−t` (row 0 at `t = +H/2`), so that an image seen
+//! from the `+axis` side (for axis z: from above, x right, y up) appears upright. For texture
+//! coordinates, `(u, v)` with `v` up (OBJ convention) reads the image at `(u, 1 − v)`.
+
+mod projection;
+mod texture;
+
+pub use projection::{Axis, PlanarProjection};
+pub use texture::{Filter, Texture, Wrap};
+
+use std::sync::Arc;
+
+use bssrdf_core::Rgb;
+use glam::{DVec2, DVec3};
+use het_estimate::pattern::{BinaryPattern, Check, Stripe};
+use het_estimate::{CoefficientField, Coefficients, FieldBounds};
+
+use crate::error::FieldError;
+use crate::geometry::Hit;
+
+/// A procedural two-valued pattern from [`het_estimate::pattern`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Pattern {
+    /// Parallel bands.
+    Stripe(Stripe),
+    /// Checkerboard.
+    Check(Check),
+}
+
+impl Pattern {
+    /// 0 or 1 at `(s, t)`.
+    #[inline]
+    pub fn select(&self, s: f64, t: f64) -> usize {
+        match self {
+            Pattern::Stripe(p) => p.select(s, t),
+            Pattern::Check(p) => p.select(s, t),
+        }
+    }
+}
+
+/// Where an image is read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ImageMapping {
+    /// Planar projection; the image spans `size = [W, H]` scene units centred on the
+    /// projection origin (see the module docs).
+    Planar {
+        /// The projection.
+        projection: PlanarProjection,
+        /// World size `[W, H]` of the whole image.
+        size: [f64; 2],
+    },
+    /// The mesh's texture coordinates (surface only).
+    Uv,
+}
+
+/// An image-textured field: `value = scale ⊙ texel(…)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageField {
+    /// The decoded texture (shared between fields using the same file).
+    pub texture: Arc<Texture>,
+    /// Where it is read.
+    pub mapping: ImageMapping,
+    /// Outside `[0, 1]²`.
+    pub wrap: Wrap,
+    /// Reconstruction.
+    pub filter: Filter,
+    /// Per-channel multiplier (1/scene-unit per texel unit).
+    pub scale: Rgb,
+}
+
+impl ImageField {
+    #[inline]
+    fn lookup(&self, u: f64, v_down: f64) -> Rgb {
+        let t = self.texture.lookup(u, v_down, self.wrap, self.filter);
+        Rgb(t) * self.scale
+    }
+
+    #[inline]
+    fn at(&self, p: DVec3, uv: DVec2) -> Rgb {
+        match self.mapping {
+            ImageMapping::Planar { projection, size } => {
+                let (s, t) = projection.st(p);
+                self.lookup(s / size[0] + 0.5, 0.5 - t / size[1])
+            }
+            ImageMapping::Uv => self.lookup(uv.x, 1.0 - uv.y),
+        }
+    }
+}
+
+/// σa or σs over an object, linear RGB in 1/scene-unit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Field {
+    /// The same value everywhere.
+    Constant(Rgb),
+    /// `values[pattern.select(s, t)]`.
+    Pattern {
+        /// The pattern.
+        pattern: Pattern,
+        /// Value where the pattern selects 0, and where it selects 1.
+        values: [Rgb; 2],
+        /// How points map to the pattern's plane.
+        projection: PlanarProjection,
+    },
+    /// An image texture.
+    Image(ImageField),
+}
+
+fn check_value(what: impl Into<String>, v: Rgb) -> Result<Rgb, FieldError> {
+    if v.is_finite() && v.min_component() >= 0.0 {
+        Ok(v)
+    } else {
+        Err(FieldError::BadValue {
+            what: what.into(),
+            value: v.0,
+        })
+    }
+}
+
+fn check_length(what: &'static str, v: f64) -> Result<f64, FieldError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(FieldError::BadLength { what, value: v })
+    }
+}
+
+impl Field {
+    /// A constant field (`value` finite and non-negative).
+    pub fn constant(value: Rgb) -> Result<Field, FieldError> {
+        Ok(Field::Constant(check_value("value", value)?))
+    }
+
+    /// Stripes of width `width` varying along the direction at `angle_radians` in the
+    /// projection plane ([`het_estimate::pattern::Stripe`]).
+    pub fn stripe(
+        width: f64,
+        angle_radians: f64,
+        values: [Rgb; 2],
+        projection: PlanarProjection,
+    ) -> Result<Field, FieldError> {
+        check_length("stripe width", width)?;
+        if !angle_radians.is_finite() {
+            return Err(FieldError::Other(format!(
+                "stripe angle must be finite, got {angle_radians}"
+            )));
+        }
+        Ok(Field::Pattern {
+            pattern: Pattern::Stripe(Stripe {
+                width,
+                angle: angle_radians,
+            }),
+            values: [
+                check_value("values[0]", values[0])?,
+                check_value("values[1]", values[1])?,
+            ],
+            projection,
+        })
+    }
+
+    /// A checkerboard of cell side `width` ([`het_estimate::pattern::Check`]).
+    pub fn check(
+        width: f64,
+        values: [Rgb; 2],
+        projection: PlanarProjection,
+    ) -> Result<Field, FieldError> {
+        check_length("check width", width)?;
+        Ok(Field::Pattern {
+            pattern: Pattern::Check(Check { width }),
+            values: [
+                check_value("values[0]", values[0])?,
+                check_value("values[1]", values[1])?,
+            ],
+            projection,
+        })
+    }
+
+    /// An image field (`scale` finite, non-negative; planar `size` finite, positive).
+    pub fn image(
+        texture: Arc<Texture>,
+        mapping: ImageMapping,
+        wrap: Wrap,
+        filter: Filter,
+        scale: Rgb,
+    ) -> Result<Field, FieldError> {
+        if let ImageMapping::Planar { size, .. } = mapping {
+            check_length("image width (size[0])", size[0])?;
+            check_length("image height (size[1])", size[1])?;
+        }
+        Ok(Field::Image(ImageField {
+            texture,
+            mapping,
+            wrap,
+            filter,
+            scale: check_value("scale", scale)?,
+        }))
+    }
+
+    /// The field multiplied by `k ≥ 0` (unit conversion).
+    pub fn scaled(self, k: f64) -> Field {
+        match self {
+            Field::Constant(v) => Field::Constant(v * k),
+            Field::Pattern {
+                pattern,
+                values,
+                projection,
+            } => Field::Pattern {
+                pattern,
+                values: [values[0] * k, values[1] * k],
+                projection,
+            },
+            Field::Image(mut f) => {
+                f.scale *= k;
+                Field::Image(f)
+            }
+        }
+    }
+
+    /// The value at a surface point `p` with texture coordinates `uv`.
+    #[inline]
+    pub fn eval(&self, p: DVec3, uv: DVec2) -> Rgb {
+        match self {
+            Field::Constant(v) => *v,
+            Field::Pattern {
+                pattern,
+                values,
+                projection,
+            } => {
+                let (s, t) = projection.st(p);
+                values[pattern.select(s, t)]
+            }
+            Field::Image(f) => f.at(p, uv),
+        }
+    }
+
+    /// The value at a point of the volume. Meaningful only when [`Field::is_volumetric`]; a
+    /// UV-mapped image returns the midpoint of its range instead (check with
+    /// [`MediumField::is_volumetric`] or `Scene::require_volumetric` before rendering).
+    #[inline]
+    pub fn at_point(&self, p: DVec3) -> Rgb {
+        match self {
+            Field::Image(ImageField {
+                mapping: ImageMapping::Uv,
+                ..
+            }) => {
+                debug_assert!(false, "UV-mapped field evaluated in the volume");
+                (self.min() + self.max()) * 0.5
+            }
+            _ => self.eval(p, DVec2::ZERO),
+        }
+    }
+
+    /// False only for UV-mapped images (defined on the surface only).
+    pub fn is_volumetric(&self) -> bool {
+        !matches!(
+            self,
+            Field::Image(ImageField {
+                mapping: ImageMapping::Uv,
+                ..
+            })
+        )
+    }
+
+    /// True when every value has equal channels.
+    pub fn is_grey(&self) -> bool {
+        let grey = |v: Rgb| v[0] == v[1] && v[1] == v[2];
+        match self {
+            Field::Constant(v) => grey(*v),
+            Field::Pattern { values, .. } => grey(values[0]) && grey(values[1]),
+            Field::Image(f) => (grey(f.scale) && f.texture.is_grey()) || f.scale.is_zero(),
+        }
+    }
+
+    /// Channel-wise smallest value over all points.
+    pub fn min(&self) -> Rgb {
+        match self {
+            Field::Constant(v) => *v,
+            Field::Pattern { values, .. } => values[0].zip_map(values[1], f64::min),
+            Field::Image(f) => Rgb(f.texture.min().map(|c| c as f64)) * f.scale,
+        }
+    }
+
+    /// Channel-wise largest value over all points (bilinear filtering interpolates convexly,
+    /// so it never exceeds the largest texel).
+    pub fn max(&self) -> Rgb {
+        match self {
+            Field::Constant(v) => *v,
+            Field::Pattern { values, .. } => values[0].zip_map(values[1], f64::max),
+            Field::Image(f) => Rgb(f.texture.max().map(|c| c as f64)) * f.scale,
+        }
+    }
+
+    /// True when the field takes a single value.
+    pub fn is_constant(&self) -> bool {
+        self.min() == self.max()
+    }
+}
+
+/// The medium of a translucent material: σa and σs fields, with cached bounds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MediumField {
+    sigma_a: Field,
+    sigma_s: Field,
+    bounds: FieldBounds,
+    majorant: Rgb,
+    grey: bool,
+    volumetric: bool,
+}
+
+impl MediumField {
+    /// The medium with absorption `sigma_a` and scattering `sigma_s`.
+    pub fn new(sigma_a: Field, sigma_s: Field) -> Self {
+        let min = Coefficients {
+            sigma_a: sigma_a.min(),
+            sigma_s: sigma_s.min(),
+        };
+        let max = Coefficients {
+            sigma_a: sigma_a.max(),
+            sigma_s: sigma_s.max(),
+        };
+        let bounds = if min == max {
+            FieldBounds::constant(min)
+        } else {
+            FieldBounds { min, max }
+        };
+        Self {
+            majorant: max.sigma_a + max.sigma_s,
+            grey: sigma_a.is_grey() && sigma_s.is_grey(),
+            volumetric: sigma_a.is_volumetric() && sigma_s.is_volumetric(),
+            bounds,
+            sigma_a,
+            sigma_s,
+        }
+    }
+
+    /// A homogeneous medium.
+    pub fn homogeneous(c: Coefficients) -> Result<Self, FieldError> {
+        Ok(Self::new(
+            Field::constant(c.sigma_a)?,
+            Field::constant(c.sigma_s)?,
+        ))
+    }
+
+    /// The absorption field.
+    pub fn sigma_a(&self) -> &Field {
+        &self.sigma_a
+    }
+    /// The scattering field.
+    pub fn sigma_s(&self) -> &Field {
+        &self.sigma_s
+    }
+
+    /// The medium multiplied by `k` (unit conversion: coefficients per file unit ×
+    /// `unit_scale` = per scene unit).
+    pub fn scaled(self, k: f64) -> Self {
+        Self::new(self.sigma_a.scaled(k), self.sigma_s.scaled(k))
+    }
+
+    /// Coefficients at a point of the volume (for the path tracer): cheap, no allocation.
+    /// Meaningful only when [`MediumField::is_volumetric`].
+    #[inline]
+    pub fn at_point(&self, p: DVec3) -> Coefficients {
+        Coefficients {
+            sigma_a: self.sigma_a.at_point(p),
+            sigma_s: self.sigma_s.at_point(p),
+        }
+    }
+
+    /// Coefficients at a surface point with texture coordinates `uv`.
+    #[inline]
+    pub fn at_surface(&self, p: DVec3, uv: DVec2) -> Coefficients {
+        Coefficients {
+            sigma_a: self.sigma_a.eval(p, uv),
+            sigma_s: self.sigma_s.eval(p, uv),
+        }
+    }
+
+    /// False when either field is a UV-mapped image (surface only).
+    pub fn is_volumetric(&self) -> bool {
+        self.volumetric
+    }
+
+    /// True when every value of both fields has equal channels (one channel can be traced
+    /// for all three).
+    pub fn is_grey(&self) -> bool {
+        self.grey
+    }
+
+    /// True when neither field varies.
+    pub fn is_constant(&self) -> bool {
+        self.bounds.is_constant()
+    }
+
+    /// Per-channel majorant of σt = σa + σs over the whole medium.
+    pub fn majorant(&self) -> Rgb {
+        self.majorant
+    }
+
+    /// Channel-wise bounds of both coefficients.
+    pub fn field_bounds(&self) -> FieldBounds {
+        self.bounds
+    }
+}
+
+impl CoefficientField<Hit> for MediumField {
+    #[inline]
+    fn coefficients(&self, p: &Hit) -> Coefficients {
+        self.at_surface(p.p, p.uv)
+    }
+
+    /// Always `Some`; `FieldBounds::constant` for a homogeneous medium.
+    fn bounds(&self) -> Option<FieldBounds> {
+        Some(self.bounds)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stripe_and_check_read_the_shared_patterns() {
+        let a = Rgb::splat(0.1);
+        let b = Rgb::new(1.0, 2.0, 3.0);
+        let proj = PlanarProjection::new(Axis::Z, DVec3::new(0.5, -0.25, 7.0));
+        let stripe = Stripe {
+            width: 1.5,
+            angle: 0.3,
+        };
+        let fs = Field::stripe(1.5, 0.3, [a, b], proj).unwrap();
+        let fc = Field::check(0.7, [a, b], proj).unwrap();
+        let check = Check { width: 0.7 };
+        for i in 0..400 {
+            let p = DVec3::new(
+                (i as f64 * 0.731).sin() * 5.0,
+                (i as f64 * 1.37).cos() * 5.0,
+                i as f64 * 0.01,
+            );
+            let (s, t) = (p.x - 0.5, p.y + 0.25);
+            assert_eq!(fs.at_point(p), [a, b][stripe.select(s, t)]);
+            assert_eq!(fc.at_point(p), [a, b][check.select(s, t)]);
+        }
+        let m = MediumField::new(fs, Field::constant(Rgb::ONE).unwrap());
+        assert!(!m.is_grey() && m.is_volumetric() && !m.is_constant());
+        assert_eq!(m.majorant(), Rgb::new(2.0, 3.0, 4.0));
+    }
+
+    #[test]
+    fn constant_medium_bounds_are_constant() {
+        let m = MediumField::homogeneous(Coefficients::grey(0.1, 2.0)).unwrap();
+        let b = CoefficientField::<Hit>::bounds(&m).unwrap();
+        assert!(b.is_constant() && m.is_grey());
+        assert!(Field::constant(Rgb::new(0.0, -1.0, 0.0)).is_err());
+        assert!(Field::check(0.0, [Rgb::ONE; 2], PlanarProjection::default()).is_err());
+    }
+
+    #[test]
+    fn planar_image_placement() {
+        // 2x2 image of width/height 4 centred at the origin: texel (0,0) (top-left) covers
+        // s ∈ [−2, 0], t ∈ [0, 2].
+        let tex = Arc::new(
+            Texture::from_texels("t", 2, 2, vec![[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3]]).unwrap(),
+        );
+        let f = Field::image(
+            tex.clone(),
+            ImageMapping::Planar {
+                projection: PlanarProjection::default(),
+                size: [4.0, 4.0],
+            },
+            Wrap::Clamp,
+            Filter::Nearest,
+            Rgb::splat(2.0),
+        )
+        .unwrap();
+        assert_eq!(f.at_point(DVec3::new(-1.0, 1.0, 9.0)), Rgb::splat(0.0));
+        assert_eq!(f.at_point(DVec3::new(1.0, 1.0, 9.0)), Rgb::splat(2.0));
+        assert_eq!(f.at_point(DVec3::new(-1.0, -1.0, 9.0)), Rgb::splat(4.0));
+        assert_eq!(f.max(), Rgb::splat(6.0));
+        let uvf = Field::image(
+            tex,
+            ImageMapping::Uv,
+            Wrap::Clamp,
+            Filter::Nearest,
+            Rgb::ONE,
+        )
+        .unwrap();
+        assert!(!uvf.is_volumetric());
+        // uv (0.25, 0.75): v up, so the top row: texel (0, 0).
+        assert_eq!(
+            uvf.eval(DVec3::ZERO, DVec2::new(0.25, 0.75)),
+            Rgb::splat(0.0)
+        );
+        assert_eq!(
+            uvf.eval(DVec3::ZERO, DVec2::new(0.75, 0.25)),
+            Rgb::splat(3.0)
+        );
+    }
+}

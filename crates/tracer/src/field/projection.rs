@@ -1,0 +1,79 @@
+//! Planar projection: the map from a 3-D point to the 2-D coordinates `(s, t)` of a pattern or
+//! a planar-mapped image. The field is then constant along the projection axis (the paper's
+//! assumption that coefficients vary only along tangent directions, §3.1).
+
+use glam::DVec3;
+
+/// A coordinate axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Axis {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z (default: the paper's experiments lie on the plane z = 0).
+    #[default]
+    Z,
+}
+
+impl Axis {
+    /// `"x"`, `"y"` or `"z"`.
+    pub fn parse(s: &str) -> Option<Axis> {
+        match s {
+            "x" | "X" => Some(Axis::X),
+            "y" | "Y" => Some(Axis::Y),
+            "z" | "Z" => Some(Axis::Z),
+            _ => None,
+        }
+    }
+}
+
+/// Projection along `axis` with `origin` mapped to `(s, t) = (0, 0)`.
+///
+/// Mapping of the other two coordinates (cyclic, so that `ŝ × t̂ = axis`):
+/// * axis z: `(s, t) = (x − o_x, y − o_y)`;
+/// * axis x: `(s, t) = (y − o_y, z − o_z)`;
+/// * axis y: `(s, t) = (z − o_z, x − o_x)`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlanarProjection {
+    /// The axis the field is constant along.
+    pub axis: Axis,
+    /// The point mapped to `(0, 0)` (only its two in-plane coordinates matter).
+    pub origin: DVec3,
+}
+
+impl PlanarProjection {
+    /// Projection along `axis` about `origin`.
+    pub const fn new(axis: Axis, origin: DVec3) -> Self {
+        Self { axis, origin }
+    }
+
+    /// `(s, t)` of `p`.
+    #[inline]
+    pub fn st(&self, p: DVec3) -> (f64, f64) {
+        let d = p - self.origin;
+        match self.axis {
+            Axis::Z => (d.x, d.y),
+            Axis::X => (d.y, d.z),
+            Axis::Y => (d.z, d.x),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mapping_is_cyclic_and_right_handed() {
+        let o = DVec3::new(1.0, 2.0, 3.0);
+        let p = DVec3::new(5.0, 7.0, 11.0);
+        assert_eq!(PlanarProjection::new(Axis::Z, o).st(p), (4.0, 5.0));
+        assert_eq!(PlanarProjection::new(Axis::X, o).st(p), (5.0, 8.0));
+        assert_eq!(PlanarProjection::new(Axis::Y, o).st(p), (8.0, 4.0));
+        // ŝ × t̂ = axis for each choice.
+        assert_eq!(DVec3::X.cross(DVec3::Y), DVec3::Z);
+        assert_eq!(DVec3::Y.cross(DVec3::Z), DVec3::X);
+        assert_eq!(DVec3::Z.cross(DVec3::X), DVec3::Y);
+    }
+}

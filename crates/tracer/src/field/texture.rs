@@ -1,0 +1,294 @@
+//! Image textures: decoding (PNG through `image`, EXR through `exr`), validation and filtered
+//! lookup.
+//!
+//! Texel values are linear RGB `f32`. 8- and 16-bit images are decoded from sRGB
+//! (IEC 61966-2-1) unless the texture is declared `linear` (it holds data, not colour); EXR
+//! files are always linear. Alpha is ignored; grey images give equal channels.
+//!
+//! Image space: texel `(i, j)` (column `i` from the left, row `j` from the top) covers
+//! `[i, i+1) × [j, j+1)` in continuous texel coordinates; normalised coordinates `(u, v_down)`
+//! are those divided by the image size (`v_down` grows downward).
+
+use std::path::Path;
+
+use crate::error::TextureError;
+use crate::output::srgb_decode;
+
+/// How lookups outside `[0, 1]²` behave.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Wrap {
+    /// Tile the image.
+    #[default]
+    Repeat,
+    /// Extend the edge texels.
+    Clamp,
+}
+
+/// Reconstruction filter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Filter {
+    /// The texel containing the point.
+    Nearest,
+    /// Bilinear interpolation between the four nearest texel centres.
+    #[default]
+    Bilinear,
+}
+
+/// A decoded image: linear RGB texels, row-major, row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    /// The file it came from (for messages).
+    pub file: String,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    texels: Vec<[f32; 3]>,
+    min: [f32; 3],
+    max: [f32; 3],
+    grey: bool,
+}
+
+impl Texture {
+    /// A texture from linear texels (row-major, row 0 at the top). Every value must be finite
+    /// and non-negative; the error names `file` and the texel.
+    pub fn from_texels(
+        file: &str,
+        width: u32,
+        height: u32,
+        texels: Vec<[f32; 3]>,
+    ) -> Result<Texture, TextureError> {
+        if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
+            return Err(TextureError::Empty {
+                file: file.to_string(),
+                width,
+                height,
+            });
+        }
+        let mut min = [f32::INFINITY; 3];
+        let mut max = [0.0f32; 3];
+        let mut grey = true;
+        for (k, t) in texels.iter().enumerate() {
+            for c in 0..3 {
+                let v = t[c];
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(TextureError::BadTexel {
+                        file: file.to_string(),
+                        x: (k % width as usize) as u32,
+                        y: (k / width as usize) as u32,
+                        channel: c,
+                        value: v,
+                    });
+                }
+                min[c] = min[c].min(v);
+                max[c] = max[c].max(v);
+            }
+            grey &= t[0] == t[1] && t[1] == t[2];
+        }
+        Ok(Texture {
+            file: file.to_string(),
+            width,
+            height,
+            texels,
+            min,
+            max,
+            grey,
+        })
+    }
+
+    /// Decodes an image file: `.exr` (linear) through `exr`, anything else through `image`
+    /// (PNG; 8/16-bit decoded from sRGB unless `linear`, float images linear).
+    pub fn load(path: &Path, linear: bool) -> Result<Texture, TextureError> {
+        let file = path.display().to_string();
+        let is_exr = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        if is_exr {
+            let (w, h, px) = crate::output::decode_exr_rgb(path).map_err(|e| match e {
+                crate::output::ExrReadError::Io(source) => TextureError::Io {
+                    file: file.clone(),
+                    source,
+                },
+                crate::output::ExrReadError::Decode(message) => TextureError::Decode {
+                    file: file.clone(),
+                    message,
+                },
+            })?;
+            return Texture::from_texels(&file, w, h, px);
+        }
+        Self::load_ldr(path, &file, linear)
+    }
+
+    #[cfg(feature = "png")]
+    fn load_ldr(path: &Path, file: &str, linear: bool) -> Result<Texture, TextureError> {
+        use image::DynamicImage;
+        let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
+            file: file.to_string(),
+            source,
+        })?;
+        let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| TextureError::Decode {
+                file: file.to_string(),
+                message: e.to_string(),
+            })?
+            .decode()
+            .map_err(|e| TextureError::Decode {
+                file: file.to_string(),
+                message: e.to_string(),
+            })?;
+        let (w, h) = (img.width(), img.height());
+        let texels: Vec<[f32; 3]> = match &img {
+            DynamicImage::ImageLuma8(_)
+            | DynamicImage::ImageLumaA8(_)
+            | DynamicImage::ImageRgb8(_)
+            | DynamicImage::ImageRgba8(_) => {
+                let lut: Vec<f32> = (0..256)
+                    .map(|i| {
+                        let x = i as f64 / 255.0;
+                        (if linear { x } else { srgb_decode(x) }) as f32
+                    })
+                    .collect();
+                img.to_rgb8()
+                    .pixels()
+                    .map(|p| p.0.map(|b| lut[b as usize]))
+                    .collect()
+            }
+            DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
+                img.to_rgb32f().pixels().map(|p| p.0).collect()
+            }
+            _ => img
+                .to_rgb16()
+                .pixels()
+                .map(|p| {
+                    p.0.map(|s| {
+                        let x = s as f64 / 65535.0;
+                        (if linear { x } else { srgb_decode(x) }) as f32
+                    })
+                })
+                .collect(),
+        };
+        Texture::from_texels(file, w, h, texels)
+    }
+
+    #[cfg(not(feature = "png"))]
+    fn load_ldr(_path: &Path, file: &str, _linear: bool) -> Result<Texture, TextureError> {
+        Err(TextureError::Unsupported {
+            file: file.to_string(),
+            message: "PNG textures need the `png` feature of het-bssrdf-tracer".into(),
+        })
+    }
+
+    /// Texel `(i, j)` (column, row from the top).
+    #[inline]
+    pub fn texel(&self, i: u32, j: u32) -> [f32; 3] {
+        self.texels[j as usize * self.width as usize + i as usize]
+    }
+
+    /// Smallest value of each channel.
+    pub fn min(&self) -> [f32; 3] {
+        self.min
+    }
+    /// Largest value of each channel.
+    pub fn max(&self) -> [f32; 3] {
+        self.max
+    }
+    /// True when every texel has equal channels.
+    pub fn is_grey(&self) -> bool {
+        self.grey
+    }
+
+    /// The filtered value at normalised image coordinates `(u, v_down)` (see the module docs).
+    #[inline]
+    pub fn lookup(&self, u: f64, v_down: f64, wrap: Wrap, filter: Filter) -> [f64; 3] {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let x = u * w as f64;
+        let y = v_down * h as f64;
+        let fetch = |i: i64, j: i64| -> [f64; 3] {
+            let (i, j) = match wrap {
+                Wrap::Repeat => (i.rem_euclid(w), j.rem_euclid(h)),
+                Wrap::Clamp => (i.clamp(0, w - 1), j.clamp(0, h - 1)),
+            };
+            self.texels[(j * w + i) as usize].map(|c| c as f64)
+        };
+        // Guard against NaN/inf coordinates (never from finite points): clamp into a sane
+        // integer range before converting.
+        let to_i = |f: f64| f.clamp(-1e15, 1e15) as i64;
+        match filter {
+            Filter::Nearest => fetch(to_i(x.floor()), to_i(y.floor())),
+            Filter::Bilinear => {
+                let (xc, yc) = (x - 0.5, y - 0.5);
+                let (x0, y0) = (xc.floor(), yc.floor());
+                let (fx, fy) = (xc - x0, yc - y0);
+                let (i0, j0) = (to_i(x0), to_i(y0));
+                let a = fetch(i0, j0);
+                let b = fetch(i0 + 1, j0);
+                let c = fetch(i0, j0 + 1);
+                let d = fetch(i0 + 1, j0 + 1);
+                let mut out = [0.0; 3];
+                for k in 0..3 {
+                    let top = a[k] + fx * (b[k] - a[k]);
+                    let bottom = c[k] + fx * (d[k] - c[k]);
+                    out[k] = top + fy * (bottom - top);
+                }
+                out
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tex() -> Texture {
+        // 2x2: (0,0)=0, (1,0)=1, (0,1)=2, (1,1)=3 in every channel.
+        Texture::from_texels("t.png", 2, 2, vec![[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3]]).unwrap()
+    }
+
+    #[test]
+    fn nearest_and_wrap() {
+        let t = tex();
+        assert_eq!(t.lookup(0.25, 0.25, Wrap::Repeat, Filter::Nearest)[0], 0.0);
+        assert_eq!(t.lookup(0.75, 0.25, Wrap::Repeat, Filter::Nearest)[0], 1.0);
+        assert_eq!(t.lookup(0.25, 0.75, Wrap::Repeat, Filter::Nearest)[0], 2.0);
+        assert_eq!(t.lookup(1.25, -0.25, Wrap::Repeat, Filter::Nearest)[0], 2.0);
+        assert_eq!(t.lookup(1.25, -0.25, Wrap::Clamp, Filter::Nearest)[0], 1.0);
+    }
+
+    #[test]
+    fn bilinear_interpolates_between_texel_centres() {
+        let t = tex();
+        // Texel centres at 0.25 and 0.75: halfway is the mean of the four.
+        let v = t.lookup(0.5, 0.5, Wrap::Clamp, Filter::Bilinear)[0];
+        assert!((v - 1.5).abs() < 1e-12);
+        // At a texel centre the value is exact.
+        assert!((t.lookup(0.75, 0.25, Wrap::Clamp, Filter::Bilinear)[0] - 1.0).abs() < 1e-12);
+        // A quarter of the way from centre (0,0) to (1,0) along x: 0.25.
+        let v = t.lookup(0.375, 0.25, Wrap::Clamp, Filter::Bilinear)[0];
+        assert!((v - 0.25).abs() < 1e-12);
+        // Independent check: bilinear weights at an arbitrary point.
+        let (u, w) = (0.6, 0.4);
+        let (fx, fy) = (u * 2.0 - 0.5, w * 2.0 - 0.5);
+        let expect = (1.0 - fx) * (1.0 - fy) * 0.0
+            + fx * (1.0 - fy) * 1.0
+            + (1.0 - fx) * fy * 2.0
+            + fx * fy * 3.0;
+        assert!((t.lookup(u, w, Wrap::Clamp, Filter::Bilinear)[0] - expect).abs() < 1e-12);
+        // Repeat wraps across the edge: at u = 0 the value is halfway between columns 1 and 0.
+        let v = t.lookup(0.0, 0.25, Wrap::Repeat, Filter::Bilinear)[0];
+        assert!((v - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_texels_are_named() {
+        let e = Texture::from_texels("bad.exr", 2, 1, vec![[0.0; 3], [0.0, f32::NAN, 0.0]])
+            .unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.contains("bad.exr") && s.contains("x = 1") && s.contains("y = 0"),
+            "{s}"
+        );
+        assert!(Texture::from_texels("neg.exr", 1, 1, vec![[-1.0, 0.0, 0.0]]).is_err());
+    }
+}

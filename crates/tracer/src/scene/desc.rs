@@ -1,0 +1,473 @@
+//! The raw scene description: what the TOML file says, before validation. Each section or
+//! array element with a `type` key is read in two steps (the `type`, then the struct of that
+//! type) so that serde's errors keep their position in the file.
+
+use serde::Deserialize;
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+
+/// A colour or coefficient: a number (grey) or `[r, g, b]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RgbDesc(pub [f64; 3]);
+
+impl<'de> Deserialize<'de> for RgbDesc {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RgbDesc;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number (grey) or an array of three numbers [r, g, b]")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<RgbDesc, E> {
+                Ok(RgbDesc([v; 3]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<RgbDesc, E> {
+                Ok(RgbDesc([v as f64; 3]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<RgbDesc, E> {
+                Ok(RgbDesc([v as f64; 3]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<RgbDesc, A::Error> {
+                rgb_from_seq(seq, &self)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+fn rgb_from_seq<'de, A: SeqAccess<'de>>(
+    mut seq: A,
+    exp: &dyn de::Expected,
+) -> Result<RgbDesc, A::Error> {
+    let mut v = [0.0; 3];
+    for (i, c) in v.iter_mut().enumerate() {
+        *c = seq
+            .next_element::<f64>()?
+            .ok_or_else(|| de::Error::invalid_length(i, exp))?;
+    }
+    if seq.next_element::<de::IgnoredAny>()?.is_some() {
+        return Err(de::Error::invalid_length(4, exp));
+    }
+    Ok(RgbDesc(v))
+}
+
+/// A coefficient field: a number (grey constant), `[r, g, b]` (constant), or a table with a
+/// `type` (constant | stripe | check | image).
+#[derive(Debug, Clone, PartialEq)]
+pub enum FieldDesc {
+    /// A constant written as a number or an array.
+    Constant(RgbDesc),
+    /// A table.
+    Table(Box<FieldTable>),
+}
+
+impl<'de> Deserialize<'de> for FieldDesc {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = FieldDesc;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a number (grey), an array [r, g, b], or a table with `type` = \"constant\" | \"stripe\" | \"check\" | \"image\"",
+                )
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<FieldDesc, E> {
+                Ok(FieldDesc::Constant(RgbDesc([v; 3])))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<FieldDesc, E> {
+                Ok(FieldDesc::Constant(RgbDesc([v as f64; 3])))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<FieldDesc, E> {
+                Ok(FieldDesc::Constant(RgbDesc([v as f64; 3])))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<FieldDesc, A::Error> {
+                rgb_from_seq(seq, &self).map(FieldDesc::Constant)
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<FieldDesc, A::Error> {
+                FieldTable::deserialize(de::value::MapAccessDeserializer::new(map))
+                    .map(|t| FieldDesc::Table(Box::new(t)))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The kinds of field tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldKind {
+    /// `value`.
+    Constant,
+    /// `width`, `angle` (degrees), `values`, `axis`, `origin`.
+    Stripe,
+    /// `width`, `values`, `axis`, `origin`.
+    Check,
+    /// `texture`, `mapping`, `axis`, `origin`, `size`, `wrap`, `filter`, `scale`.
+    Image,
+}
+
+/// A field table. Which keys apply depends on `type`; the loader rejects the others.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldTable {
+    /// The kind.
+    #[serde(rename = "type")]
+    pub kind: FieldKind,
+    /// constant: the value.
+    pub value: Option<RgbDesc>,
+    /// stripe / check: band width or cell side (scene units; `unit_scale` does not apply to
+    /// lengths).
+    pub width: Option<f64>,
+    /// stripe: angle θ in DEGREES; bands vary along (cos θ, sin θ) in the (s, t) plane.
+    pub angle: Option<f64>,
+    /// stripe / check: the two values.
+    pub values: Option<[RgbDesc; 2]>,
+    /// Projection axis `"x" | "y" | "z"` (default z).
+    pub axis: Option<AxisDesc>,
+    /// Projection origin (default `[0, 0, 0]`).
+    pub origin: Option<[f64; 3]>,
+    /// image: the `[[texture]]` name.
+    pub texture: Option<String>,
+    /// image: `"planar"` (default) or `"uv"`.
+    pub mapping: Option<MappingDesc>,
+    /// image, planar: world size `[W, H]` of the image (scene units).
+    pub size: Option<[f64; 2]>,
+    /// image: `"repeat"` (default) or `"clamp"`.
+    pub wrap: Option<WrapDesc>,
+    /// image: `"bilinear"` (default) or `"nearest"`.
+    pub filter: Option<FilterDesc>,
+    /// image: per-channel multiplier of the texel values (default 1).
+    pub scale: Option<RgbDesc>,
+}
+
+/// Projection axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AxisDesc {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z.
+    Z,
+}
+
+/// Image mapping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MappingDesc {
+    /// Planar projection.
+    Planar,
+    /// Mesh texture coordinates.
+    Uv,
+}
+
+/// Wrap mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WrapDesc {
+    /// Tile.
+    Repeat,
+    /// Clamp to the edge.
+    Clamp,
+}
+
+/// Filter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FilterDesc {
+    /// Nearest texel.
+    Nearest,
+    /// Bilinear.
+    Bilinear,
+}
+
+/// `[render]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Random seed (default 0).
+    #[serde(default)]
+    pub seed: u64,
+    /// Maximum path depth (renderer default when absent).
+    pub max_depth: Option<u32>,
+    /// Estimator name (parsed by the renderer).
+    pub estimator: Option<String>,
+    /// `"multiple" | "single" | "all"`.
+    pub scattering: Option<String>,
+}
+
+/// `[camera]` with `type = "perspective"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerspectiveDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Eye position.
+    pub eye: [f64; 3],
+    /// Point looked at.
+    pub target: [f64; 3],
+    /// Up direction on screen.
+    pub up: [f64; 3],
+    /// Full vertical field of view in DEGREES.
+    pub fov_y: f64,
+}
+
+/// `[camera]` with `type = "orthographic"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrthographicDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Centre of the view rectangle (rays start on its plane).
+    pub centre: [f64; 3],
+    /// View direction (rays travel along it).
+    pub direction: [f64; 3],
+    /// Up direction on screen.
+    pub up: [f64; 3],
+    /// View width (scene units).
+    pub width: f64,
+    /// View height (scene units).
+    pub height: f64,
+}
+
+/// `[[texture]]`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureDesc {
+    /// Name used by fields.
+    pub name: String,
+    /// Image file, relative to the scene file.
+    pub path: String,
+    /// True when an 8/16-bit image holds data rather than sRGB colour (default false; EXR is
+    /// always linear).
+    #[serde(default)]
+    pub linear: bool,
+}
+
+/// `[[material]]` with `type = "translucent"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TranslucentDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Name used by shapes.
+    pub name: String,
+    /// Absorption coefficient field (per file unit, see `unit_scale`).
+    pub sigma_a: FieldDesc,
+    /// Scattering coefficient field (per file unit).
+    pub sigma_s: FieldDesc,
+    /// HG asymmetry (default 0), |g| < 1.
+    #[serde(default)]
+    pub g: f64,
+    /// Relative index of refraction ≥ 1 (default 1).
+    #[serde(default = "one")]
+    pub eta: f64,
+    /// Profile model name (dipole | pbd | better-dipole).
+    pub profile: Option<String>,
+    /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.
+    /// 1000 for coefficients per mm in a scene modelled in metres.
+    #[serde(default = "one")]
+    pub unit_scale: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[[material]]` with `type = "diffuse"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiffuseDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Name used by shapes.
+    pub name: String,
+    /// Lambertian albedo in [0, 1].
+    pub albedo: RgbDesc,
+}
+
+/// `[[light]]` with `type = "directional"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Direction the light TRAVELS.
+    pub direction: [f64; 3],
+    /// Irradiance on a surface perpendicular to the light.
+    pub irradiance: RgbDesc,
+}
+
+/// `[[light]]` with `type = "point"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Position.
+    pub position: [f64; 3],
+    /// Intensity (W/sr).
+    pub intensity: RgbDesc,
+}
+
+/// `[[light]]` with `type = "quad"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// A corner.
+    pub corner: [f64; 3],
+    /// First edge.
+    pub edge_u: [f64; 3],
+    /// Second edge; light leaves on the side of edge_u × edge_v.
+    pub edge_v: [f64; 3],
+    /// Radiance.
+    pub radiance: RgbDesc,
+}
+
+/// `[[light]]` with `type = "environment"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Constant radiance.
+    pub radiance: RgbDesc,
+}
+
+/// `[[light]]` with `type = "beam"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Start point.
+    pub origin: [f64; 3],
+    /// Direction of travel.
+    pub direction: [f64; 3],
+    /// Power.
+    pub power: RgbDesc,
+}
+
+/// A shape's optional transform: `p' = translate + R(rotate) · (scale ⊙ p)`.
+#[derive(Debug, Clone, PartialEq, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    /// Uniform (number) or per-axis (`[sx, sy, sz]`) scale, applied first.
+    pub scale: Option<RgbDesc>,
+    /// Rotation about an axis, applied second.
+    pub rotate: Option<RotateDesc>,
+    /// Translation, applied last.
+    pub translate: Option<[f64; 3]>,
+}
+
+/// Axis-angle rotation.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotateDesc {
+    /// Rotation axis (need not be unit).
+    pub axis: [f64; 3],
+    /// Angle in DEGREES, right-handed about `axis`.
+    pub degrees: f64,
+}
+
+/// Keys shared by every shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShapeCommon {
+    /// Material name.
+    pub material: String,
+    /// Optional object name (default `shape[i]`).
+    pub name: Option<String>,
+    /// Optional transform.
+    pub transform: Option<TransformDesc>,
+}
+
+macro_rules! shape_desc {
+    ($(#[$doc:meta])* $name:ident { $($(#[$fdoc:meta])* $field:ident : $ty:ty),* $(,)? }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, PartialEq, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct $name {
+            #[serde(rename = "type")]
+            _type: String,
+            /// Material name.
+            pub material: String,
+            /// Optional object name.
+            pub name: Option<String>,
+            /// Optional transform.
+            pub transform: Option<TransformDesc>,
+            $($(#[$fdoc])* pub $field: $ty,)*
+        }
+        impl $name {
+            /// The keys shared by every shape.
+            pub fn common(&self) -> ShapeCommon {
+                ShapeCommon {
+                    material: self.material.clone(),
+                    name: self.name.clone(),
+                    transform: self.transform.clone(),
+                }
+            }
+        }
+    };
+}
+
+shape_desc!(
+    /// `[[shape]]` with `type = "box"`.
+    BoxDesc {
+        /// Smallest corner.
+        min: [f64; 3],
+        /// Largest corner.
+        max: [f64; 3],
+    }
+);
+
+shape_desc!(
+    /// `[[shape]]` with `type = "sphere"`.
+    SphereDesc {
+        /// Centre.
+        centre: [f64; 3],
+        /// Radius.
+        radius: f64,
+        /// Icosphere subdivisions (default 5: 20,480 triangles; at most 9).
+        subdivisions: Option<u32>,
+    }
+);
+
+shape_desc!(
+    /// `[[shape]]` with `type = "half_space"`: a large box whose top face is `z = top`.
+    HalfSpaceDesc {
+        /// Height of the surface (default 0).
+        top: Option<f64>,
+        /// Centre of the top face in x, y (default `[0, 0]`).
+        centre: Option<[f64; 2]>,
+        /// Side of the top face (default 1000).
+        size: Option<f64>,
+        /// Depth below the top (default size / 2).
+        depth: Option<f64>,
+        /// Grid subdivisions of the top face (default 32).
+        subdivisions: Option<u32>,
+    }
+);
+
+shape_desc!(
+    /// `[[shape]]` with `type = "obj"`.
+    ObjDesc {
+        /// Mesh file, relative to the scene file.
+        path: String,
+    }
+);
+
+shape_desc!(
+    /// `[[shape]]` with `type = "gltf"`.
+    GltfDesc {
+        /// Mesh file (.gltf or .glb), relative to the scene file.
+        path: String,
+    }
+);

@@ -1,0 +1,910 @@
+//! TOML → [`Scene`]: parsing with positions, validation with key paths, lazy texture
+//! decoding, mesh loading.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use bssrdf_core::{ProfileModel, Rgb, Scattering};
+use glam::{DQuat, DVec3};
+use serde::Deserialize;
+use toml::Spanned;
+use toml::de::{DeTable, DeValue, ValueDeserializer};
+
+use super::builder::{AssemblyInfo, PendingObject, assemble, validate_material, validate_settings};
+use super::desc::*;
+use super::locate::Locator;
+use super::{Material, RenderSettings, Scene, Translucent};
+use crate::camera::{Camera, CameraError};
+use crate::error::{FieldError, SceneError};
+use crate::field::{
+    Axis, Field, Filter, ImageMapping, MediumField, PlanarProjection, Texture, Wrap,
+};
+use crate::geometry::{Transform, TriangleMesh, primitives};
+use crate::light::{Light, LightError};
+
+const SECTIONS: &[&str] = &["render", "camera", "texture", "material", "light", "shape"];
+
+impl Scene {
+    /// Loads a scene file; relative paths inside it are relative to its directory.
+    pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            file: path.to_path_buf(),
+            key: String::new(),
+            line: None,
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut scene = Self::from_toml_str(&text, base, &path.display().to_string())?;
+        scene.source_path = Some(path.to_path_buf());
+        Ok(scene)
+    }
+
+    /// Parses a scene from TOML text. `base_dir` resolves relative mesh and texture paths;
+    /// `display_name` names the scene in errors.
+    pub fn from_toml_str(
+        text: &str,
+        base_dir: &Path,
+        display_name: &str,
+    ) -> Result<Scene, SceneError> {
+        let file = PathBuf::from(display_name);
+        let root = DeTable::parse(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| 1 + text[..s.start.min(text.len())].matches('\n').count());
+            SceneError::Parse {
+                file: file.clone(),
+                key: String::new(),
+                line,
+                message: format!("malformed TOML: {}", e.message()),
+            }
+        })?;
+        let loc = Locator::new(text, &root);
+        let cx = Cx {
+            file,
+            base_dir: base_dir.to_path_buf(),
+            loc,
+        };
+        cx.load(&root, display_name)
+    }
+}
+
+/// Loading context: the file name, the base directory and the key locator.
+struct Cx {
+    file: PathBuf,
+    base_dir: PathBuf,
+    loc: Locator,
+}
+
+type Val<'i> = Spanned<DeValue<'i>>;
+
+impl Cx {
+    fn parse_err(&self, e: toml::de::Error, fallback_key: &str) -> SceneError {
+        let (key, line) = match e.span() {
+            Some(s) => {
+                let k = self.loc.key_at(s.start);
+                // Keep the more specific of the located key and the context key.
+                let k = if k.starts_with(fallback_key) {
+                    k
+                } else {
+                    fallback_key.to_string()
+                };
+                (k, self.loc.line_of(s.start))
+            }
+            None => (fallback_key.to_string(), self.loc.line_of_key(fallback_key)),
+        };
+        SceneError::Parse {
+            file: self.file.clone(),
+            key,
+            line,
+            message: e.message().to_string(),
+        }
+    }
+
+    fn parse_msg(&self, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Parse {
+            file: self.file.clone(),
+            key: key.to_string(),
+            line: self.loc.line_of_key(key),
+            message: message.into(),
+        }
+    }
+
+    fn invalid(&self, key: &str, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.clone(),
+            key: key.to_string(),
+            line: self.loc.line_of_key(key),
+            message: message.into(),
+        }
+    }
+
+    fn de<'i, T: Deserialize<'i>>(&self, v: &Val<'i>, key: &str) -> Result<T, SceneError> {
+        T::deserialize(ValueDeserializer::from(v.clone())).map_err(|e| self.parse_err(e, key))
+    }
+
+    /// The `type` of a table element, as a string.
+    fn type_of<'a>(
+        &self,
+        v: &'a Val<'_>,
+        key: &str,
+        expected: &str,
+    ) -> Result<&'a str, SceneError> {
+        let DeValue::Table(t) = v.get_ref() else {
+            return Err(self.parse_msg(key, format!("expected a table with `type` = {expected}")));
+        };
+        match t.get("type").map(|t| t.get_ref()) {
+            Some(DeValue::String(s)) => Ok(s.as_ref()),
+            Some(_) => Err(self.parse_msg(
+                &format!("{key}.type"),
+                format!("`type` must be a string: {expected}"),
+            )),
+            None => Err(self.parse_msg(key, format!("missing key `type` (expected {expected})"))),
+        }
+    }
+
+    fn elements<'a, 'i>(
+        &self,
+        root: &'a DeTable<'i>,
+        name: &str,
+    ) -> Result<Vec<(String, &'a Val<'i>)>, SceneError> {
+        match root.get(name).map(|v| v.get_ref()) {
+            None => Ok(Vec::new()),
+            Some(DeValue::Array(a)) => Ok(a
+                .iter()
+                .enumerate()
+                .map(|(i, v)| (format!("{name}[{i}]"), v))
+                .collect()),
+            Some(_) => {
+                Err(self.parse_msg(name, format!("expected an array of tables `[[{name}]]`")))
+            }
+        }
+    }
+
+    fn resolve(&self, rel: &str) -> PathBuf {
+        let p = Path::new(rel);
+        if p.is_absolute() {
+            p.to_path_buf()
+        } else {
+            self.base_dir.join(p)
+        }
+    }
+
+    fn check_readable(&self, key: &str, path: &Path) -> Result<(), SceneError> {
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_file() => Ok(()),
+            Ok(_) => Err(SceneError::Io {
+                file: self.file.clone(),
+                key: key.to_string(),
+                line: self.loc.line_of_key(key),
+                path: path.to_path_buf(),
+                source: std::io::Error::other("not a regular file"),
+            }),
+            Err(source) => Err(SceneError::Io {
+                file: self.file.clone(),
+                key: key.to_string(),
+                line: self.loc.line_of_key(key),
+                path: path.to_path_buf(),
+                source,
+            }),
+        }
+    }
+
+    fn load(&self, root: &Spanned<DeTable<'_>>, display_name: &str) -> Result<Scene, SceneError> {
+        let t = root.get_ref();
+        for (k, _) in t.iter() {
+            if !SECTIONS.contains(&k.get_ref().as_ref()) {
+                return Err(SceneError::Parse {
+                    file: self.file.clone(),
+                    key: k.get_ref().to_string(),
+                    line: self.loc.line_of(k.span().start),
+                    message: format!(
+                        "unknown section `{}`, expected one of: {}",
+                        k.get_ref(),
+                        SECTIONS.join(", ")
+                    ),
+                });
+            }
+        }
+        let settings = self.settings(t)?;
+        let camera = self.camera(t, &settings)?;
+        let textures = self.textures(t)?;
+        let materials = self.materials(t, &textures)?;
+        let lights = self.lights(t)?;
+        let shapes = self.shapes(t, &materials)?;
+
+        // Build the materials used by some shape (decoding only their textures).
+        let mut decoded: HashMap<String, Arc<Texture>> = HashMap::new();
+        let mut built: HashMap<String, Material> = HashMap::new();
+        let mut pending = Vec::with_capacity(shapes.len());
+        for s in shapes {
+            let material = match built.get(&s.material) {
+                Some(m) => m.clone(),
+                None => {
+                    let plan = &materials[&s.material];
+                    let m = self.realize(plan, &textures, &mut decoded)?;
+                    built.insert(s.material.clone(), m.clone());
+                    m
+                }
+            };
+            pending.push(PendingObject {
+                name: s.name,
+                line: self.loc.line_of_key(&s.key),
+                key: s.key,
+                source: s.source,
+                mesh: s.mesh,
+                material,
+            });
+        }
+        assemble(
+            AssemblyInfo {
+                file: self.file.clone(),
+                display_name: display_name.to_string(),
+                source_path: None,
+                locator: &self.loc,
+            },
+            settings,
+            camera,
+            lights,
+            pending,
+        )
+    }
+
+    fn settings(&self, t: &DeTable<'_>) -> Result<RenderSettings, SceneError> {
+        let v = t.get("render").ok_or_else(|| {
+            self.parse_msg("", "missing section [render] (width, height, spp, seed)")
+        })?;
+        let r: RenderDesc = self.de(v, "render")?;
+        let scattering = match &r.scattering {
+            None => None,
+            Some(s) => Some(
+                s.parse::<Scattering>()
+                    .map_err(|e| self.invalid("render.scattering", e.to_string()))?,
+            ),
+        };
+        let s = RenderSettings {
+            width: r.width,
+            height: r.height,
+            spp: r.spp,
+            seed: r.seed,
+            max_depth: r.max_depth,
+            estimator: r.estimator,
+            scattering,
+        };
+        validate_settings(&s).map_err(|(k, m)| self.invalid(&format!("render.{k}"), m))?;
+        Ok(s)
+    }
+
+    fn camera(&self, t: &DeTable<'_>, s: &RenderSettings) -> Result<Camera, SceneError> {
+        let v = t
+            .get("camera")
+            .ok_or_else(|| self.parse_msg("", "missing section [camera]"))?;
+        const KINDS: &str = "\"perspective\" | \"orthographic\"";
+        let (cam, fov_key) = match self.type_of(v, "camera", KINDS)? {
+            "perspective" => {
+                let d: PerspectiveDesc = self.de(v, "camera")?;
+                (
+                    Camera::perspective(
+                        d.eye.into(),
+                        d.target.into(),
+                        d.up.into(),
+                        d.fov_y,
+                        s.width,
+                        s.height,
+                    ),
+                    "camera.fov_y",
+                )
+            }
+            "orthographic" => {
+                let d: OrthographicDesc = self.de(v, "camera")?;
+                (
+                    Camera::orthographic(
+                        d.centre.into(),
+                        d.direction.into(),
+                        d.up.into(),
+                        d.width,
+                        d.height,
+                        s.width,
+                        s.height,
+                    ),
+                    "camera.width",
+                )
+            }
+            other => {
+                return Err(self.parse_msg(
+                    "camera.type",
+                    format!("unknown camera type `{other}`, expected {KINDS}"),
+                ));
+            }
+        };
+        cam.map_err(|e| {
+            let key = match e {
+                CameraError::BadFov(_) | CameraError::BadViewSize(..) => fov_key,
+                CameraError::BadFrame => "camera.up",
+                CameraError::BadResolution(..) => "render.width",
+                _ => "camera",
+            };
+            self.invalid(key, e.to_string())
+        })
+    }
+
+    fn textures(
+        &self,
+        t: &DeTable<'_>,
+    ) -> Result<HashMap<String, (String, TextureDesc)>, SceneError> {
+        let mut out = HashMap::new();
+        for (key, v) in self.elements(t, "texture")? {
+            let d: TextureDesc = self.de(v, &key)?;
+            if out.contains_key(&d.name) {
+                return Err(self.invalid(
+                    &format!("{key}.name"),
+                    format!("duplicate texture name `{}`", d.name),
+                ));
+            }
+            out.insert(d.name.clone(), (key, d));
+        }
+        Ok(out)
+    }
+
+    fn materials(
+        &self,
+        t: &DeTable<'_>,
+        textures: &HashMap<String, (String, TextureDesc)>,
+    ) -> Result<HashMap<String, MaterialPlan>, SceneError> {
+        const KINDS: &str = "\"translucent\" | \"diffuse\"";
+        let mut out = HashMap::new();
+        for (key, v) in self.elements(t, "material")? {
+            let plan = match self.type_of(v, &key, KINDS)? {
+                "translucent" => {
+                    let d: TranslucentDesc = self.de(v, &key)?;
+                    let profile =
+                        match &d.profile {
+                            None => None,
+                            Some(p) => Some(p.parse::<ProfileModel>().map_err(|e| {
+                                self.invalid(&format!("{key}.profile"), e.to_string())
+                            })?),
+                        };
+                    let sigma_a =
+                        self.field_spec(&d.sigma_a, &format!("{key}.sigma_a"), textures)?;
+                    let sigma_s =
+                        self.field_spec(&d.sigma_s, &format!("{key}.sigma_s"), textures)?;
+                    // Validate the scalar values now with placeholder constant fields (so that
+                    // unused materials are checked too).
+                    let probe = Translucent {
+                        name: d.name.clone(),
+                        medium: MediumField::new(
+                            Field::Constant(Rgb::ZERO),
+                            Field::Constant(Rgb::ZERO),
+                        ),
+                        g: d.g,
+                        eta: d.eta,
+                        profile,
+                        unit_scale: d.unit_scale,
+                        key: key.clone(),
+                        line: self.loc.line_of_key(&key),
+                    };
+                    validate_material(&Material::Translucent(probe.clone()))
+                        .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+                    (
+                        d.name.clone(),
+                        MaterialPlan::Translucent {
+                            base: probe,
+                            sigma_a,
+                            sigma_s,
+                        },
+                    )
+                }
+                "diffuse" => {
+                    let d: DiffuseDesc = self.de(v, &key)?;
+                    let m = Material::Diffuse {
+                        albedo: Rgb(d.albedo.0),
+                    };
+                    validate_material(&m)
+                        .map_err(|(k, msg)| self.invalid(&format!("{key}.{k}"), msg))?;
+                    (d.name.clone(), MaterialPlan::Ready(m))
+                }
+                other => {
+                    return Err(self.parse_msg(
+                        &format!("{key}.type"),
+                        format!("unknown material type `{other}`, expected {KINDS}"),
+                    ));
+                }
+            };
+            if out.contains_key(&plan.0) {
+                return Err(self.invalid(
+                    &format!("{key}.name"),
+                    format!("duplicate material name `{}`", plan.0),
+                ));
+            }
+            out.insert(plan.0, plan.1);
+        }
+        Ok(out)
+    }
+
+    /// Validates a field description without decoding images.
+    fn field_spec(
+        &self,
+        d: &FieldDesc,
+        key: &str,
+        textures: &HashMap<String, (String, TextureDesc)>,
+    ) -> Result<FieldSpec, SceneError> {
+        let ferr = |e: FieldError| self.invalid(key, e.to_string());
+        let tbl = match d {
+            FieldDesc::Constant(v) => {
+                return Field::constant(Rgb(v.0))
+                    .map(FieldSpec::Ready)
+                    .map_err(ferr);
+            }
+            FieldDesc::Table(t) => t,
+        };
+        // Which keys each kind accepts.
+        let present: Vec<(&str, bool)> = vec![
+            ("value", tbl.value.is_some()),
+            ("width", tbl.width.is_some()),
+            ("angle", tbl.angle.is_some()),
+            ("values", tbl.values.is_some()),
+            ("axis", tbl.axis.is_some()),
+            ("origin", tbl.origin.is_some()),
+            ("texture", tbl.texture.is_some()),
+            ("mapping", tbl.mapping.is_some()),
+            ("size", tbl.size.is_some()),
+            ("wrap", tbl.wrap.is_some()),
+            ("filter", tbl.filter.is_some()),
+            ("scale", tbl.scale.is_some()),
+        ];
+        let (kind, allowed, required): (&str, &[&str], &[&str]) = match tbl.kind {
+            FieldKind::Constant => ("constant", &["value"], &["value"]),
+            FieldKind::Stripe => (
+                "stripe",
+                &["width", "angle", "values", "axis", "origin"],
+                &["width", "values"],
+            ),
+            FieldKind::Check => (
+                "check",
+                &["width", "values", "axis", "origin"],
+                &["width", "values"],
+            ),
+            FieldKind::Image => (
+                "image",
+                &[
+                    "texture", "mapping", "axis", "origin", "size", "wrap", "filter", "scale",
+                ],
+                &["texture"],
+            ),
+        };
+        for (k, is) in &present {
+            if *is && !allowed.contains(k) {
+                return Err(self.invalid(
+                    &format!("{key}.{k}"),
+                    format!(
+                        "`{k}` does not apply to a `{kind}` field (its keys: {})",
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+        for r in required {
+            if !present.iter().any(|(k, is)| k == r && *is) {
+                return Err(self.invalid(key, format!("a `{kind}` field needs `{r}`")));
+            }
+        }
+        let axis = match tbl.axis.unwrap_or(AxisDesc::Z) {
+            AxisDesc::X => Axis::X,
+            AxisDesc::Y => Axis::Y,
+            AxisDesc::Z => Axis::Z,
+        };
+        let projection = PlanarProjection::new(axis, DVec3::from(tbl.origin.unwrap_or([0.0; 3])));
+        let values = tbl.values.map(|v| [Rgb(v[0].0), Rgb(v[1].0)]);
+        match tbl.kind {
+            FieldKind::Constant => Field::constant(Rgb(tbl.value.unwrap().0))
+                .map(FieldSpec::Ready)
+                .map_err(ferr),
+            FieldKind::Stripe => Field::stripe(
+                tbl.width.unwrap(),
+                tbl.angle.unwrap_or(0.0).to_radians(),
+                values.unwrap(),
+                projection,
+            )
+            .map(FieldSpec::Ready)
+            .map_err(ferr),
+            FieldKind::Check => Field::check(tbl.width.unwrap(), values.unwrap(), projection)
+                .map(FieldSpec::Ready)
+                .map_err(ferr),
+            FieldKind::Image => {
+                let name = tbl.texture.clone().unwrap();
+                if !textures.contains_key(&name) {
+                    let mut known: Vec<&String> = textures.keys().collect();
+                    known.sort();
+                    return Err(self.invalid(
+                        &format!("{key}.texture"),
+                        format!("unknown texture `{name}` (defined: {known:?})"),
+                    ));
+                }
+                let mapping = match tbl.mapping.unwrap_or(MappingDesc::Planar) {
+                    MappingDesc::Uv => {
+                        for k in ["axis", "origin", "size"] {
+                            if present.iter().any(|(p, is)| *p == k && *is) {
+                                return Err(self.invalid(
+                                    &format!("{key}.{k}"),
+                                    format!("`{k}` does not apply to `mapping = \"uv\"`"),
+                                ));
+                            }
+                        }
+                        ImageMapping::Uv
+                    }
+                    MappingDesc::Planar => {
+                        let size = tbl.size.ok_or_else(|| {
+                            self.invalid(
+                                key,
+                                "a planar image field needs `size = [W, H]` (scene units)",
+                            )
+                        })?;
+                        for (i, s) in size.iter().enumerate() {
+                            if !(s.is_finite() && *s > 0.0) {
+                                return Err(self.invalid(
+                                    &format!("{key}.size"),
+                                    format!("size[{i}] must be finite and positive, got {s}"),
+                                ));
+                            }
+                        }
+                        ImageMapping::Planar { projection, size }
+                    }
+                };
+                let scale = Rgb(tbl.scale.map_or([1.0; 3], |s| s.0));
+                if !(scale.is_finite() && scale.min_component() >= 0.0) {
+                    return Err(self.invalid(
+                        &format!("{key}.scale"),
+                        format!("scale must be finite and non-negative, got {:?}", scale.0),
+                    ));
+                }
+                Ok(FieldSpec::Image {
+                    texture: name,
+                    mapping,
+                    wrap: match tbl.wrap.unwrap_or(WrapDesc::Repeat) {
+                        WrapDesc::Repeat => Wrap::Repeat,
+                        WrapDesc::Clamp => Wrap::Clamp,
+                    },
+                    filter: match tbl.filter.unwrap_or(FilterDesc::Bilinear) {
+                        FilterDesc::Bilinear => Filter::Bilinear,
+                        FilterDesc::Nearest => Filter::Nearest,
+                    },
+                    scale,
+                    key: key.to_string(),
+                })
+            }
+        }
+    }
+
+    /// Builds a material, decoding the textures it uses (once per texture).
+    fn realize(
+        &self,
+        plan: &MaterialPlan,
+        textures: &HashMap<String, (String, TextureDesc)>,
+        decoded: &mut HashMap<String, Arc<Texture>>,
+    ) -> Result<Material, SceneError> {
+        match plan {
+            MaterialPlan::Ready(m) => Ok(m.clone()),
+            MaterialPlan::Translucent {
+                base,
+                sigma_a,
+                sigma_s,
+            } => {
+                let a = self.realize_field(sigma_a, textures, decoded)?;
+                let s = self.realize_field(sigma_s, textures, decoded)?;
+                let mut t = base.clone();
+                t.medium = MediumField::new(a, s).scaled(base.unit_scale);
+                Ok(Material::Translucent(t))
+            }
+        }
+    }
+
+    fn realize_field(
+        &self,
+        spec: &FieldSpec,
+        textures: &HashMap<String, (String, TextureDesc)>,
+        decoded: &mut HashMap<String, Arc<Texture>>,
+    ) -> Result<Field, SceneError> {
+        match spec {
+            FieldSpec::Ready(f) => Ok(f.clone()),
+            FieldSpec::Image {
+                texture,
+                mapping,
+                wrap,
+                filter,
+                scale,
+                key,
+            } => {
+                let tex = match decoded.get(texture) {
+                    Some(t) => t.clone(),
+                    None => {
+                        let (tkey, desc) = &textures[texture];
+                        let path = self.resolve(&desc.path);
+                        let path_key = format!("{tkey}.path");
+                        self.check_readable(&path_key, &path)?;
+                        let t = Texture::load(&path, desc.linear).map_err(|source| {
+                            SceneError::Texture {
+                                file: self.file.clone(),
+                                line: self.loc.line_of_key(&path_key),
+                                key: path_key.clone(),
+                                source: Box::new(source),
+                            }
+                        })?;
+                        let t = Arc::new(t);
+                        decoded.insert(texture.clone(), t.clone());
+                        t
+                    }
+                };
+                Field::image(tex, *mapping, *wrap, *filter, *scale)
+                    .map_err(|e| self.invalid(key, e.to_string()))
+            }
+        }
+    }
+
+    fn lights(&self, t: &DeTable<'_>) -> Result<Vec<Light>, SceneError> {
+        const KINDS: &str = "\"directional\" | \"point\" | \"quad\" | \"environment\" | \"beam\"";
+        let mut out = Vec::new();
+        for (key, v) in self.elements(t, "light")? {
+            let light = match self.type_of(v, &key, KINDS)? {
+                "directional" => {
+                    let d: DirectionalDesc = self.de(v, &key)?;
+                    Light::directional(d.direction.into(), Rgb(d.irradiance.0))
+                }
+                "point" => {
+                    let d: PointDesc = self.de(v, &key)?;
+                    Light::point(d.position.into(), Rgb(d.intensity.0))
+                }
+                "quad" => {
+                    let d: QuadDesc = self.de(v, &key)?;
+                    Light::quad(
+                        d.corner.into(),
+                        d.edge_u.into(),
+                        d.edge_v.into(),
+                        Rgb(d.radiance.0),
+                    )
+                }
+                "environment" => {
+                    let d: EnvironmentDesc = self.de(v, &key)?;
+                    Light::environment(Rgb(d.radiance.0))
+                }
+                "beam" => {
+                    let d: BeamDesc = self.de(v, &key)?;
+                    Light::beam(d.origin.into(), d.direction.into(), Rgb(d.power.0))
+                }
+                other => {
+                    return Err(self.parse_msg(
+                        &format!("{key}.type"),
+                        format!("unknown light type `{other}`, expected {KINDS}"),
+                    ));
+                }
+            };
+            out.push(light.map_err(|e| {
+                let sub = match &e {
+                    LightError::BadDirection(w) | LightError::NonFinite(w) => *w,
+                    LightError::BadValue { what, .. } => what,
+                    LightError::DegenerateQuad => "edge_v",
+                };
+                self.invalid(&format!("{key}.{sub}"), e.to_string())
+            })?);
+        }
+        Ok(out)
+    }
+
+    fn shapes(
+        &self,
+        t: &DeTable<'_>,
+        materials: &HashMap<String, MaterialPlan>,
+    ) -> Result<Vec<ShapePlan>, SceneError> {
+        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\"";
+        let mut out: Vec<ShapePlan> = Vec::new();
+        let mut names = HashSet::new();
+        for (i, (key, v)) in self.elements(t, "shape")?.into_iter().enumerate() {
+            let k = |sub: &str| format!("{key}.{sub}");
+            let (common, mesh, source) = match self.type_of(v, &key, KINDS)? {
+                "box" => {
+                    let d: BoxDesc = self.de(v, &key)?;
+                    let (lo, hi) = (DVec3::from(d.min), DVec3::from(d.max));
+                    if !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
+                        return Err(self.invalid(
+                            &k("max"),
+                            format!(
+                                "need min < max in every axis, got min {:?}, max {:?}",
+                                d.min, d.max
+                            ),
+                        ));
+                    }
+                    (d.common(), primitives::cuboid(lo, hi), "<box>".to_string())
+                }
+                "sphere" => {
+                    let d: SphereDesc = self.de(v, &key)?;
+                    let c = DVec3::from(d.centre);
+                    if !(d.radius.is_finite() && d.radius > 0.0) {
+                        return Err(self.invalid(
+                            &k("radius"),
+                            format!("radius must be finite and positive, got {}", d.radius),
+                        ));
+                    }
+                    if !c.is_finite() {
+                        return Err(self.invalid(&k("centre"), "centre must be finite"));
+                    }
+                    let s = d.subdivisions.unwrap_or(5);
+                    if s > 9 {
+                        return Err(self.invalid(
+                            &k("subdivisions"),
+                            format!("at most 9 (5,242,880 triangles), got {s}"),
+                        ));
+                    }
+                    (
+                        d.common(),
+                        primitives::icosphere(c, d.radius, s),
+                        "<sphere>".to_string(),
+                    )
+                }
+                "half_space" => {
+                    let d: HalfSpaceDesc = self.de(v, &key)?;
+                    let size = d.size.unwrap_or(1000.0);
+                    let depth = d.depth.unwrap_or(0.5 * size);
+                    let top = d.top.unwrap_or(0.0);
+                    let centre = d.centre.unwrap_or([0.0, 0.0]);
+                    let sub = d.subdivisions.unwrap_or(32);
+                    for (name, val) in [("size", size), ("depth", depth)] {
+                        if !(val.is_finite() && val > 0.0) {
+                            return Err(self.invalid(
+                                &k(name),
+                                format!("{name} must be finite and positive, got {val}"),
+                            ));
+                        }
+                    }
+                    if !(top.is_finite() && centre.iter().all(|c| c.is_finite())) {
+                        return Err(self.invalid(&k("top"), "top and centre must be finite"));
+                    }
+                    if sub == 0 || sub > 1024 {
+                        return Err(self.invalid(
+                            &k("subdivisions"),
+                            format!("must be in 1..=1024, got {sub}"),
+                        ));
+                    }
+                    (
+                        d.common(),
+                        primitives::half_space(top, centre, size, depth, sub),
+                        "<half_space>".to_string(),
+                    )
+                }
+                kind @ ("obj" | "gltf") => {
+                    let (common, rel) = if kind == "obj" {
+                        let d: ObjDesc = self.de(v, &key)?;
+                        (d.common(), d.path)
+                    } else {
+                        let d: GltfDesc = self.de(v, &key)?;
+                        (d.common(), d.path)
+                    };
+                    let path = self.resolve(&rel);
+                    self.check_readable(&k("path"), &path)?;
+                    let mesh = self
+                        .load_mesh(kind, &path)
+                        .map_err(|source| SceneError::Mesh {
+                            file: self.file.clone(),
+                            key: k("path"),
+                            line: self.loc.line_of_key(&k("path")),
+                            source: Box::new(source),
+                        })?;
+                    (common, mesh, path.display().to_string())
+                }
+                other => {
+                    return Err(self.parse_msg(
+                        &k("type"),
+                        format!("unknown shape type `{other}`, expected {KINDS}"),
+                    ));
+                }
+            };
+            if !materials.contains_key(&common.material) {
+                let mut known: Vec<&String> = materials.keys().collect();
+                known.sort();
+                return Err(self.invalid(
+                    &k("material"),
+                    format!(
+                        "unknown material `{}` (defined: {known:?})",
+                        common.material
+                    ),
+                ));
+            }
+            let name = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
+            if !names.insert(name.clone()) {
+                return Err(self.invalid(&k("name"), format!("duplicate shape name `{name}`")));
+            }
+            let mut mesh = mesh;
+            if let Some(tf) = &common.transform {
+                let xf = self.transform(tf, &k("transform"))?;
+                mesh.transform(&xf);
+            }
+            out.push(ShapePlan {
+                name,
+                key,
+                material: common.material,
+                mesh,
+                source,
+            });
+        }
+        Ok(out)
+    }
+
+    fn load_mesh(&self, kind: &str, path: &Path) -> Result<TriangleMesh, crate::error::MeshError> {
+        let file = path.display().to_string();
+        match kind {
+            #[cfg(feature = "obj")]
+            "obj" => crate::geometry::obj::load_obj(path),
+            #[cfg(feature = "gltf")]
+            "gltf" => crate::geometry::gltf::load_gltf(path),
+            _ => Err(crate::error::MeshError::Unsupported {
+                file,
+                format: if kind == "obj" { "OBJ" } else { "glTF" },
+                feature: if kind == "obj" { "obj" } else { "gltf" },
+            }),
+        }
+    }
+
+    fn transform(&self, d: &TransformDesc, key: &str) -> Result<Transform, SceneError> {
+        let mut t = Transform::IDENTITY;
+        if let Some(s) = d.scale {
+            let s = DVec3::from(s.0);
+            if !(s.is_finite() && s.abs().min_element() > 0.0) {
+                return Err(self.invalid(
+                    &format!("{key}.scale"),
+                    format!("scale must be finite and non-zero, got {:?}", s.to_array()),
+                ));
+            }
+            t.scale = s;
+        }
+        if let Some(r) = &d.rotate {
+            let axis = DVec3::from(r.axis);
+            if !(axis.is_finite() && axis.length() > 0.0 && r.degrees.is_finite()) {
+                return Err(self.invalid(
+                    &format!("{key}.rotate"),
+                    "rotate needs a finite non-zero `axis` and finite `degrees`",
+                ));
+            }
+            t.rotation = DQuat::from_axis_angle(axis.normalize(), r.degrees.to_radians());
+        }
+        if let Some(tr) = d.translate {
+            let tr = DVec3::from(tr);
+            if !tr.is_finite() {
+                return Err(self.invalid(&format!("{key}.translate"), "translate must be finite"));
+            }
+            t.translation = tr;
+        }
+        Ok(t)
+    }
+}
+
+/// A material after validation, before its textures are decoded.
+#[allow(clippy::large_enum_variant)] // a few per scene, built once
+enum MaterialPlan {
+    Ready(Material),
+    Translucent {
+        base: Translucent,
+        sigma_a: FieldSpec,
+        sigma_s: FieldSpec,
+    },
+}
+
+/// A validated field; images are decoded later, only if used.
+enum FieldSpec {
+    Ready(Field),
+    Image {
+        texture: String,
+        mapping: ImageMapping,
+        wrap: Wrap,
+        filter: Filter,
+        scale: Rgb,
+        key: String,
+    },
+}
+
+struct ShapePlan {
+    name: String,
+    key: String,
+    material: String,
+    mesh: TriangleMesh,
+    source: String,
+}

@@ -1,0 +1,285 @@
+//! Scenes: the validated runtime form ([`Scene`]), loading from TOML ([`Scene::load`]), and a
+//! programmatic [`SceneBuilder`] for tests and experiments.
+//!
+//! # File format (TOML)
+//! Units are explicit: lengths in scene units, angles in degrees, coefficients in 1/scene-unit
+//! (after `unit_scale`), colours as a number (grey) or `[r, g, b]` (linear). Unknown keys are
+//! errors; every error names the file, the key path (`material[1].sigma_a.width`) and the line.
+//!
+//! * `[render]`: `width`, `height`, `spp` (all ≥ 1), `seed` (default 0), optional `max_depth`,
+//!   `estimator` (a name the renderer parses), `scattering` (`multiple | single | all`).
+//! * `[camera]`: `type = "perspective"` with `eye`, `target`, `up`, `fov_y` (degrees, full
+//!   vertical), or `type = "orthographic"` with `centre`, `direction` (view direction; rays start
+//!   on the plane through `centre`), `up`, `width`, `height` (of the view rectangle).
+//! * `[[texture]]`: `name`, `path` (relative to the scene file), `linear` (default false: 8/16-bit
+//!   images hold sRGB colours; EXR is always linear). A texture is decoded only if a material
+//!   used by some shape refers to it.
+//! * `[[material]]`: `type = "translucent"` with `name`, `sigma_a`, `sigma_s` (fields, see
+//!   below), `g` (default 0, |g| < 1), `eta` (default 1, ≥ 1), optional `profile`
+//!   (`dipole | pbd | better-dipole`), `unit_scale` (default 1: file coefficients × unit_scale =
+//!   1/scene-unit); or `type = "diffuse"` with `name`, `albedo`. Unused materials are validated
+//!   but their textures are not decoded.
+//! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
+//!   `constant` (`value`); `stripe` (`width`, `angle` in degrees, `values = [v0, v1]`, `axis`,
+//!   `origin`); `check` (`width`, `values`, `axis`, `origin`); `image` (`texture`, `mapping =
+//!   "planar" | "uv"`, `axis`, `origin`, `size = [W, H]` for planar, `wrap = "repeat" | "clamp"`,
+//!   `filter = "bilinear" | "nearest"`, `scale`). See [`crate::field`] for the projection.
+//! * `[[light]]`: `directional` (`direction` it travels, `irradiance`), `point` (`position`,
+//!   `intensity`), `quad` (`corner`, `edge_u`, `edge_v`, `radiance`; emits on the side of
+//!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`), `beam`
+//!   (`origin`, `direction`, `power`).
+//! * `[[shape]]`: `box` (`min`, `max`), `sphere` (`centre`, `radius`, `subdivisions`),
+//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
+//!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
+//!   degrees }, translate }`.
+
+mod builder;
+mod load;
+mod locate;
+
+pub mod desc;
+
+pub use builder::SceneBuilder;
+
+use std::path::PathBuf;
+
+use bssrdf_core::{ProfileModel, Rgb, Scattering};
+use glam::DVec3;
+
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::field::MediumField;
+use crate::geometry::{Geometry, MeshReport, ObjectSurface};
+use crate::light::{BeamLight, Light};
+
+/// Render settings from `[render]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    /// Image width in pixels (≥ 1).
+    pub width: u32,
+    /// Image height in pixels (≥ 1).
+    pub height: u32,
+    /// Samples per pixel (≥ 1).
+    pub spp: u32,
+    /// Random seed.
+    pub seed: u64,
+    /// Maximum path depth, if given.
+    pub max_depth: Option<u32>,
+    /// Estimator name, if given (parsed by the renderer).
+    pub estimator: Option<String>,
+    /// Scattering orders, if given.
+    pub scattering: Option<Scattering>,
+}
+
+impl RenderSettings {
+    /// Settings with seed 0 and nothing optional.
+    pub fn new(width: u32, height: u32, spp: u32) -> Self {
+        Self {
+            width,
+            height,
+            spp,
+            seed: 0,
+            max_depth: None,
+            estimator: None,
+            scattering: None,
+        }
+    }
+}
+
+/// A translucent material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Translucent {
+    /// Material name.
+    pub name: String,
+    /// σa and σs (1/scene-unit, `unit_scale` applied).
+    pub medium: MediumField,
+    /// Henyey–Greenstein asymmetry, |g| < 1.
+    pub g: f64,
+    /// Relative index of refraction n_medium / n_outside ≥ 1.
+    pub eta: f64,
+    /// Profile model requested by the material, if any.
+    pub profile: Option<ProfileModel>,
+    /// The `unit_scale` that was applied to the file's coefficients.
+    pub unit_scale: f64,
+    /// Key of the material in the scene file (`material[2]`) for messages.
+    pub key: String,
+    /// Line of the material in the scene file, if loaded from one.
+    pub line: Option<usize>,
+}
+
+impl Translucent {
+    /// A translucent material with no profile and unit scale 1 (validated when the scene is
+    /// built).
+    pub fn new(name: impl Into<String>, medium: MediumField, g: f64, eta: f64) -> Self {
+        let name = name.into();
+        Self {
+            key: format!("material `{name}`"),
+            name,
+            medium,
+            g,
+            eta,
+            profile: None,
+            unit_scale: 1.0,
+            line: None,
+        }
+    }
+}
+
+/// What an object is made of.
+// One per object, matched outside hot loops: the size difference does not matter, and an
+// unboxed `Translucent` keeps patterns like `Material::Translucent(Translucent { medium, .. })`.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, PartialEq)]
+pub enum Material {
+    /// A participating medium inside a (closed) mesh.
+    Translucent(Translucent),
+    /// A Lambertian reflector.
+    Diffuse {
+        /// Albedo in [0, 1].
+        albedo: Rgb,
+    },
+    /// An emitter (the geometry of a quad light).
+    Emissive {
+        /// Emitted radiance (on the light's emitting side).
+        radiance: Rgb,
+    },
+}
+
+impl Material {
+    /// The translucent material, if this is one.
+    pub fn translucent(&self) -> Option<&Translucent> {
+        match self {
+            Material::Translucent(t) => Some(t),
+            _ => None,
+        }
+    }
+}
+
+/// One object of the scene: `scene.geometry`'s object with the same index.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    /// Object name (`shape[i]` by default, `light[j]` for quad lights).
+    pub name: String,
+    /// Its material.
+    pub material: Material,
+    /// Topology of its mesh (closedness, orientation).
+    pub report: MeshReport,
+    /// Index into `scene.lights` when the object is a light's geometry.
+    pub emitter: Option<usize>,
+    /// Key in the scene file (`shape[3]`, `light[0]`).
+    pub key: String,
+    /// Line in the scene file, if loaded from one.
+    pub line: Option<usize>,
+    /// Where the mesh came from: a file path, or `<box>`, `<sphere>`…
+    pub source: String,
+}
+
+/// A validated scene: camera, lights, objects with their materials, and the geometry.
+#[derive(Debug)]
+pub struct Scene {
+    /// The camera (its resolution equals `settings.width × settings.height`).
+    pub camera: Camera,
+    /// Every light (quad lights are also objects).
+    pub lights: Vec<Light>,
+    /// Objects; `objects[i]` is object `i` of `geometry`.
+    pub objects: Vec<Object>,
+    /// The meshes and their BVHs.
+    pub geometry: Geometry,
+    /// `[render]`.
+    pub settings: RenderSettings,
+    /// The scene file, when loaded from one.
+    pub source_path: Option<PathBuf>,
+    /// The name used in messages (the file path, or the builder's name).
+    pub display_name: String,
+}
+
+impl Scene {
+    /// The surface of `object` for the estimators.
+    pub fn object_surface(&self, object: u32) -> ObjectSurface<'_> {
+        ObjectSurface::new(&self.geometry, object)
+    }
+
+    /// The beam lights (for the beam experiment).
+    pub fn beams(&self) -> impl Iterator<Item = &BeamLight> {
+        self.lights.iter().filter_map(|l| match l {
+            Light::Beam(b) => Some(b),
+            _ => None,
+        })
+    }
+
+    /// Total environment radiance arriving along an escaped ray travelling in `dir`.
+    pub fn environment_radiance(&self, dir: DVec3) -> Rgb {
+        let mut l = Rgb::ZERO;
+        for light in &self.lights {
+            l += light.le(dir);
+        }
+        l
+    }
+
+    /// Indices of the translucent objects.
+    pub fn translucent_objects(&self) -> impl Iterator<Item = (u32, &Translucent)> {
+        self.objects
+            .iter()
+            .enumerate()
+            .filter_map(|(i, o)| o.material.translucent().map(|t| (i as u32, t)))
+    }
+
+    fn invalid(&self, key: String, line: Option<usize>, message: String) -> SceneError {
+        SceneError::Invalid {
+            file: PathBuf::from(&self.display_name),
+            key,
+            line,
+            message,
+        }
+    }
+
+    /// Errors when a translucent object's mesh is not closed (open edges, non-manifold or
+    /// inconsistently oriented edges): the volumetric path tracer needs a well-defined inside.
+    /// BSSRDF renders tolerate open meshes and need not call this.
+    pub fn require_closed_translucent(&self) -> Result<(), SceneError> {
+        for o in &self.objects {
+            if matches!(o.material, Material::Translucent(_)) && !o.report.is_closed() {
+                return Err(self.invalid(
+                    o.key.clone(),
+                    o.line,
+                    format!(
+                        "the translucent mesh `{}` ({}) is {}; the path tracer needs a closed mesh",
+                        o.name,
+                        o.source,
+                        o.report.summary()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Errors when a translucent material used by an object has a field defined only on the
+    /// surface (a UV-mapped image): a volumetric render needs coefficients in the volume.
+    pub fn require_volumetric(&self) -> Result<(), SceneError> {
+        for (_, t) in self.translucent_objects() {
+            for (which, f) in [
+                ("sigma_a", t.medium.sigma_a()),
+                ("sigma_s", t.medium.sigma_s()),
+            ] {
+                if !f.is_volumetric() {
+                    return Err(self.invalid(
+                        format!("{}.{which}", t.key),
+                        t.line,
+                        format!(
+                            "material `{}`: {which} is a UV-mapped image, defined only on the surface; a volumetric (path-traced) render needs a planar projection (`mapping = \"planar\"`)",
+                            t.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Both checks a volumetric path-traced render needs.
+    pub fn require_path_traceable(&self) -> Result<(), SceneError> {
+        self.require_volumetric()?;
+        self.require_closed_translucent()
+    }
+}

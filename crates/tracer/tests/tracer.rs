@@ -1,0 +1,18 @@
+//! Integration tests of the tracer's infrastructure (one test binary, one module per theme).
+
+#[path = "tracer/common.rs"]
+mod common;
+#[path = "tracer/geometry.rs"]
+mod geometry;
+#[path = "tracer/lights.rs"]
+mod lights;
+#[path = "tracer/meshes.rs"]
+mod meshes;
+#[path = "tracer/offset.rs"]
+mod offset;
+#[path = "tracer/output.rs"]
+mod output;
+#[path = "tracer/scene.rs"]
+mod scene;
+#[path = "tracer/textures.rs"]
+mod textures;

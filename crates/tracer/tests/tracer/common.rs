@@ -1,0 +1,49 @@
+//! Helpers shared by the test modules: random directions and an independent f64
+//! ray/triangle test for brute-force comparisons.
+
+use glam::DVec3;
+use tracer::rng::Rng;
+
+/// Uniform direction on the sphere.
+pub fn random_dir(rng: &mut Rng) -> DVec3 {
+    let z = 1.0 - 2.0 * rng.uniform();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * rng.uniform();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Möller–Trumbore in f64 (written independently of the tracer's watertight test): the
+/// distance to triangle `v` along the ray, if hit with t in (t_min, t_max).
+pub fn brute_triangle(o: DVec3, d: DVec3, v: [DVec3; 3], t_min: f64, t_max: f64) -> Option<f64> {
+    let e1 = v[1] - v[0];
+    let e2 = v[2] - v[0];
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - v[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let w = d.dot(q) * inv;
+    if w < 0.0 || u + w > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    (t > t_min && t < t_max).then_some(t)
+}
+
+/// True when `path` exists; otherwise prints a note that the test is skipped.
+pub fn asset(path: &str) -> Option<std::path::PathBuf> {
+    let p = std::path::PathBuf::from(path);
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!("note: {path} is absent on this machine: test skipped");
+        None
+    }
+}
