@@ -10,7 +10,7 @@ use tracer::geometry::{Geometry, Ray, Transform, TriangleMesh};
 
 use crate::common::asset;
 
-const CUBE_OBJ: &str = "\
+pub const CUBE_OBJ: &str = "\
 # unit cube as quads, with normals and texture coordinates
 o cube
 v 0 0 0
@@ -146,7 +146,7 @@ fn bad_obj_files_are_rejected_naming_the_file() {
 
 /// A tetrahedron in a glTF file with an external buffer, under two nested nodes (translation,
 /// then scale), with texture coordinates.
-fn write_gltf(dir: &Path) -> std::path::PathBuf {
+pub fn write_gltf(dir: &Path) -> std::path::PathBuf {
     let pos: [[f32; 3]; 4] = [
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
