@@ -1,4 +1,6 @@
 //! Integration tests of the tracer's infrastructure (one test binary, one module per theme).
+// Channel loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
 
 #[path = "tracer/common.rs"]
 mod common;
