@@ -30,6 +30,8 @@
 //! * No hits: see [`MissPolicy`]; with hits only, a channel without hits gets the endpoint
 //!   mean (for step 1 too), flagged in the diagnostics.
 
+use std::num::NonZeroU32;
+
 use bssrdf_core::Rgb;
 
 use crate::budget::{MissPolicy, SampleBudget};
@@ -75,6 +77,16 @@ impl SoneParams {
             misses: MissPolicy::HitsOnly,
             use_field_average: true,
         }
+    }
+
+    /// The paper's reading with error-controlled sampling, for reference renders: each stage
+    /// samples until the estimated relative standard error of every averaged channel is 1%
+    /// (at most 4096 points per stage).
+    pub const fn reference() -> Self {
+        Self::paper().with_samples(SampleBudget::TargetRelError {
+            rel_se: 0.01,
+            max: NonZeroU32::new(4096).unwrap(),
+        })
     }
 
     /// The same parameters with `samples` for both the disk and the ellipse.

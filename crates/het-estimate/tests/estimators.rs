@@ -339,6 +339,13 @@ fn linear_ramp_gives_the_centroid_value() {
             assert_eq!(fa.diagnostics.projections, 0);
         }
     }
+    // The presets too (the reference preset stops early: a linear field has no variance).
+    for p in [SoneParams::paper(), SoneParams::reference()] {
+        let mut p = p;
+        p.use_field_average = false;
+        let est = run(Estimator::Sone(p), 0.0, &Plane, &field, &x_i, &x_o, 3);
+        assert!(close(est.coefficients), "{p:?}: {:?}", est.coefficients);
+    }
 }
 
 /// The Sone estimate on the Figure 4 stripe preset against an independent computation:
