@@ -1,1 +1,4 @@
-//! Workspace integration tests (one binary; modules per theme).
+//! Workspace integration tests: one binary, one module per theme.
+
+mod common;
+mod validation;

@@ -120,7 +120,9 @@ pub fn render<E: PixelEstimator>(
         }
         let per_sample = pass_start.elapsed().as_secs_f64() / (end - done) as f64;
         done = end;
-        let Budget::Time(limit) = options.budget else { break };
+        let Budget::Time(limit) = options.budget else {
+            break;
+        };
         // The next pass doubles the count; stop if it is predicted to overshoot the budget.
         let next = done;
         let predicted = start.elapsed().as_secs_f64() + per_sample * next as f64;
@@ -171,13 +173,24 @@ mod tests {
     }
 
     fn opts(budget: Budget) -> RenderOptions {
-        RenderOptions { budget, seed: 5, progress: false, label: String::new() }
+        RenderOptions {
+            budget,
+            seed: 5,
+            progress: false,
+            label: String::new(),
+        }
     }
 
     #[test]
     fn identical_whatever_the_thread_count() {
-        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let two = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
         let a = one.install(|| render(13, 7, &Noise, &opts(Budget::Samples(5))));
         let b = two.install(|| render(13, 7, &Noise, &opts(Budget::Samples(5))));
         assert_eq!(a.spp, 5);

@@ -1,0 +1,498 @@
+//! The paper's Figure 4 experiment: a pencil beam of unit power enters a non-refractive
+//! (η = 1) semi-infinite medium at the origin, perpendicular to its surface z = 0 (medium in
+//! z < 0); σs is constant, σa is a texture varying in x and y only. The output is the diffuse
+//! exitance map — power leaving through the surface per unit area, in all directions, per unit
+//! beam power (1/length²) — over [−E, E]² on an N × N grid.
+//!
+//! Map convention: row 0 is y = +E, column 0 is x = −E; pixel (i, j) covers
+//! x ∈ [−E + jΔ, −E + (j+1)Δ], y ∈ [E − (i+1)Δ, E − iΔ], Δ = 2E/N; a value is the pixel average.
+//!
+//! Everything runs through the tracer: the half-space is a large box mesh, the beam's entry
+//! point and every exitant point are found by tracing, and the estimators' projection rays
+//! use the BVH.
+//! * `pt` ([`trace_photons`]): light tracing with the volumetric random walk of the path
+//!   tracer ([`crate::integrator::walk`]). Every photon carries weight 1 (analog tracking,
+//!   η = 1), so a pixel's value is an integer count of exits / (photons · Δ²): sums of
+//!   integers are exact, so the map is identical whatever the thread count.
+//! * BSSRDF methods ([`bssrdf_map`]): for `k × k` stratified jittered points x_o per pixel,
+//!   estimate the homogeneous coefficients for (x_i, x_o) and evaluate the profile R(r) at
+//!   r = |x_o − x_i|.
+
+use std::time::{Duration, Instant};
+
+use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use glam::DVec3;
+use het_estimate::{Coefficients, Estimator};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::field::{Field, MediumField, PlanarProjection};
+use crate::geometry::{Hit, Ray, primitives};
+use crate::integrator::PathCounters;
+use crate::integrator::path::ChannelView;
+use crate::integrator::walk::{Interface, WalkEnd, WalkMedium};
+use crate::light::Light;
+use crate::render::Counters;
+use crate::rng::Rng;
+use crate::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+
+/// Side of the box standing in for the half-space (scene units), and its depth. With
+/// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
+/// sides or bottom is below e⁻²⁴ of the beam.
+pub const HALF_SPACE_SIZE: f64 = 400.0;
+/// Depth of the half-space box.
+pub const HALF_SPACE_DEPTH: f64 = 200.0;
+/// Photons per parallel batch of the light tracer.
+const BATCH: u64 = 1 << 13;
+
+/// The σa texture of the experiment (values in 1/length).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum BeamTexture {
+    /// The same σa everywhere.
+    Const {
+        /// σa.
+        value: f64,
+    },
+    /// Stripes: u = x cos θ + y sin θ, k = floor(u/w + ½), σa = values[k mod 2].
+    Stripe {
+        /// The two values; the band containing the origin has `values[0]`.
+        values: [f64; 2],
+        /// Band width w.
+        width: f64,
+        /// θ in degrees.
+        angle_deg: f64,
+    },
+    /// Checks: k = floor(x/w + ½) + floor(y/w + ½), σa = values[k mod 2].
+    Check {
+        /// The two values; the cell containing the origin has `values[0]`.
+        values: [f64; 2],
+        /// Cell side w.
+        width: f64,
+    },
+}
+
+impl BeamTexture {
+    /// The reference pair: `stripe` (45°, width 4) or `check` (width 4), values 0.005 and 0.1.
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "stripe" => Some(BeamTexture::Stripe {
+                values: [0.005, 0.1],
+                width: 4.0,
+                angle_deg: 45.0,
+            }),
+            "check" => Some(BeamTexture::Check {
+                values: [0.005, 0.1],
+                width: 4.0,
+            }),
+            _ => None,
+        }
+    }
+
+    /// The texture as a tracer field (planar projection along z, origin at 0).
+    pub fn field(&self) -> Result<Field, crate::error::FieldError> {
+        let proj = PlanarProjection::default();
+        match *self {
+            BeamTexture::Const { value } => Field::constant(Rgb::splat(value)),
+            BeamTexture::Stripe {
+                values,
+                width,
+                angle_deg,
+            } => Field::stripe(
+                width,
+                angle_deg.to_radians(),
+                [Rgb::splat(values[0]), Rgb::splat(values[1])],
+                proj,
+            ),
+            BeamTexture::Check { values, width } => {
+                Field::check(width, [Rgb::splat(values[0]), Rgb::splat(values[1])], proj)
+            }
+        }
+    }
+}
+
+/// Everything that defines one beam experiment except the method.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BeamSetup {
+    /// σa texture.
+    pub texture: BeamTexture,
+    /// Constant σs.
+    pub sigma_s: f64,
+    /// HG mean cosine.
+    pub g: f64,
+    /// Half-width E of the mapped square [−E, E]².
+    pub extent: f64,
+    /// N: the map is N × N.
+    pub resolution: u32,
+    /// Scattering orders counted (the paper: multiple).
+    #[serde(serialize_with = "serialize_display")]
+    pub scattering: Scattering,
+}
+
+fn serialize_display<T: std::fmt::Display, S: serde::Serializer>(
+    v: &T,
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    s.collect_str(v)
+}
+
+impl BeamSetup {
+    /// The paper's set-up with a given texture: σs = 1, isotropic, E = 15, N = 120, multiple
+    /// scattering only.
+    pub fn paper(texture: BeamTexture) -> Self {
+        Self {
+            texture,
+            sigma_s: 1.0,
+            g: 0.0,
+            extent: 15.0,
+            resolution: 120,
+            scattering: Scattering::Multiple,
+        }
+    }
+
+    /// Pixel side Δ = 2E/N.
+    pub fn pixel_size(&self) -> f64 {
+        2.0 * self.extent / self.resolution as f64
+    }
+
+    /// The scene: the half-space box with the textured medium, the beam at (0, 0, 1) pointing
+    /// down, and an orthographic camera over the mapped square.
+    pub fn scene(&self) -> Result<Scene, SceneError> {
+        let bad = |key: &str, message: String| SceneError::Invalid {
+            file: "<beam experiment>".into(),
+            key: key.into(),
+            line: None,
+            message,
+        };
+        if !(self.extent > 0.0 && self.extent.is_finite()) {
+            return Err(bad(
+                "extent",
+                format!("must be a positive number, got {}", self.extent),
+            ));
+        }
+        if self.resolution == 0 {
+            return Err(bad("resolution", "must be at least 1".into()));
+        }
+        let sigma_a = self
+            .texture
+            .field()
+            .map_err(|e| bad("texture", e.to_string()))?;
+        let sigma_s =
+            Field::constant(Rgb::splat(self.sigma_s)).map_err(|e| bad("sigma-s", e.to_string()))?;
+        let medium = MediumField::new(sigma_a, sigma_s);
+        let n = self.resolution;
+        let camera = Camera::orthographic(
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::NEG_Z,
+            DVec3::Y,
+            2.0 * self.extent,
+            2.0 * self.extent,
+            n,
+            n,
+        )
+        .map_err(|e| bad("extent", e.to_string()))?;
+        SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
+            .name("<beam experiment>")
+            .light(
+                Light::beam(DVec3::new(0.0, 0.0, 1.0), DVec3::NEG_Z, Rgb::ONE)
+                    .map_err(|e| bad("beam", e.to_string()))?,
+            )
+            .object(
+                "half-space",
+                primitives::half_space(0.0, [0.0, 0.0], HALF_SPACE_SIZE, HALF_SPACE_DEPTH, 40),
+                Material::Translucent(Translucent::new("medium", medium, self.g, 1.0)),
+            )
+            .build()
+    }
+}
+
+/// Photons to trace.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PhotonBudget {
+    /// Exactly this many (rounded up to whole batches of 8192).
+    Count(u64),
+    /// Doubling batches while they fit in this wall-clock time.
+    Time(Duration),
+}
+
+/// Exits of the light tracer through the top face, by scattering order (whatever the map).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ExitCounts {
+    /// Photons traced.
+    pub photons: u64,
+    /// Exits after exactly one scattering event.
+    pub single: u64,
+    /// Exits after two or more.
+    pub multiple: u64,
+    /// Exits without scattering (impossible at normal incidence; kept for completeness).
+    pub unscattered: u64,
+}
+
+impl ExitCounts {
+    /// Reflectance (fraction of beam power leaving through the top) with `scattering`, and its
+    /// standard error √(p(1−p)/n) (each photon contributes 0 or 1).
+    pub fn reflectance(&self, scattering: Scattering) -> (f64, f64) {
+        let k = match scattering {
+            Scattering::Single => self.single,
+            Scattering::Multiple => self.multiple,
+            Scattering::All => self.single + self.multiple + self.unscattered,
+        };
+        let n = self.photons.max(1) as f64;
+        let p = k as f64 / n;
+        (p, (p * (1.0 - p) / n).sqrt())
+    }
+}
+
+/// A beam exitance map and how it was made.
+#[derive(Debug, Clone, Serialize)]
+pub struct BeamMap {
+    /// N.
+    pub resolution: u32,
+    /// E.
+    pub extent: f64,
+    /// Exitance per unit area per unit beam power, row-major, row 0 at y = +E.
+    #[serde(skip)]
+    pub values: Vec<f64>,
+    /// Per-pixel standard error (light tracing only).
+    #[serde(skip)]
+    pub std_error: Option<Vec<f64>>,
+    /// `pt` or the estimator name.
+    pub method: String,
+    /// Profile model (BSSRDF methods).
+    pub profile: Option<String>,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+    /// Photons (pt) or x_o points (BSSRDF).
+    pub samples: u64,
+    /// Light tracing: exits by order.
+    pub exits: Option<ExitCounts>,
+    /// Work and rare-event counters.
+    pub counters: PathCounters,
+}
+
+fn entry_point(scene: &Scene) -> Result<(Hit, DVec3), SceneError> {
+    let beam = scene
+        .beams()
+        .next()
+        .copied()
+        .ok_or_else(|| SceneError::Invalid {
+            file: "<beam experiment>".into(),
+            key: "beam".into(),
+            line: None,
+            message: "the scene has no beam light".into(),
+        })?;
+    let hit = scene
+        .geometry
+        .intersect(&Ray::new(beam.origin, beam.direction))
+        .ok_or_else(|| SceneError::Invalid {
+            file: "<beam experiment>".into(),
+            key: "beam".into(),
+            line: None,
+            message: "the beam misses the medium".into(),
+        })?;
+    Ok((hit, beam.direction))
+}
+
+/// Light tracing from the beam (the reference), with a progress callback receiving the photon
+/// count so far.
+pub fn trace_photons(
+    setup: &BeamSetup,
+    budget: PhotonBudget,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<BeamMap, SceneError> {
+    let scene = setup.scene()?;
+    let (entry, dir) = entry_point(&scene)?;
+    let Material::Translucent(t) = &scene.objects[entry.object as usize].material else {
+        unreachable!("the beam scene's only object is translucent")
+    };
+    let view = ChannelView::new(&t.medium, 0);
+    let walk = WalkMedium {
+        geometry: &scene.geometry,
+        object: entry.object,
+        medium: &view,
+        g: t.g,
+        interface: Interface { eta: 1.0 },
+    };
+    let n = setup.resolution as usize;
+    let (e, delta) = (setup.extent, setup.pixel_size());
+    let start = Instant::now();
+    let mut counts = vec![0u64; n * n];
+    let mut exits = ExitCounts::default();
+    let mut counters = PathCounters::default();
+    let mut batches_done = 0u64;
+    let mut next = match budget {
+        PhotonBudget::Count(p) => p.div_ceil(BATCH).max(1),
+        PhotonBudget::Time(_) => 1,
+    };
+    loop {
+        let pass_start = Instant::now();
+        let results: Vec<(Vec<u32>, ExitCounts, PathCounters)> = (batches_done
+            ..batches_done + next)
+            .into_par_iter()
+            .map(|b| {
+                let mut local = vec![0u32; n * n];
+                let mut ex = ExitCounts::default();
+                let mut c = PathCounters::default();
+                for k in b * BATCH..(b + 1) * BATCH {
+                    let mut rng = Rng::from_keys(seed, &[0xbea, k]);
+                    let mut order = 0;
+                    c.paths += 1;
+                    let end = walk.walk(
+                        entry.spawn_origin(dir),
+                        dir,
+                        &mut order,
+                        &mut rng,
+                        &mut c,
+                        |_, _, _, _| {},
+                    );
+                    if let WalkEnd::Exited { hit, .. } = end
+                        && hit.ng.z > 0.5
+                    {
+                        {
+                            match order {
+                                0 => ex.unscattered += 1,
+                                1 => ex.single += 1,
+                                _ => ex.multiple += 1,
+                            }
+                            if setup.scattering.counts(order) {
+                                let j = ((hit.p.x + e) / delta).floor();
+                                let i = ((e - hit.p.y) / delta).floor();
+                                if (0.0..n as f64).contains(&j) && (0.0..n as f64).contains(&i) {
+                                    local[i as usize * n + j as usize] += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+                ex.photons = BATCH;
+                progress(BATCH);
+                (local, ex, c)
+            })
+            .collect();
+        for (local, ex, c) in &results {
+            for (a, b) in counts.iter_mut().zip(local) {
+                *a += *b as u64;
+            }
+            exits.photons += ex.photons;
+            exits.single += ex.single;
+            exits.multiple += ex.multiple;
+            exits.unscattered += ex.unscattered;
+            counters.merge(c);
+        }
+        batches_done += next;
+        let PhotonBudget::Time(limit) = budget else {
+            break;
+        };
+        let per_batch = pass_start.elapsed().as_secs_f64() / next as f64;
+        if start.elapsed().as_secs_f64() + per_batch * batches_done as f64 > limit.as_secs_f64() {
+            break;
+        }
+        next = batches_done;
+    }
+    let photons = exits.photons as f64;
+    let norm = 1.0 / (photons * delta * delta);
+    Ok(BeamMap {
+        resolution: setup.resolution,
+        extent: setup.extent,
+        values: counts.iter().map(|&c| c as f64 * norm).collect(),
+        std_error: Some(counts.iter().map(|&c| (c as f64).sqrt() * norm).collect()),
+        method: "pt".into(),
+        profile: None,
+        seconds: start.elapsed().as_secs_f64(),
+        samples: exits.photons,
+        exits: Some(exits),
+        counters,
+    })
+}
+
+/// The map of a BSSRDF method: `sub × sub` stratified jittered points per pixel.
+pub fn bssrdf_map(
+    setup: &BeamSetup,
+    estimator: Estimator,
+    profile: ProfileModel,
+    sub: u32,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<BeamMap, SceneError> {
+    let bad = |key: &str, message: String| SceneError::Invalid {
+        file: "<beam experiment>".into(),
+        key: key.into(),
+        line: None,
+        message,
+    };
+    let scene = setup.scene()?;
+    let (x_i, _) = entry_point(&scene)?;
+    let Material::Translucent(t) = &scene.objects[x_i.object as usize].material else {
+        unreachable!("the beam scene's only object is translucent")
+    };
+    let family = ProfileFamily::new(profile, setup.scattering, t.g, 1.0)
+        .map_err(|e| bad("profile", e.to_string()))?;
+    let prepared = estimator
+        .prepare(t.g)
+        .map_err(|e| bad("estimator", e.to_string()))?;
+    let surface = scene.object_surface(x_i.object);
+    let n = setup.resolution as usize;
+    let sub = sub.max(1);
+    let (e, delta) = (setup.extent, setup.pixel_size());
+    let start = Instant::now();
+    let rows: Vec<(Vec<f64>, PathCounters)> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let mut row = vec![0.0; n];
+            let mut c = PathCounters::default();
+            for (j, value) in row.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for s in 0..sub * sub {
+                    let mut rng = Rng::from_keys(seed, &[0xb55, i as u64, j as u64, s as u64]);
+                    let (a, b) = ((s % sub) as f64, (s / sub) as f64);
+                    let x = -e + (j as f64 + (a + rng.uniform()) / sub as f64) * delta;
+                    let y = e - (i as f64 + (b + rng.uniform()) / sub as f64) * delta;
+                    let down = Ray::new(DVec3::new(x, y, 1.0), DVec3::NEG_Z);
+                    let Some(x_o) = scene.geometry.intersect_object(x_i.object, &down) else {
+                        c.probe_misses += 1;
+                        continue;
+                    };
+                    let est = prepared.estimate(&surface, &t.medium, &x_i, &x_o, &mut rng);
+                    c.estimates += 1;
+                    c.estimator_samples += est.diagnostics.samples as u64;
+                    c.projection_misses += est.diagnostics.misses as u64;
+                    c.short_circuits += est.diagnostics.short_circuit as u64;
+                    c.estimator_fallbacks += est.diagnostics.fallback as u64;
+                    sum += eval_grey(&family, est.coefficients, (x_o.p - x_i.p).length());
+                }
+                *value = sum / (sub * sub) as f64;
+            }
+            progress(1);
+            (row, c)
+        })
+        .collect();
+    let mut counters = PathCounters::default();
+    let mut values = Vec::with_capacity(n * n);
+    for (row, c) in &rows {
+        values.extend_from_slice(row);
+        counters.merge(c);
+    }
+    Ok(BeamMap {
+        resolution: setup.resolution,
+        extent: setup.extent,
+        values,
+        std_error: None,
+        method: estimator.name().into(),
+        profile: Some(profile.name().into()),
+        seconds: start.elapsed().as_secs_f64(),
+        samples: (n * n) as u64 * (sub * sub) as u64,
+        exits: None,
+        counters,
+    })
+}
+
+/// The profile of grey coefficients (channel 0) at distance `r`; 0 for invalid input.
+fn eval_grey(family: &ProfileFamily, c: Coefficients, r: f64) -> f64 {
+    family
+        .profile(c.sigma_a[0], c.sigma_s[0])
+        .map(|p| p.eval(r))
+        .unwrap_or(0.0)
+}

@@ -1,0 +1,5 @@
+//! Experiments: the beam exitance maps of the paper's Figure 4, image comparison and
+//! error-against-time studies.
+
+pub mod beam;
+pub mod metrics;

@@ -1,0 +1,67 @@
+//! Rare-event and work counters kept by the integrators (pbrt's `STAT_COUNTER` idea), merged
+//! deterministically and printed beside timings so that no cap or fallback biases a result
+//! silently.
+
+use serde::Serialize;
+
+use crate::render::Counters;
+use crate::volume::TrackingCounters;
+
+/// Counters of one render (or one row of it).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct PathCounters {
+    /// Camera paths (or photons) started.
+    pub paths: u64,
+    /// Real scattering events inside media.
+    pub scatterings: u64,
+    /// Tentative collisions drawn by delta tracking.
+    pub delta_steps: u64,
+    /// Tentative collisions drawn by ratio tracking (shadow rays through media).
+    pub ratio_steps: u64,
+    /// Paths stopped by the collision cap inside one medium (see `walk::MAX_COLLISIONS`); their
+    /// remaining contribution is lost, so a non-zero count means a (tiny) bias.
+    pub capped: u64,
+    /// Rays inside a closed object that found no boundary (slipped between triangles or
+    /// started numerically outside); the path is terminated.
+    pub leaks: u64,
+    /// Boundary hits seen from the wrong side inside a medium (numerical), stepped over.
+    pub wrong_side: u64,
+    /// BSSRDF probe rays that found no incident point.
+    pub probe_misses: u64,
+    /// BSSRDF parameter estimates made.
+    pub estimates: u64,
+    /// Averaging samples drawn by the estimators.
+    pub estimator_samples: u64,
+    /// Estimator projections that missed the object.
+    pub projection_misses: u64,
+    /// Estimates answered by the constant-field short-circuit.
+    pub short_circuits: u64,
+    /// Estimates where a channel fell back to the endpoint average (no hits at all).
+    pub estimator_fallbacks: u64,
+}
+
+impl PathCounters {
+    /// Adds tracking work.
+    pub fn add_tracking(&mut self, t: &TrackingCounters) {
+        self.delta_steps += t.delta_steps;
+        self.ratio_steps += t.ratio_steps;
+    }
+}
+
+impl Counters for PathCounters {
+    fn merge(&mut self, o: &Self) {
+        self.paths += o.paths;
+        self.scatterings += o.scatterings;
+        self.delta_steps += o.delta_steps;
+        self.ratio_steps += o.ratio_steps;
+        self.capped += o.capped;
+        self.leaks += o.leaks;
+        self.wrong_side += o.wrong_side;
+        self.probe_misses += o.probe_misses;
+        self.estimates += o.estimates;
+        self.estimator_samples += o.estimator_samples;
+        self.projection_misses += o.projection_misses;
+        self.short_circuits += o.short_circuits;
+        self.estimator_fallbacks += o.estimator_fallbacks;
+    }
+}

@@ -1,0 +1,41 @@
+//! Integrators. The reference volumetric path tracer and the BSSRDF renderer are one camera
+//! path loop ([`path`]) that differs only at translucent surfaces; the random walk inside a
+//! medium ([`walk`]) also serves the light tracer of the beam experiment.
+
+pub mod counters;
+pub mod lighting;
+pub mod path;
+pub mod probe;
+pub mod walk;
+
+pub use counters::PathCounters;
+pub use path::{Method, PathIntegrator, PathOptions};
+
+/// Why a render could not start.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The scene cannot be rendered with this method (open mesh, surface-only field, …).
+    #[error(transparent)]
+    Scene(#[from] crate::error::SceneError),
+    /// A material's parameters are invalid for the chosen profile or estimator.
+    #[error("object `{object}`: invalid {what}: {source}")]
+    Param {
+        /// The object.
+        object: String,
+        /// What was being prepared ("profile", "estimator").
+        what: &'static str,
+        /// The parameter error.
+        source: bssrdf_core::ParamError,
+    },
+}
+
+impl RenderError {
+    pub(crate) fn param(object: &str, what: &'static str, source: bssrdf_core::ParamError) -> Self {
+        RenderError::Param {
+            object: object.to_string(),
+            what,
+            source,
+        }
+    }
+}

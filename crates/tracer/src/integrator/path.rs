@@ -1,0 +1,705 @@
+//! The camera path loop shared by the reference path tracer and the BSSRDF renderer.
+//!
+//! Both renders trace the same camera rays through the same BVH, shade diffuse surfaces the
+//! same way (next-event estimation with MIS against cosine sampling, pbrt-v4 §13.4), use the
+//! same lights and the same Russian roulette; they differ only where a path meets a
+//! translucent object:
+//! * [`Method::PathTraced`]: the path refracts in and performs the volumetric random walk
+//!   ([`super::walk`]), with next-event estimation at every real scattering vertex through
+//!   index-matched boundaries (shadow transmittance by ratio tracking);
+//! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
+//!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
+//!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
+//!
+//! Radiance is RGB. Media whose coefficients are grey in every object are traced once for all
+//! three channels; otherwise each path traces one channel chosen uniformly (weight 3), so the
+//! estimator stays unbiased per channel.
+
+use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use glam::DVec3;
+use het_estimate::{CoefficientField, Estimator, PreparedEstimator};
+
+use crate::field::MediumField;
+use crate::geometry::{Hit, ObjectSurface, Ray};
+use crate::integrator::RenderError;
+use crate::integrator::counters::PathCounters;
+use crate::integrator::lighting::{LightSet, power_heuristic};
+use crate::integrator::probe::{ProbeSampler, sample_probe};
+use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
+use crate::light::Light;
+use crate::render::PixelEstimator;
+use crate::rng::Rng;
+use crate::scene::{Material, Scene, Translucent};
+use crate::volume::{ChannelMedium, direction_about, transmittance};
+
+/// Russian roulette starts after this many surface interactions.
+const RR_DEPTH: u32 = 3;
+/// Most boundary crossings followed by one shadow ray.
+const MAX_SHADOW_CROSSINGS: u32 = 64;
+
+/// How translucent objects are rendered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Method {
+    /// The reference: volumetric path tracing inside every translucent object.
+    PathTraced,
+    /// A homogeneous BSSRDF with parameters from `estimator`.
+    Bssrdf {
+        /// How (x_i, x_o) become homogeneous coefficients.
+        estimator: Estimator,
+        /// Profile model; `None` uses each material's own (or the dipole).
+        profile: Option<ProfileModel>,
+    },
+}
+
+impl Method {
+    /// `pt`, or the estimator's name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::PathTraced => "pt",
+            Method::Bssrdf { estimator, .. } => estimator.name(),
+        }
+    }
+}
+
+/// Options shared by both methods.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathOptions {
+    /// Which orders of scattering inside media count (the paper: multiple only).
+    pub scattering: Scattering,
+    /// Most surface interactions per path.
+    pub max_depth: u32,
+}
+
+/// A channel of a medium field, as the tracking routines see it.
+pub struct ChannelView<'a> {
+    field: &'a MediumField,
+    channel: usize,
+    majorant: f64,
+    constant: Option<(f64, f64)>,
+}
+
+impl<'a> ChannelView<'a> {
+    /// Channel `channel` of `field`.
+    pub fn new(field: &'a MediumField, channel: usize) -> Self {
+        let majorant = field.majorant()[channel];
+        let constant = field.is_constant().then(|| {
+            let c = field.at_point(DVec3::ZERO);
+            (c.sigma_a[channel], c.sigma_s[channel])
+        });
+        Self {
+            field,
+            channel,
+            majorant,
+            constant,
+        }
+    }
+}
+
+impl ChannelMedium for ChannelView<'_> {
+    #[inline]
+    fn coefficients(&self, p: DVec3) -> (f64, f64) {
+        if let Some(c) = self.constant {
+            return c;
+        }
+        let c = self.field.at_point(p);
+        (c.sigma_a[self.channel], c.sigma_s[self.channel])
+    }
+    fn majorant(&self) -> f64 {
+        self.majorant
+    }
+    fn constant(&self) -> Option<(f64, f64)> {
+        self.constant
+    }
+}
+
+/// BSSRDF data of one translucent object, prepared once per render.
+struct BssrdfObject {
+    family: ProfileFamily,
+    sampler: ProbeSampler,
+    estimator: PreparedEstimator,
+    /// c = 1 − 2·C1(1/η), the normalisation of pbrt-v4's `NormalizedFresnelBxDF` S_w.
+    sw_norm: f64,
+}
+
+/// Per-object data prepared once per render.
+enum ObjectKind<'s> {
+    Opaque,
+    Translucent {
+        material: &'s Translucent,
+        bssrdf: Option<Box<BssrdfObject>>,
+    },
+}
+
+/// Which colour channels a path carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Channels {
+    /// Grey media: one walk serves all three channels (coefficients of channel 0).
+    All,
+    /// Only this channel (its weight is multiplied by 3).
+    One(usize),
+}
+
+impl Channels {
+    fn medium_channel(self) -> usize {
+        match self {
+            Channels::All => 0,
+            Channels::One(c) => c,
+        }
+    }
+}
+
+/// The previous vertex of a path, for MIS when the path hits an emitter by chance.
+#[derive(Debug, Clone, Copy)]
+enum Prev {
+    /// Camera or a specular event: emission counts fully.
+    Specular,
+    /// A vertex where light sampling was also done: direction pdf (solid angle).
+    Sampled { p: DVec3, pdf: f64 },
+}
+
+/// The integrator: a [`PixelEstimator`] over a scene.
+pub struct PathIntegrator<'s> {
+    scene: &'s Scene,
+    method: Method,
+    options: PathOptions,
+    objects: Vec<ObjectKind<'s>>,
+    lights: LightSet,
+    channels_grey: bool,
+}
+
+struct PathState {
+    l: Rgb,
+    beta: Rgb,
+    channels: Channels,
+    /// Real scattering events inside media so far.
+    order: u32,
+    /// The path has been inside a medium (the scattering-order filter applies).
+    entered: bool,
+    prev: Prev,
+}
+
+impl PathState {
+    /// Adds `contribution` if the scattering-order filter lets this path's light through.
+    fn add(&mut self, contribution: Rgb, order: u32, entered: bool, filter: Scattering) {
+        if !entered || filter.counts(order) {
+            self.l += self.mask(contribution);
+        }
+    }
+    fn mask(&self, v: Rgb) -> Rgb {
+        match self.channels {
+            Channels::All => v,
+            Channels::One(c) => {
+                let mut m = Rgb::ZERO;
+                m[c] = v[c] * 3.0;
+                m
+            }
+        }
+    }
+}
+
+/// The outcome of shading one surface interaction.
+enum Step {
+    Continue(Ray),
+    Stop,
+}
+
+impl<'s> PathIntegrator<'s> {
+    /// Prepares `method` for `scene`. The path tracer needs every translucent object closed
+    /// and every translucent field defined in the volume; the BSSRDF renderer builds a profile
+    /// table and prepares its estimator for each translucent material.
+    pub fn new(
+        scene: &'s Scene,
+        method: Method,
+        options: PathOptions,
+    ) -> Result<Self, RenderError> {
+        if method == Method::PathTraced {
+            scene.require_path_traceable()?;
+        }
+        let mut objects = Vec::with_capacity(scene.objects.len());
+        let mut channels_grey = true;
+        for object in &scene.objects {
+            objects.push(match &object.material {
+                Material::Translucent(t) => {
+                    channels_grey &= t.medium.is_grey();
+                    let bssrdf = match method {
+                        Method::PathTraced => None,
+                        Method::Bssrdf { estimator, profile } => {
+                            let model = profile.or(t.profile).unwrap_or(ProfileModel::Dipole);
+                            let family = ProfileFamily::new(model, options.scattering, t.g, t.eta)
+                                .map_err(|e| RenderError::param(&object.name, "profile", e))?;
+                            let estimator = estimator
+                                .prepare(t.g)
+                                .map_err(|e| RenderError::param(&object.name, "estimator", e))?;
+                            let sw_norm =
+                                1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / t.eta);
+                            Some(Box::new(BssrdfObject {
+                                sampler: ProbeSampler::new(family, &t.medium),
+                                family,
+                                estimator,
+                                sw_norm,
+                            }))
+                        }
+                    };
+                    ObjectKind::Translucent {
+                        material: t,
+                        bssrdf,
+                    }
+                }
+                _ => ObjectKind::Opaque,
+            });
+        }
+        Ok(Self {
+            scene,
+            method,
+            options,
+            objects,
+            lights: LightSet::new(&scene.lights),
+            channels_grey,
+        })
+    }
+
+    /// The method rendered.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// Radiance arriving along `ray` (one sample).
+    pub fn li(&self, ray: Ray, rng: &mut Rng, counters: &mut PathCounters) -> Rgb {
+        counters.paths += 1;
+        let channels = if self.channels_grey || self.method != Method::PathTraced {
+            Channels::All
+        } else {
+            Channels::One(rng.below(3) as usize)
+        };
+        let mut st = PathState {
+            l: Rgb::ZERO,
+            beta: Rgb::ONE,
+            channels,
+            order: 0,
+            entered: false,
+            prev: Prev::Specular,
+        };
+        let mut ray = ray;
+        let filter = self.options.scattering;
+        for depth in 0..self.options.max_depth {
+            let Some(hit) = self.scene.geometry.intersect(&ray) else {
+                let le = self.escaped(&ray, st.prev);
+                st.add(st.beta * le, st.order, st.entered, filter);
+                break;
+            };
+            let step = match &self.objects[hit.object as usize] {
+                ObjectKind::Translucent { material, bssrdf } => match bssrdf {
+                    None => self.volumetric(&hit, &ray, material, &mut st, rng, counters),
+                    Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
+                },
+                ObjectKind::Opaque => match &self.scene.objects[hit.object as usize].material {
+                    Material::Emissive { .. } => {
+                        let le = self.emitted(&hit, &ray, st.prev);
+                        st.add(st.beta * le, st.order, st.entered, filter);
+                        Step::Stop
+                    }
+                    Material::Diffuse { albedo } => {
+                        self.diffuse(&hit, &ray, *albedo, &mut st, rng, counters)
+                    }
+                    Material::Translucent(_) => unreachable!("translucent objects are prepared"),
+                },
+            };
+            match step {
+                Step::Continue(next) => ray = next,
+                Step::Stop => break,
+            }
+            if depth + 1 >= RR_DEPTH {
+                let q = st.beta.max_component().min(0.95);
+                if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                    break;
+                }
+                st.beta = st.beta / q;
+            }
+        }
+        st.l
+    }
+
+    /// Environment radiance along an escaped ray, MIS-weighted against light sampling.
+    fn escaped(&self, ray: &Ray, prev: Prev) -> Rgb {
+        let mut le = Rgb::ZERO;
+        for (i, light) in self.scene.lights.iter().enumerate() {
+            if let Light::Environment(_) = light {
+                let w = match prev {
+                    Prev::Specular => 1.0,
+                    Prev::Sampled { p, pdf } => {
+                        let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
+                        power_heuristic(pdf, pl)
+                    }
+                };
+                le += light.le(ray.dir) * w;
+            }
+        }
+        le
+    }
+
+    /// Emission of an emissive object hit by chance, MIS-weighted.
+    fn emitted(&self, hit: &Hit, ray: &Ray, prev: Prev) -> Rgb {
+        let Some(i) = self.scene.objects[hit.object as usize].emitter else {
+            return Rgb::ZERO;
+        };
+        let light = &self.scene.lights[i];
+        let le = light.emitted(hit, -ray.dir);
+        match prev {
+            Prev::Specular => le,
+            Prev::Sampled { p, pdf } => {
+                let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
+                le * power_heuristic(pdf, pl)
+            }
+        }
+    }
+
+    fn light_pdf(&self, i: usize) -> f64 {
+        if self.lights.contains(i) {
+            self.lights.select_pdf()
+        } else {
+            0.0
+        }
+    }
+
+    /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
+    /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
+    /// pdf), times the shadow ray's transmittance. Returns radiance (before path weight).
+    fn direct(
+        &self,
+        p: DVec3,
+        origin_for: impl Fn(DVec3) -> DVec3,
+        f_and_pdf: impl Fn(DVec3) -> (f64, f64),
+        channel: usize,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Rgb {
+        let u = rng.uniform();
+        let u2 = rng.uniform2();
+        let Some(i) = self.lights.select(u) else {
+            return Rgb::ZERO;
+        };
+        let light = &self.scene.lights[i];
+        let Some(ls) = light.sample_li(p, u2) else {
+            return Rgb::ZERO;
+        };
+        let (f, pdf_dir) = f_and_pdf(ls.wi);
+        if f.is_nan() || f <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let t_max = if ls.dist.is_finite() {
+            ls.dist * (1.0 - 1e-6)
+        } else {
+            f64::INFINITY
+        };
+        let tr = self.shadow(origin_for(ls.wi), ls.wi, t_max, channel, rng, counters);
+        if tr == 0.0 {
+            return Rgb::ZERO;
+        }
+        let w = if ls.delta {
+            1.0
+        } else {
+            power_heuristic(ls.pdf * self.lights.select_pdf(), pdf_dir)
+        };
+        ls.li * (f * tr * w / self.lights.select_pdf())
+    }
+
+    /// Transmittance of the segment `origin + t·dir`, `t < t_max`: 0 if anything opaque is in
+    /// the way; through index-matched media (path tracing only) by ratio tracking.
+    fn shadow(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        channel: usize,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> f64 {
+        let mut origin = origin;
+        let mut remaining = t_max;
+        let mut tr = 1.0;
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            let ray = Ray::with_range(origin, dir, 0.0, remaining);
+            let Some(h) = self.scene.geometry.intersect(&ray) else {
+                return tr;
+            };
+            let ObjectKind::Translucent {
+                material,
+                bssrdf: None,
+            } = &self.objects[h.object as usize]
+            else {
+                return 0.0;
+            };
+            if material.eta != 1.0 {
+                return 0.0;
+            }
+            if dir.dot(h.ng) > 0.0 {
+                // Leaving the medium: the segment so far lay inside it.
+                let view = ChannelView::new(&material.medium, channel);
+                let mut tc = crate::volume::TrackingCounters::default();
+                tr *= transmittance(&view, origin, dir, h.t, rng, &mut tc);
+                counters.add_tracking(&tc);
+                if tr == 0.0 {
+                    return 0.0;
+                }
+            }
+            origin = h.spawn_origin(dir);
+            remaining -= h.t;
+            if remaining <= 0.0 {
+                return tr;
+            }
+        }
+        0.0
+    }
+
+    /// A diffuse surface: NEE plus cosine-weighted continuation.
+    fn diffuse(
+        &self,
+        hit: &Hit,
+        ray: &Ray,
+        albedo: Rgb,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
+        let n = if hit.ns.dot(ray.dir) < 0.0 {
+            hit.ns
+        } else {
+            -hit.ns
+        };
+        let ld = self.direct(
+            hit.p,
+            |wi| hit.spawn_origin(wi),
+            |wi| {
+                let c = wi.dot(n);
+                if c > 0.0 {
+                    (c / std::f64::consts::PI, c / std::f64::consts::PI)
+                } else {
+                    (0.0, 0.0)
+                }
+            },
+            st.channels.medium_channel(),
+            rng,
+            counters,
+        );
+        st.add(
+            st.beta * albedo * ld,
+            st.order,
+            st.entered,
+            self.options.scattering,
+        );
+        let u = rng.uniform2();
+        let cos = u[0].sqrt();
+        let wi = direction_about(n, cos, std::f64::consts::TAU * u[1]);
+        if cos <= 0.0 {
+            return Step::Stop;
+        }
+        st.beta *= albedo;
+        st.prev = Prev::Sampled {
+            p: hit.p,
+            pdf: cos / std::f64::consts::PI,
+        };
+        Step::Continue(hit.spawn_ray(wi))
+    }
+
+    /// Path tracing inside a translucent object hit at `hit` by `ray`.
+    fn volumetric(
+        &self,
+        hit: &Hit,
+        ray: &Ray,
+        material: &Translucent,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
+        let interface = Interface { eta: material.eta };
+        if ray.dir.dot(hit.ng) >= 0.0 {
+            // Arrived from inside (a camera inside the object): pass the face.
+            return Step::Continue(hit.spawn_ray(ray.dir));
+        }
+        let dir = match interface.cross(ray.dir, hit.ng, rng) {
+            Crossing::Reflect(r) => {
+                st.prev = Prev::Specular;
+                return Step::Continue(hit.spawn_ray(r));
+            }
+            Crossing::Transmit(t) => t,
+        };
+        st.entered = true;
+        let channel = st.channels.medium_channel();
+        let view = ChannelView::new(&material.medium, channel);
+        let walk = WalkMedium {
+            geometry: &self.scene.geometry,
+            object: hit.object,
+            medium: &view,
+            g: material.g,
+            interface,
+        };
+        let nee = interface.is_index_matched() && !self.lights.is_empty();
+        let filter = self.options.scattering;
+        let beta = st.beta;
+        let mut added = Rgb::ZERO;
+        let mut nee_counters = PathCounters::default();
+        let mut order = st.order;
+        let end = walk.walk(
+            hit.spawn_origin(dir),
+            dir,
+            &mut order,
+            rng,
+            counters,
+            |p, d_in, k, rng| {
+                if nee && filter.counts(k) {
+                    let g = material.g;
+                    let ld = self.direct(
+                        p,
+                        |_| p,
+                        |wi| {
+                            let f = bssrdf_core::hg::phase(d_in.dot(wi), g);
+                            (f, f)
+                        },
+                        channel,
+                        rng,
+                        &mut nee_counters,
+                    );
+                    added += beta * ld;
+                }
+            },
+        );
+        counters.add_tracking(&crate::volume::TrackingCounters {
+            delta_steps: 0,
+            ratio_steps: nee_counters.ratio_steps,
+        });
+        st.l += st.mask(added);
+        st.order = order;
+        match end {
+            WalkEnd::Exited {
+                hit: exit,
+                dir,
+                last_scatter,
+            } => {
+                st.prev = match last_scatter {
+                    Some((p, pdf)) if nee => Prev::Sampled { p, pdf },
+                    _ => Prev::Specular,
+                };
+                Step::Continue(exit.spawn_ray(dir))
+            }
+            WalkEnd::Absorbed | WalkEnd::Capped | WalkEnd::Leaked => Step::Stop,
+        }
+    }
+
+    /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then an incident point x_i from
+    /// probe rays, the estimated homogeneous coefficients, the profile, and irradiance at x_i
+    /// with pbrt-v4's normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π),
+    /// c = 1 − 2 C1(1/η) (pbrt-v4 §11.4, `NormalizedFresnelBxDF`). The path continues from x_i
+    /// with a cosine-sampled direction.
+    #[allow(clippy::too_many_arguments)]
+    fn subsurface(
+        &self,
+        hit: &Hit,
+        ray: &Ray,
+        material: &Translucent,
+        b: &BssrdfObject,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
+        if ray.dir.dot(hit.ng) >= 0.0 {
+            return Step::Continue(hit.spawn_ray(ray.dir));
+        }
+        let n_o = if hit.ns.dot(ray.dir) < 0.0 {
+            hit.ns
+        } else {
+            hit.ng
+        };
+        if material.eta != 1.0 {
+            let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
+            if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
+                st.prev = Prev::Specular;
+                return Step::Continue(
+                    hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
+                );
+            }
+        }
+        let object = hit.object;
+        let at_xo = material.medium.coefficients(hit);
+        let Some(probe) = sample_probe(&self.scene.geometry, object, hit, at_xo, &b.sampler, rng)
+        else {
+            counters.probe_misses += 1;
+            return Step::Stop;
+        };
+        let x_i = probe.hit;
+        let surface = ObjectSurface {
+            geometry: &self.scene.geometry,
+            object,
+        };
+        let est = b
+            .estimator
+            .estimate(&surface, &material.medium, &x_i, hit, rng);
+        counters.estimates += 1;
+        counters.estimator_samples += est.diagnostics.samples as u64;
+        counters.projection_misses += est.diagnostics.misses as u64;
+        counters.short_circuits += est.diagnostics.short_circuit as u64;
+        counters.estimator_fallbacks += est.diagnostics.fallback as u64;
+        let r = (x_i.p - hit.p).length();
+        let c = est.coefficients;
+        let mut rd = Rgb::ZERO;
+        for ch in 0..3 {
+            if let Ok(profile) = b.family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
+                rd[ch] = profile.eval(r);
+            }
+        }
+        st.beta = st.beta * rd / probe.pdf;
+        if st.beta.is_zero() {
+            return Step::Stop;
+        }
+        // Irradiance at x_i through the lobe S_w.
+        let n_i = x_i.ns;
+        let eta = material.eta;
+        let sw = |cos: f64| {
+            (1.0 - bssrdf_core::fresnel::dielectric(cos, eta)) / (b.sw_norm * std::f64::consts::PI)
+        };
+        let ld = self.direct(
+            x_i.p,
+            |wi| x_i.spawn_origin(wi),
+            |wi| {
+                let cos = wi.dot(n_i);
+                if cos > 0.0 {
+                    (sw(cos) * cos, cos / std::f64::consts::PI)
+                } else {
+                    (0.0, 0.0)
+                }
+            },
+            0,
+            rng,
+            counters,
+        );
+        st.l += st.beta * ld;
+        let u = rng.uniform2();
+        let cos = u[0].sqrt();
+        if cos <= 0.0 {
+            return Step::Stop;
+        }
+        let wi = direction_about(n_i, cos, std::f64::consts::TAU * u[1]);
+        // S_w·cos / (cos/π) = (1 − F(cos)) / c.
+        st.beta *= sw(cos) * std::f64::consts::PI;
+        st.prev = Prev::Sampled {
+            p: x_i.p,
+            pdf: cos / std::f64::consts::PI,
+        };
+        Step::Continue(x_i.spawn_ray(wi))
+    }
+
+    /// The coefficients of object `object` at its surface point `hit` (point lookup).
+    pub fn lookup(&self, hit: &Hit) -> Option<het_estimate::Coefficients> {
+        match &self.objects[hit.object as usize] {
+            ObjectKind::Translucent { material, .. } => Some(material.medium.coefficients(hit)),
+            ObjectKind::Opaque => None,
+        }
+    }
+}
+
+impl PixelEstimator for PathIntegrator<'_> {
+    type Counters = PathCounters;
+    fn sample(&self, fx: f64, fy: f64, rng: &mut Rng, counters: &mut PathCounters) -> Rgb {
+        let ray = self.scene.camera.ray(fx, fy);
+        self.li(ray, rng, counters)
+    }
+}

@@ -1,0 +1,3 @@
+//! Independent reference computations for the workspace tests (never the code under test).
+
+pub mod chandrasekhar;
