@@ -129,6 +129,7 @@ impl PreparedEstimator {
     /// ≥ 0. If `field.bounds()` says the field is constant, the constant is returned without
     /// any lookup or projection ([`crate::Diagnostics::short_circuit`]); components that the
     /// bounds show to be constant are not averaged.
+    #[inline]
     pub fn estimate<S, F, U>(
         &self,
         surface: &S,
