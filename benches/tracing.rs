@@ -1,0 +1,157 @@
+//! Ray-query throughput of the tracer's [`Geometry`] (obvhs CWBVH, leaf-order triangles, the
+//! watertight test, `f64` hit records) on closed icospheres of ~100k and ~1M triangles
+//! (generated in code, no files).
+//!
+//! Run: `cargo bench --bench tracing` (add `-- 1310720` or `-- closest` to filter). Ids are
+//! `tracing/<query>/<ray set>/tris=<N>`; criterion reports throughput in elements/s = rays/s
+//! (single thread unless the id says `2 threads`). Ray sets, 8192 rays each, generated once:
+//! * `interior`: origins uniform inside the sphere, uniform directions (a subsurface random
+//!   walk looking for the boundary);
+//! * `camera`: origins on a sphere of 3 radii, aimed at uniform points of the bounding box
+//!   (about 60 % hit);
+//! * `segments`: interior origins with a length uniform in [0, 2r] (shadow / free-flight
+//!   tests; about half are occluded).
+//!
+//! `closest` builds the full [`tracer::geometry::Hit`] (f64 refinement, normals); `occluded`
+//! stops at the first hit; `crossings` is `for_each_object_hit` over the whole line.
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::DVec3;
+use rayon::prelude::*;
+use tracer::geometry::{Geometry, Ray, primitives};
+use tracer::rng::Rng;
+
+const RAYS: usize = 8192;
+
+fn dir(rng: &mut Rng) -> DVec3 {
+    let z = 1.0 - 2.0 * rng.uniform();
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f64::consts::TAU * rng.uniform();
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+fn interior(rng: &mut Rng, radius: f64) -> DVec3 {
+    loop {
+        let q = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0;
+        if q.length_squared() <= 1.0 {
+            return 0.95 * radius * q;
+        }
+    }
+}
+
+fn ray_sets(radius: f64) -> Vec<(&'static str, Vec<Ray>)> {
+    let mut rng = Rng::from_keys(1234, &[]);
+    let interior_rays = (0..RAYS)
+        .map(|_| Ray::new(interior(&mut rng, radius), dir(&mut rng)))
+        .collect();
+    let camera_rays = (0..RAYS)
+        .map(|_| {
+            let o = 3.0 * radius * dir(&mut rng);
+            let target =
+                (DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0) * radius;
+            Ray::new(o, (target - o).normalize())
+        })
+        .collect();
+    let segments = (0..RAYS)
+        .map(|_| {
+            Ray::segment(
+                interior(&mut rng, radius),
+                dir(&mut rng),
+                2.0 * radius * rng.uniform(),
+            )
+        })
+        .collect();
+    vec![
+        ("interior", interior_rays),
+        ("camera", camera_rays),
+        ("segments", segments),
+    ]
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tracing");
+    group
+        .sample_size(20)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(RAYS as u64));
+    for subdivisions in [6u32, 8] {
+        let radius = 1.0;
+        let t0 = Instant::now();
+        let g = Geometry::build(vec![primitives::icosphere(
+            DVec3::ZERO,
+            radius,
+            subdivisions,
+        )]);
+        let n = g.triangle_count();
+        eprintln!(
+            "tracing: icosphere({subdivisions}) = {n} triangles, BVH built in {:.2?}",
+            t0.elapsed()
+        );
+        let sets = ray_sets(radius);
+        for (name, rays) in &sets {
+            if *name != "segments" {
+                group.bench_with_input(
+                    BenchmarkId::new(format!("closest/{name}"), format!("tris={n}")),
+                    rays,
+                    |b, rays| {
+                        b.iter(|| {
+                            rays.iter()
+                                .filter(|r| black_box(g.intersect(r)).is_some())
+                                .count()
+                        })
+                    },
+                );
+                group.bench_with_input(
+                    BenchmarkId::new(format!("closest-object/{name}"), format!("tris={n}")),
+                    rays,
+                    |b, rays| {
+                        b.iter(|| {
+                            rays.iter()
+                                .filter(|r| black_box(g.intersect_object(0, r)).is_some())
+                                .count()
+                        })
+                    },
+                );
+            }
+            group.bench_with_input(
+                BenchmarkId::new(format!("occluded/{name}"), format!("tris={n}")),
+                rays,
+                |b, rays| b.iter(|| rays.iter().filter(|r| g.occluded(r)).count()),
+            );
+        }
+        let (_, camera) = &sets[1];
+        group.bench_with_input(
+            BenchmarkId::new("crossings/camera", format!("tris={n}")),
+            camera,
+            |b, rays| {
+                b.iter(|| {
+                    let mut k = 0usize;
+                    for r in rays {
+                        g.for_each_object_hit(0, r, |h| k += black_box(h).prim as usize & 1);
+                    }
+                    k
+                })
+            },
+        );
+        let (_, inner) = &sets[0];
+        group.bench_with_input(
+            BenchmarkId::new("closest/interior 2 threads", format!("tris={n}")),
+            inner,
+            |b, rays| {
+                b.iter(|| {
+                    rays.par_iter()
+                        .filter(|r| black_box(g.intersect(r)).is_some())
+                        .count()
+                })
+            },
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
