@@ -1,6 +1,6 @@
 //! Light sources and their sampling for next-event estimation.
 //!
-//! Conventions (radiometry as in pbrt-v4 §4 and §12, book keyed PBRT4 in docs/references.md):
+//! Conventions (radiometry as in pbrt4 §4 and §12):
 //! * `wi` points from the shading point toward the light.
 //! * [`LightSample::li`] is the incident radiance along `−wi` **divided by the pdf** of the
 //!   sample (solid angle); for delta lights it is the factor such that a BSDF `f` contributes

@@ -75,7 +75,7 @@ pub fn write_json(value: &serde_json::Value, path: &Path) -> Result<(), OutputEr
     write_atomic(path, s.as_bytes())
 }
 
-/// The sRGB transfer function (IEC 61966-2-1): linear `[0, 1]` → encoded `[0, 1]`.
+/// The sRGB transfer function (sRGB: IEC 61966-2-1): linear `[0, 1]` → encoded `[0, 1]`.
 #[inline]
 pub fn srgb_encode(linear: f64) -> f64 {
     if linear <= 0.003_130_8 {

@@ -26,12 +26,12 @@ const SCALED_EXTENT_LOG2: i32 = 12;
 /// Largest coordinate magnitude allowed in scaled space: 2³².
 const SCALED_COORD_LOG2: i32 = 32;
 /// Triangle bounding boxes are padded by this fraction of the object's extent (2⁻¹⁶) before
-/// the BVH is built. obvhs's slab test is not conservative: a ray through a triangle edge that
-/// lies on its node's boundary (every edge of an axis-aligned box) can be culled by a one-ulp
-/// difference between the entry and exit distances. The slab test's rounding error grows
-/// with the distance from the ray origin to the node (≈ 3 ulps of it); the padding (≈ 128
-/// ulps of the object's extent) covers rays starting within about 40 extents of the object,
-/// which includes every ray of a random walk inside it.
+/// the BVH is built. obvhs's slab test is not conservative (Ize13): a ray through a triangle
+/// edge that lies on its node's boundary (every edge of an axis-aligned box) can be culled by
+/// a one-ulp difference between the entry and exit distances. The slab test's rounding error
+/// grows with the distance from the ray origin to the node (≈ 3 ulps of it); the padding
+/// (≈ 128 ulps of the object's extent) covers rays starting within about 40 extents of the
+/// object, which includes every ray of a random walk inside it.
 const BOX_PAD_REL: f32 = 1.0 / 65536.0;
 
 /// A triangle's padded bounding box, what the BVH is built on.

@@ -8,12 +8,19 @@
 //! [`Hit::spawn_origin`], the offset used to start a new ray from the surface.
 //!
 //! # Robustness
-//! * The ray/triangle test is watertight (Woop, Benthin & Wald 2013, "Watertight Ray/Triangle
-//!   Intersection", JCGT 2(1)): rays never slip between the triangles of a closed mesh.
+//! * The ray/triangle test is watertight (WBW13: Woop, Benthin & Wald 2013, "Watertight
+//!   Ray/Triangle Intersection", JCGT 2(1)): rays never slip between the triangles of a closed
+//!   mesh.
 //! * obvhs's node test clamps the entry distance to an absolute `1e-4`, which would skip
 //!   surfaces closer than that to the ray origin. Every object's BVH is therefore built on
 //!   vertices scaled by a power of two (exact in floating point) that maps the object's extent
 //!   to about 2¹², so that `1e-4` lies far below `f32` resolution of the object.
+//! * obvhs's slab test is not conservative, so triangle boxes are padded by 2⁻¹⁶ of the
+//!   object's extent (Ize13): rays through the edges of axis-aligned boxes are not lost.
+//!
+//! Tested (`tests/tracer/geometry.rs`): 1e5 random rays from inside a closed icosphere and
+//! rays through every vertex and edge midpoint all hit; rays from inside a cube toward its
+//! corners, edges and face diagonals all hit; the BVH agrees with a brute-force f64 scan.
 
 mod bvh;
 #[cfg(feature = "gltf")]

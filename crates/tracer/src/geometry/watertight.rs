@@ -1,6 +1,6 @@
-//! Watertight ray/triangle intersection (Woop, Benthin & Wald 2013, "Watertight Ray/Triangle
-//! Intersection", JCGT 2(1), Listing 1 and §4: the `f32` test with a double-precision fallback
-//! for the edge functions when one of them is exactly zero).
+//! Watertight ray/triangle intersection (WBW13: Woop, Benthin & Wald 2013, "Watertight
+//! Ray/Triangle Intersection", JCGT 2(1), Listing 1 and §4: the `f32` test with a
+//! double-precision fallback for the edge functions when one of them is exactly zero).
 //!
 //! The ray is transformed once into a sheared space where it runs along +z from the origin;
 //! a triangle is hit when its three 2-D edge functions `U, V, W` (evaluated on the sheared
