@@ -4,7 +4,11 @@
 //! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
 //! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap).
 
+mod beam;
+mod common;
+mod compare;
 mod profile;
+mod render;
 
 use std::process::ExitCode;
 
@@ -23,11 +27,20 @@ struct Cli {
 enum Command {
     /// Print a homogeneous radial profile R(r) as CSV, or its total diffuse reflectance.
     Profile(profile::Args),
+    /// Render a scene file with the path-traced reference or a BSSRDF method.
+    Render(render::Args),
+    /// The paper's Figure 4: exitance map of a pencil beam in a textured half-space.
+    Beam(beam::Args),
+    /// Error metrics of a test image against a reference, and a difference image.
+    Compare(compare::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Profile(args) => profile::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Beam(args) => beam::run(args),
+        Command::Compare(args) => compare::run(args),
     }
 }
 

@@ -496,3 +496,55 @@ fn eval_grey(family: &ProfileFamily, c: Coefficients, r: f64) -> f64 {
         .map(|p| p.eval(r))
         .unwrap_or(0.0)
 }
+
+/// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar
+/// beside it (feature `plot`), and a JSON sidecar with the set-up, the method, timings and
+/// counters (`extra` is merged in).
+pub fn write_beam_map(
+    map: &BeamMap,
+    setup: &BeamSetup,
+    exr: &std::path::Path,
+    extra: serde_json::Value,
+) -> Result<(), crate::plot_or_output::WriteError> {
+    let n = map.resolution;
+    crate::output::write_grey_exr(n, n, &map.values, exr)?;
+    #[cfg(feature = "plot")]
+    {
+        use crate::plot::{MapPlot, MapScale, map_png};
+        let e = map.extent;
+        let title = match &map.profile {
+            Some(p) => format!("{} ({p})", map.method),
+            None => map.method.clone(),
+        };
+        map_png(
+            &exr.with_extension("png"),
+            &MapPlot {
+                values: &map.values,
+                width: n,
+                height: n,
+                extent: [-e, e, -e, e],
+                scale: MapScale::log_for(&map.values, 6.0),
+                title: &title,
+                label: "exitance per unit power (1/area)",
+            },
+        )?;
+    }
+    let mut value = serde_json::json!({
+        "setup": setup,
+        "map": map,
+        "photons_per_second_per_core": (map.method == "pt").then(|| {
+            map.samples as f64 / map.seconds.max(1e-9) / rayon::current_num_threads() as f64
+        }),
+        "reflectance": map.exits.map(|x| {
+            let (a, a_se) = x.reflectance(Scattering::All);
+            let (s, s_se) = x.reflectance(Scattering::Single);
+            let (m, m_se) = x.reflectance(Scattering::Multiple);
+            serde_json::json!({"all": [a, a_se], "single": [s, s_se], "multiple": [m, m_se]})
+        }),
+    });
+    if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
+        obj.extend(more);
+    }
+    crate::output::write_json(&value, &exr.with_extension("json"))?;
+    Ok(())
+}

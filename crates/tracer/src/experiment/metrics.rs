@@ -81,6 +81,58 @@ pub fn compare(
     })
 }
 
+/// Compares two images given as films, optionally ignoring pixels whose centres lie closer
+/// than `min_radius` (scene units) to the centre of a square map of half-width `extent`.
+/// Grey images (equal channels in both) are compared on one channel.
+pub fn compare_films(
+    test: &crate::film::Film,
+    reference: &crate::film::Film,
+    exclusion: Option<(f64, f64)>,
+) -> Result<Metrics, MetricsError> {
+    if (test.width, test.height) != (reference.width, reference.height) {
+        return Err(MetricsError::SizeMismatch {
+            test: (test.width, test.height),
+            reference: (reference.width, reference.height),
+        });
+    }
+    let grey = |f: &crate::film::Film| f.pixels.iter().all(|p| p[0] == p[1] && p[1] == p[2]);
+    let channels = if grey(test) && grey(reference) { 1 } else { 3 };
+    let flat = |f: &crate::film::Film| -> Vec<f64> {
+        f.pixels
+            .iter()
+            .flat_map(|p| p.0[..channels].to_vec())
+            .collect()
+    };
+    let (w, h) = (test.width as usize, test.height as usize);
+    let keep = |i: usize| match exclusion {
+        None => true,
+        Some((min_radius, extent)) => {
+            let (x, y) = (i % w, i / w);
+            let px = -extent + (x as f64 + 0.5) * 2.0 * extent / w as f64;
+            let py = extent - (y as f64 + 0.5) * 2.0 * extent / h as f64;
+            px.hypot(py) >= min_radius
+        }
+    };
+    compare(&flat(test), &flat(reference), channels, keep)
+}
+
+/// Per-pixel log10(T/R) of the luminances (NaN where either is not positive), for the
+/// difference image.
+pub fn log_ratio(test: &crate::film::Film, reference: &crate::film::Film) -> Vec<f64> {
+    test.pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(t, r)| {
+            let (t, r) = (t.luminance(), r.luminance());
+            if t > 0.0 && r > 0.0 {
+                (t / r).log10()
+            } else {
+                f64::NAN
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -3,3 +3,4 @@
 
 pub mod beam;
 pub mod metrics;
+pub mod run;

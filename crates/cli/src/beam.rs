@@ -1,0 +1,270 @@
+//! `het-bssrdf beam`: the paper's Figure 4 experiment. A pencil beam of unit power enters an
+//! index-matched half-space at the origin; σa is a texture varying in x and y. Writes the
+//! diffuse exitance map over [−E, E]² (grey EXR, row 0 at y = +E), a false-colour log-scale
+//! PNG with a colour bar, and a JSON sidecar.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use bssrdf_core::{ProfileModel, Scattering};
+use tracer::experiment::beam::{
+    BeamMap, BeamSetup, BeamTexture, PhotonBudget, bssrdf_map, trace_photons, write_beam_map,
+};
+use tracer::integrator::Method;
+
+use crate::common::{
+    check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
+};
+
+/// Texture kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TextureKind {
+    /// One σa everywhere (`--values A`).
+    Const,
+    /// Stripes (`--values A,B --width W --angle DEG`).
+    Stripe,
+    /// Checks (`--values A,B --width W`).
+    Check,
+}
+
+/// The reference texture pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preset {
+    /// Stripes at 45°, width 4, σa 0.005 / 0.1 (the band through the origin has 0.005).
+    Stripe,
+    /// Checks of width 4, σa 0.005 / 0.1 (the cell at the origin has 0.005).
+    Check,
+}
+
+/// The beam experiment's set-up flags (shared with `converge --beam`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SetupArgs {
+    /// A reference texture (overrides --texture/--values/--width/--angle).
+    #[arg(long, value_enum, conflicts_with_all = ["texture", "values", "width", "angle"])]
+    pub preset: Option<Preset>,
+    /// σa texture kind.
+    #[arg(long, value_enum, default_value = "const")]
+    pub texture: TextureKind,
+    /// σa value(s): `A` for const, `A,B` for stripe and check (1/length, ≥ 0).
+    #[arg(long, value_delimiter = ',', default_values_t = [0.01])]
+    pub values: Vec<f64>,
+    /// Stripe or check width (length).
+    #[arg(long, default_value_t = 4.0)]
+    pub width: f64,
+    /// Stripe orientation in degrees.
+    #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
+    pub angle: f64,
+    /// Constant σs (1/length).
+    #[arg(long = "sigma-s", default_value_t = 1.0)]
+    pub sigma_s: f64,
+    /// Henyey–Greenstein g.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub g: f64,
+    /// Half-width E of the mapped square [−E, E]².
+    #[arg(long, default_value_t = 15.0)]
+    pub extent: f64,
+    /// N: the map is N × N pixels.
+    #[arg(long, value_parser = parse_positive, default_value_t = 120)]
+    pub resolution: u64,
+    /// Scattering orders: multiple (the paper), single or all.
+    #[arg(long, default_value = "multiple")]
+    pub scattering: Scattering,
+}
+
+impl SetupArgs {
+    /// The validated set-up.
+    pub fn setup(&self) -> anyhow::Result<BeamSetup> {
+        let texture = match self.preset {
+            Some(Preset::Stripe) => BeamTexture::preset("stripe").expect("built-in preset"),
+            Some(Preset::Check) => BeamTexture::preset("check").expect("built-in preset"),
+            None => {
+                for v in &self.values {
+                    if !(v.is_finite() && *v >= 0.0) {
+                        bail!("--values: σa must be a finite number ≥ 0, got {v}");
+                    }
+                }
+                if !(self.width.is_finite() && self.width > 0.0) {
+                    bail!("--width must be a positive number, got {}", self.width);
+                }
+                if !self.angle.is_finite() {
+                    bail!("--angle must be finite, got {}", self.angle);
+                }
+                let pair = || -> anyhow::Result<[f64; 2]> {
+                    match self.values.as_slice() {
+                        [a, b] => Ok([*a, *b]),
+                        v => bail!(
+                            "--values: {:?} needs two values A,B, got {}",
+                            self.texture,
+                            v.len()
+                        ),
+                    }
+                };
+                match self.texture {
+                    TextureKind::Const => match self.values.as_slice() {
+                        [a] => BeamTexture::Const { value: *a },
+                        v => bail!("--values: const needs one value, got {}", v.len()),
+                    },
+                    TextureKind::Stripe => BeamTexture::Stripe {
+                        values: pair()?,
+                        width: self.width,
+                        angle_deg: self.angle,
+                    },
+                    TextureKind::Check => BeamTexture::Check {
+                        values: pair()?,
+                        width: self.width,
+                    },
+                }
+            }
+        };
+        if !(self.sigma_s.is_finite() && self.sigma_s >= 0.0) {
+            bail!(
+                "--sigma-s must be a finite number ≥ 0, got {}",
+                self.sigma_s
+            );
+        }
+        if !(self.g.is_finite() && self.g.abs() < 1.0) {
+            bail!("--g must lie in (-1, 1), got {}", self.g);
+        }
+        if !(self.extent.is_finite() && self.extent > 0.0) {
+            bail!("--extent must be a positive number, got {}", self.extent);
+        }
+        Ok(BeamSetup {
+            texture,
+            sigma_s: self.sigma_s,
+            g: self.g,
+            extent: self.extent,
+            resolution: u32::try_from(self.resolution).context("--resolution is too large")?,
+            scattering: self.scattering,
+        })
+    }
+
+    /// A short name for default file names.
+    pub fn tag(&self) -> String {
+        match self.preset {
+            Some(Preset::Stripe) => "stripe".into(),
+            Some(Preset::Check) => "check".into(),
+            None => format!("{:?}", self.texture).to_lowercase(),
+        }
+    }
+}
+
+/// Arguments of `het-bssrdf beam`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(flatten)]
+    setup: SetupArgs,
+    /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
+    /// endpoints, segment, sone.
+    #[arg(long, value_parser = parse_method, default_value = "sone")]
+    method: Method,
+    /// Profile model for BSSRDF methods.
+    #[arg(long, default_value = "dipole")]
+    profile: ProfileModel,
+    /// Photons for `pt` (rounded up to batches of 8192).
+    #[arg(long, value_parser = parse_positive, conflicts_with = "time")]
+    photons: Option<u64>,
+    /// Time budget in seconds for `pt` instead of a photon count.
+    #[arg(long, value_parser = parse_seconds)]
+    time: Option<Duration>,
+    /// BSSRDF methods: K×K stratified points x_o per pixel.
+    #[arg(long, value_parser = parse_positive, default_value_t = 4)]
+    subsamples: u64,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Runs one beam experiment (library entry used by `beam`, `converge` and `reproduce`).
+pub fn run_method(
+    setup: &BeamSetup,
+    method: Method,
+    profile: ProfileModel,
+    photons: PhotonBudget,
+    subsamples: u32,
+    seed: u64,
+    show_progress: bool,
+) -> anyhow::Result<BeamMap> {
+    Ok(match method {
+        Method::PathTraced => {
+            let len = match photons {
+                PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
+                PhotonBudget::Time(_) => 0,
+            };
+            let bar = if show_progress {
+                progress(len, "pt", "photons")
+            } else {
+                indicatif::ProgressBar::hidden()
+            };
+            let map = trace_photons(setup, photons, seed, &|k| bar.inc(k))?;
+            bar.finish_and_clear();
+            map
+        }
+        Method::Bssrdf {
+            estimator,
+            profile: p,
+        } => {
+            let bar = if show_progress {
+                progress(setup.resolution as u64, estimator.name(), "rows")
+            } else {
+                indicatif::ProgressBar::hidden()
+            };
+            let map = bssrdf_map(
+                setup,
+                estimator,
+                p.unwrap_or(profile),
+                subsamples,
+                seed,
+                &|k| bar.inc(k),
+            )?;
+            bar.finish_and_clear();
+            map
+        }
+    })
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let setup = args.setup.setup()?;
+    let name = match args.method {
+        Method::PathTraced => "pt".to_string(),
+        m => format!("{}-{}", m.name(), args.profile),
+    };
+    let out = args
+        .out
+        .unwrap_or_else(|| PathBuf::from(format!("beam-{}-{name}.exr", args.setup.tag())));
+    check_writable(&out)?;
+    let photons = match (args.photons, args.time) {
+        (_, Some(t)) => PhotonBudget::Time(t),
+        (Some(n), None) => PhotonBudget::Count(n),
+        (None, None) => PhotonBudget::Count(1 << 20),
+    };
+    let sub = u32::try_from(args.subsamples).context("--subsamples is too large")?;
+    let map = run_method(
+        &setup,
+        args.method,
+        args.profile,
+        photons,
+        sub,
+        args.seed,
+        true,
+    )?;
+    write_beam_map(&map, &setup, &out, serde_json::json!({"seed": args.seed}))?;
+    eprintln!(
+        "{}: {} samples in {:.2} s; wrote {}",
+        map.method,
+        map.samples,
+        map.seconds,
+        out.display()
+    );
+    if let Some(x) = map.exits {
+        let (a, se) = x.reflectance(Scattering::All);
+        let rate = map.samples as f64 / map.seconds.max(1e-9) / rayon::current_num_threads() as f64;
+        eprintln!("  total reflectance {a:.5} ± {se:.5}; {rate:.3e} photons/s/core");
+    }
+    warn_counters(&map.counters);
+    Ok(())
+}

@@ -1,0 +1,76 @@
+//! Helpers shared by the subcommands: method names, output paths, progress bars, summaries.
+
+use std::path::Path;
+use std::time::Duration;
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use tracer::integrator::{Method, PathCounters};
+
+/// Parses a `--method` value (`pt` or an estimator name).
+pub fn parse_method(s: &str) -> Result<Method, String> {
+    s.parse()
+}
+
+/// Parses a duration in seconds (> 0).
+pub fn parse_seconds(s: &str) -> Result<Duration, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("`{s}` is not a number of seconds"))?;
+    if !(v > 0.0 && v.is_finite()) {
+        return Err(format!(
+            "the time budget must be a positive number of seconds, got {s}"
+        ));
+    }
+    Ok(Duration::from_secs_f64(v))
+}
+
+/// Parses a positive integer.
+pub fn parse_positive(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(v) if v > 0 => Ok(v),
+        _ => Err(format!("expected a positive whole number, got `{s}`")),
+    }
+}
+
+/// A progress bar on stderr over `len` units (hidden when stderr is not a terminal).
+pub fn progress(len: u64, prefix: &str, unit: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{prefix:>14}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}  {{elapsed}}<{{eta}}"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar.set_prefix(prefix.to_string());
+    bar
+}
+
+/// Fails early, before a long run, if `path` cannot be written.
+pub fn check_writable(path: &Path) -> anyhow::Result<()> {
+    tracer::experiment::run::check_output_path(path)
+        .with_context(|| format!("cannot write the output `{}`", path.display()))
+}
+
+/// One line per rare event that happened, so that no cap or fallback is silent.
+pub fn warn_counters(c: &PathCounters) {
+    if c.capped > 0 {
+        eprintln!(
+            "warning: {} paths hit the collision cap (their remaining light is lost)",
+            c.capped
+        );
+    }
+    if c.leaks > 0 {
+        eprintln!(
+            "warning: {} rays inside a closed object found no boundary (paths ended)",
+            c.leaks
+        );
+    }
+    if c.estimator_fallbacks > 0 {
+        eprintln!(
+            "note: {} estimates fell back to the endpoint average (every projection missed)",
+            c.estimator_fallbacks
+        );
+    }
+}

@@ -1,0 +1,205 @@
+//! One render of a scene with one method, and its files: EXR (f32 RGB), a PNG preview and a
+//! JSON sidecar (scene, method, spp, seed, wall time, rays traced, counters). Shared by the
+//! `render`, `converge` and `reproduce` commands.
+
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+use bssrdf_core::{ProfileModel, Scattering};
+use het_estimate::Estimator;
+use serde_json::json;
+
+use crate::error::OutputError;
+use crate::film::Film;
+use crate::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
+use crate::output::{write_exr, write_json, write_png};
+use crate::render::{Budget, RenderOptions, Rendered, render};
+use crate::scene::Scene;
+
+/// Default most surface interactions per camera path.
+pub const DEFAULT_MAX_DEPTH: u32 = 8;
+
+impl FromStr for Method {
+    type Err = String;
+    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`)
+    /// with the estimator's default parameters and each material's own profile.
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "pt" {
+            return Ok(Method::PathTraced);
+        }
+        Estimator::from_str(s)
+            .map(|estimator| Method::Bssrdf {
+                estimator,
+                profile: None,
+            })
+            .map_err(|e| format!("{e}; or `pt` for the path-traced reference"))
+    }
+}
+
+impl Method {
+    /// The method with its profile model overridden (BSSRDF methods only).
+    pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
+        match self {
+            Method::Bssrdf { estimator, .. } => Method::Bssrdf { estimator, profile },
+            m => m,
+        }
+    }
+}
+
+/// What a render needs besides the scene.
+#[derive(Debug, Clone)]
+pub struct RenderJob {
+    /// How translucent objects are rendered.
+    pub method: Method,
+    /// Samples per pixel or time budget.
+    pub budget: Budget,
+    /// Seed of every random stream.
+    pub seed: u64,
+    /// Scattering orders counted.
+    pub scattering: Scattering,
+    /// Most surface interactions per path.
+    pub max_depth: u32,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+impl RenderJob {
+    /// The scene's own settings (spp, seed, max depth, scattering) with `method`.
+    pub fn from_scene(scene: &Scene, method: Method) -> Self {
+        Self {
+            method,
+            budget: Budget::Samples(scene.settings.spp),
+            seed: scene.settings.seed,
+            scattering: scene.settings.scattering.unwrap_or_default(),
+            max_depth: scene.settings.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
+            progress: false,
+        }
+    }
+}
+
+/// A finished render.
+#[derive(Debug, Clone)]
+pub struct RenderOutcome {
+    /// The image.
+    pub film: Film,
+    /// Samples per pixel taken.
+    pub spp: u32,
+    /// Wall-clock seconds of sampling.
+    pub seconds: f64,
+    /// Rays traced (all kinds).
+    pub rays: u64,
+    /// Integrator counters.
+    pub counters: PathCounters,
+    /// The method's name.
+    pub method: String,
+}
+
+/// Renders `scene` with `job`.
+pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
+    let integrator = PathIntegrator::new(
+        scene,
+        job.method,
+        PathOptions {
+            scattering: job.scattering,
+            max_depth: job.max_depth,
+        },
+    )?;
+    let (w, h) = scene.camera.resolution();
+    let rays_before = scene.geometry.rays_traced();
+    let Rendered {
+        pixels,
+        spp,
+        seconds,
+        counters,
+        ..
+    } = render(
+        w,
+        h,
+        &integrator,
+        &RenderOptions {
+            budget: job.budget,
+            seed: job.seed,
+            progress: job.progress,
+            label: job.method.name().to_string(),
+        },
+    );
+    let mut film = Film::new(w, h);
+    film.pixels = pixels;
+    Ok(RenderOutcome {
+        film,
+        spp,
+        seconds,
+        rays: scene.geometry.rays_traced() - rays_before,
+        counters,
+        method: job.method.name().to_string(),
+    })
+}
+
+/// The PNG and JSON paths written beside an EXR path.
+pub fn sidecar_paths(exr: &Path) -> (PathBuf, PathBuf) {
+    (exr.with_extension("png"), exr.with_extension("json"))
+}
+
+/// Checks before a long run that `path` can be written: its directory exists and it is not
+/// itself a directory.
+pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
+    if path.is_dir() {
+        return Err(OutputError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(OutputError::MissingDirectory {
+            path: path.to_path_buf(),
+            dir,
+        });
+    }
+    Ok(())
+}
+
+/// Writes the EXR, the PNG preview (exposure in stops) and the JSON sidecar of a render.
+pub fn write_render(
+    outcome: &RenderOutcome,
+    scene: &Scene,
+    job: &RenderJob,
+    exr: &Path,
+    exposure: f64,
+) -> Result<(), OutputError> {
+    write_exr(&outcome.film, exr)?;
+    let (png, json_path) = sidecar_paths(exr);
+    write_png(&outcome.film, &png, exposure)?;
+    let profile = match job.method {
+        Method::Bssrdf { profile, .. } => Some(
+            profile
+                .map(|p| p.name().to_string())
+                .unwrap_or_else(|| "per material".to_string()),
+        ),
+        Method::PathTraced => None,
+    };
+    let estimator = match job.method {
+        Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
+        Method::PathTraced => None,
+    };
+    let value = json!({
+        "scene": scene.source_path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name.clone()),
+        "method": outcome.method,
+        "profile": profile,
+        "estimator_parameters": estimator,
+        "scattering": job.scattering.name(),
+        "spp": outcome.spp,
+        "seed": job.seed,
+        "max_depth": job.max_depth,
+        "width": outcome.film.width,
+        "height": outcome.film.height,
+        "wall_seconds": outcome.seconds,
+        "rays_traced": outcome.rays,
+        "threads": rayon::current_num_threads(),
+        "counters": outcome.counters,
+        "mean_rgb": outcome.film.mean().0,
+    });
+    write_json(&value, &json_path)
+}
