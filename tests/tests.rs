@@ -1,4 +1,8 @@
 //! Workspace integration tests: one binary, one module per theme.
 
 mod common;
+mod integrators;
+mod precision;
+mod stability;
+mod stiff;
 mod validation;

@@ -58,3 +58,142 @@ fn half_space_albedo_matches_chandrasekhar_and_orders_split_exactly() {
         );
     }
 }
+
+/// Photons injected at surface point `from` with cosine-distributed directions into the beam
+/// experiment's medium; the fraction leaving through the disk of radius `radius` around `to`.
+fn diffuse_transfer(
+    setup: &BeamSetup,
+    from: [f64; 2],
+    to: [f64; 2],
+    radius: f64,
+    photons: u64,
+    seed: u64,
+) -> (u64, u64) {
+    use glam::DVec3;
+    use tracer::geometry::Ray;
+    use tracer::integrator::PathCounters;
+    use tracer::integrator::path::ChannelView;
+    use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
+    use tracer::rng::Rng;
+    use tracer::scene::Material;
+    use tracer::volume::direction_about;
+    let scene = setup.scene().unwrap();
+    let entry = scene
+        .geometry
+        .intersect(&Ray::new(DVec3::new(from[0], from[1], 1.0), DVec3::NEG_Z))
+        .unwrap();
+    let Material::Translucent(t) = &scene.objects[0].material else {
+        unreachable!()
+    };
+    let view = ChannelView::new(&t.medium, 0);
+    let walk = WalkMedium {
+        geometry: &scene.geometry,
+        object: 0,
+        medium: &view,
+        g: t.g,
+        interface: Interface { eta: 1.0 },
+    };
+    let mut counters = PathCounters::default();
+    let mut hits = 0;
+    for k in 0..photons {
+        let mut rng = Rng::from_keys(seed, &[k]);
+        let u = rng.uniform2();
+        let dir = direction_about(DVec3::NEG_Z, u[0].sqrt(), std::f64::consts::TAU * u[1]);
+        let mut order = 0;
+        if let WalkEnd::Exited { hit, .. } = walk.walk(
+            entry.spawn_origin(dir),
+            dir,
+            &mut order,
+            &mut rng,
+            &mut counters,
+            |_, _, _, _| {},
+        ) && hit.ng.z > 0.5
+            && (hit.p.x - to[0]).hypot(hit.p.y - to[1]) < radius
+        {
+            hits += 1;
+        }
+    }
+    assert_eq!(counters.capped + counters.leaks, 0);
+    (hits, photons)
+}
+
+#[test]
+fn transport_is_reciprocal_in_a_heterogeneous_medium() {
+    // With a cosine-weighted (diffuse) source and hemispherical detection, reciprocity of the
+    // radiative transfer equation makes the transfer from a to b equal that from b to a, even
+    // though a and b lie in bands of different absorption (a: σa = 0.005, b: 0.1).
+    let setup = BeamSetup::paper(BeamTexture::preset("stripe").unwrap());
+    let (a, b) = ([0.0, 0.0], [2.5, 1.5]);
+    let n = 600_000;
+    let (ab, _) = diffuse_transfer(&setup, a, b, 0.5, n, 1);
+    let (ba, _) = diffuse_transfer(&setup, b, a, 0.5, n, 2);
+    let se = ((ab + ba) as f64).sqrt();
+    assert!(ab > 1000 && ba > 1000, "too few counts: {ab}, {ba}");
+    assert!(
+        (ab as f64 - ba as f64).abs() < 4.0 * se,
+        "a→b {ab}, b→a {ba}"
+    );
+}
+
+#[test]
+fn stripe_beam_map_has_the_texture_symmetries() {
+    // The 45° stripe pattern is symmetric under reflection across the line along the stripes
+    // ((x, y) → (−y, −x)) and across the perpendicular line ((x, y) → (y, x)); so must be the
+    // path tracer's exitance map of a beam at the origin. Compare each pixel's count with its
+    // mirror's: Σ (c₁ − c₂)²/(c₁ + c₂) over pairs is χ² with one degree of freedom per pair.
+    let mut setup = BeamSetup::paper(BeamTexture::preset("stripe").unwrap());
+    setup.resolution = 16;
+    setup.extent = 8.0;
+    let photons = 1 << 18;
+    let map = trace_photons(&setup, PhotonBudget::Count(photons), 5, &|_| {}).unwrap();
+    let n = setup.resolution as usize;
+    let scale = map.samples as f64 * setup.pixel_size().powi(2);
+    let count = |i: usize, j: usize| (map.values[i * n + j] * scale).round();
+    for (name, mirror) in [
+        (
+            "along the stripes",
+            (|i, j, n| (n - 1 - j, n - 1 - i)) as fn(usize, usize, usize) -> (usize, usize),
+        ),
+        ("across the stripes", |i, j, _| (j, i)),
+    ] {
+        let (mut chi2, mut dof) = (0.0, 0usize);
+        for i in 0..n {
+            for j in 0..n {
+                let (mi, mj) = mirror(i, j, n);
+                if (mi, mj) <= (i, j) {
+                    continue; // each pair once; fixed points carry no information
+                }
+                let (c1, c2) = (count(i, j), count(mi, mj));
+                if c1 + c2 >= 20.0 {
+                    chi2 += (c1 - c2).powi(2) / (c1 + c2);
+                    dof += 1;
+                }
+            }
+        }
+        // Wilson–Hilferty upper 0.001 quantile of χ²(dof).
+        let k = dof as f64;
+        let crit = k * (1.0 - 2.0 / (9.0 * k) + 3.09 * (2.0 / (9.0 * k)).sqrt()).powi(3);
+        assert!(dof > 50, "{name}: too few pairs ({dof})");
+        assert!(
+            chi2 < crit,
+            "{name}: χ² = {chi2:.1} over {dof} pairs (critical {crit:.1})"
+        );
+    }
+    // And the map is not symmetric under a transformation that breaks the pattern: a
+    // quarter turn maps 45° stripes to −45° ones (a sanity check that the test can fail).
+    let (mut chi2, mut dof) = (0.0, 0usize);
+    for i in 0..n {
+        for j in 0..n {
+            let (mi, mj) = (j, n - 1 - i);
+            let (c1, c2) = (count(i, j), count(mi, mj));
+            if (mi, mj) > (i, j) && c1 + c2 >= 20.0 {
+                chi2 += (c1 - c2).powi(2) / (c1 + c2);
+                dof += 1;
+            }
+        }
+    }
+    assert!(
+        chi2 > 3.0 * dof as f64,
+        "a quarter turn looks symmetric: χ² = {chi2} over {dof}"
+    );
+}

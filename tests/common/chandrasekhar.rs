@@ -76,6 +76,15 @@ pub fn half_space_albedo(omega: f64) -> f64 {
     1.0 - h(omega, 1.0) * (1.0 - omega).sqrt()
 }
 
+/// Radiance leaving an isotropic, index-matched half-space along the direction with cosine
+/// `mu` (to the normal), lit by a collimated beam at cosine `mu0` whose irradiance on a surface
+/// perpendicular to it is 1: `I = ϖ μ0 H(μ) H(μ0) / (4π (μ + μ0))` (Cha50, the diffuse
+/// reflection law for isotropic scattering, with πF = 1). Returns (all orders, single only).
+pub fn emergent_radiance(omega: f64, mu: f64, mu0: f64) -> (f64, f64) {
+    let single = omega * mu0 / (4.0 * std::f64::consts::PI * (mu + mu0));
+    (single * h(omega, mu) * h(omega, mu0), single)
+}
+
 /// Single-scattering reflectance at normal incidence, isotropic phase, index-matched.
 pub fn single_scattering_albedo(omega: f64) -> f64 {
     0.5 * omega * (1.0 - std::f64::consts::LN_2)

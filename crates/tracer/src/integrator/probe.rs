@@ -115,6 +115,25 @@ pub fn sample_probe(
     (pdf > 0.0 && pdf.is_finite()).then_some(ProbeSample { hit, pdf })
 }
 
+/// Area density (1/length²) with which one probe from `x_o` (coefficients `coeffs` there)
+/// reaches the surface point `x_i` along some chord, before the uniform choice among the
+/// chord's hits: [`sample_probe`] returns `x_i` with this density divided by the number of
+/// hits on the chord it traced.
+pub fn probe_density(x_o: &Hit, coeffs: Coefficients, sampler: &ProbeSampler, x_i: &Hit) -> f64 {
+    let coeffs = if coeffs.sigma_s.max_component() > 0.0 {
+        coeffs
+    } else {
+        sampler.fallback
+    };
+    let radial: [_; 3] = std::array::from_fn(|c| {
+        sampler
+            .table
+            .sampler(coeffs.sigma_a[c], coeffs.sigma_s[c])
+            .ok()
+    });
+    pdf_area(x_o.p, &Frame::new(x_o.ns), x_i, &radial)
+}
+
 /// Area density of producing `x_i` from `x_o` with one probe, before the 1/n_hits choice.
 fn pdf_area<P: RadialProfile>(
     x_o: DVec3,
