@@ -2,7 +2,4 @@
 
 mod common;
 mod integrators;
-mod precision;
-mod stability;
-mod stiff;
 mod validation;
