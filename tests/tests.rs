@@ -2,4 +2,7 @@
 
 mod common;
 mod integrators;
+mod precision;
+mod stability;
+mod stiff;
 mod validation;

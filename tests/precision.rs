@@ -1,0 +1,1 @@
+//! f32 geometry meets f64 physics (issue 7).
