@@ -8,9 +8,7 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use bssrdf_core::{ProfileModel, Scattering};
-use tracer::experiment::beam::{
-    BeamMap, BeamSetup, BeamTexture, PhotonBudget, bssrdf_map, trace_photons, write_beam_map,
-};
+use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
 use crate::common::{
@@ -178,7 +176,7 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-/// Runs one beam experiment (library entry used by `beam`, `converge` and `reproduce`).
+/// Runs one method with a progress bar on stderr.
 pub fn run_method(
     setup: &BeamSetup,
     method: Method,
@@ -188,42 +186,28 @@ pub fn run_method(
     seed: u64,
     show_progress: bool,
 ) -> anyhow::Result<BeamMap> {
-    Ok(match method {
-        Method::PathTraced => {
-            let len = match photons {
-                PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
-                PhotonBudget::Time(_) => 0,
-            };
-            let bar = if show_progress {
-                progress(len, "pt", "photons")
-            } else {
-                indicatif::ProgressBar::hidden()
-            };
-            let map = trace_photons(setup, photons, seed, &|k| bar.inc(k))?;
-            bar.finish_and_clear();
-            map
-        }
-        Method::Bssrdf {
-            estimator,
-            profile: p,
-        } => {
-            let bar = if show_progress {
-                progress(setup.resolution as u64, estimator.name(), "rows")
-            } else {
-                indicatif::ProgressBar::hidden()
-            };
-            let map = bssrdf_map(
-                setup,
-                estimator,
-                p.unwrap_or(profile),
-                subsamples,
-                seed,
-                &|k| bar.inc(k),
-            )?;
-            bar.finish_and_clear();
-            map
-        }
-    })
+    let bar = if !show_progress {
+        indicatif::ProgressBar::hidden()
+    } else if method == Method::PathTraced {
+        let len = match photons {
+            PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
+            PhotonBudget::Time(_) => 0,
+        };
+        progress(len, "pt", "photons")
+    } else {
+        progress(setup.resolution as u64, method.name(), "rows")
+    };
+    let map = tracer::experiment::beam::run_method(
+        setup,
+        method,
+        profile,
+        photons,
+        subsamples,
+        seed,
+        &|k| bar.inc(k),
+    )?;
+    bar.finish_and_clear();
+    Ok(map)
 }
 
 /// Runs the subcommand.

@@ -7,6 +7,7 @@
 mod beam;
 mod common;
 mod compare;
+mod converge;
 mod profile;
 mod render;
 
@@ -33,6 +34,8 @@ enum Command {
     Beam(beam::Args),
     /// Error metrics of a test image against a reference, and a difference image.
     Compare(compare::Args),
+    /// Error against run time of several methods, and their speed-up over path tracing.
+    Converge(converge::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -41,6 +44,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::run(args),
         Command::Beam(args) => beam::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Converge(args) => converge::run(args),
     }
 }
 

@@ -548,3 +548,24 @@ pub fn write_beam_map(
     crate::output::write_json(&value, &exr.with_extension("json"))?;
     Ok(())
 }
+
+/// Runs one method of the beam experiment: light tracing for [`Method::PathTraced`] (with
+/// `photons`), otherwise the BSSRDF map with `sub × sub` points per pixel and `profile` unless
+/// the method names its own. `progress` receives units of work (photons or rows).
+pub fn run_method(
+    setup: &BeamSetup,
+    method: crate::integrator::Method,
+    profile: ProfileModel,
+    photons: PhotonBudget,
+    sub: u32,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<BeamMap, SceneError> {
+    match method {
+        crate::integrator::Method::PathTraced => trace_photons(setup, photons, seed, progress),
+        crate::integrator::Method::Bssrdf {
+            estimator,
+            profile: p,
+        } => bssrdf_map(setup, estimator, p.unwrap_or(profile), sub, seed, progress),
+    }
+}

@@ -2,5 +2,7 @@
 //! error-against-time studies.
 
 pub mod beam;
+pub mod converge;
 pub mod metrics;
 pub mod run;
+pub mod study;

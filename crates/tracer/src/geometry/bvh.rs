@@ -33,6 +33,13 @@ const SCALED_COORD_LOG2: i32 = 32;
 /// (≈ 128 ulps of the object's extent) covers rays starting within about 40 extents of the
 /// object, which includes every ray of a random walk inside it.
 const BOX_PAD_REL: f32 = 1.0 / 65536.0;
+/// Lower bound of the padding in ulps of the object's largest coordinate magnitude. For an
+/// object far from the origin compared with its size (a unit sphere at (1e4, −2e4, 3e4):
+/// scaled by 2¹¹, coordinates ≈ 6e7 with an ulp of 4, against an extent pad of 0.06) the
+/// extent-relative pad is below one ulp of the box coordinates and vanishes when added to them,
+/// and a ray from the centre through a shared vertex leaked (`tests/precision.rs`). Near the
+/// origin (magnitude < 16 × extent) the extent pad is the larger and nothing changes.
+const BOX_PAD_COORD_ULPS: f64 = 8.0;
 
 /// A triangle's padded bounding box, what the BVH is built on.
 struct PaddedBox(Aabb);
@@ -165,7 +172,13 @@ impl ObjectAccel {
                 t.map(|k| Vec3A::from((mesh.positions[k as usize].as_dvec3() * scale).as_vec3()))
             })
             .collect();
-        let pad = Vec3A::splat(BOX_PAD_REL * (extent * scale) as f32);
+        // 128 ulps of the extent, but never less than 8 ulps of the largest coordinate: far
+        // from the origin the extent-relative pad alone rounds away (min − pad == min in f32).
+        let pad = Vec3A::splat(
+            (f64::from(BOX_PAD_REL) * extent * scale)
+                .max(BOX_PAD_COORD_ULPS * f64::from(f32::EPSILON) * magnitude * scale)
+                as f32,
+        );
         let boxes: Vec<PaddedBox> = scaled
             .iter()
             .map(|v| {

@@ -24,7 +24,7 @@ use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
-use crate::integrator::probe::{ProbeSampler, sample_probe};
+use crate::integrator::probe::{ProbeSampler, probe};
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::Light;
 use crate::render::PixelEstimator;
@@ -585,11 +585,12 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
-    /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then an incident point x_i from
-    /// probe rays, the estimated homogeneous coefficients, the profile, and irradiance at x_i
-    /// with pbrt-v4's normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π),
-    /// c = 1 − 2 C1(1/η) (pbrt-v4 §11.4, `NormalizedFresnelBxDF`). The path continues from x_i
-    /// with a cosine-sampled direction.
+    /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then incident points x_i from
+    /// probe rays ([`super::probe`]), and at each of them the estimated homogeneous
+    /// coefficients, the profile at r = |x_i − x_o|, and irradiance through pbrt-v4's
+    /// normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
+    /// (pbrt-v4 §11.4, `NormalizedFresnelBxDF`). The path continues from one of the x_i with a
+    /// cosine-sampled direction.
     #[allow(clippy::too_many_arguments)]
     fn subsurface(
         &self,
@@ -620,64 +621,78 @@ impl<'s> PathIntegrator<'s> {
         }
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
-        let Some(probe) = sample_probe(&self.scene.geometry, object, hit, at_xo, &b.sampler, rng)
-        else {
+        let set = probe(&self.scene.geometry, object, hit, at_xo, &b.sampler, rng);
+        if set.is_empty() {
             counters.probe_misses += 1;
             return Step::Stop;
-        };
-        let x_i = probe.hit;
+        }
         let surface = ObjectSurface {
             geometry: &self.scene.geometry,
             object,
         };
-        let est = b
-            .estimator
-            .estimate(&surface, &material.medium, &x_i, hit, rng);
-        counters.estimates += 1;
-        counters.estimator_samples += est.diagnostics.samples as u64;
-        counters.projection_misses += est.diagnostics.misses as u64;
-        counters.short_circuits += est.diagnostics.short_circuit as u64;
-        counters.estimator_fallbacks += est.diagnostics.fallback as u64;
-        let r = (x_i.p - hit.p).length();
-        let c = est.coefficients;
-        let mut rd = Rgb::ZERO;
-        for ch in 0..3 {
-            if let Ok(profile) = b.family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
-                rd[ch] = profile.eval(r);
-            }
-        }
-        st.beta = st.beta * rd / probe.pdf;
-        if st.beta.is_zero() {
-            return Step::Stop;
-        }
-        // Irradiance at x_i through the lobe S_w.
-        let n_i = x_i.ns;
         let eta = material.eta;
         let sw = |cos: f64| {
             (1.0 - bssrdf_core::fresnel::dielectric(cos, eta)) / (b.sw_norm * std::f64::consts::PI)
         };
-        let ld = self.direct(
-            x_i.p,
-            |wi| x_i.spawn_origin(wi),
-            |wi| {
-                let cos = wi.dot(n_i);
-                if cos > 0.0 {
-                    (sw(cos) * cos, cos / std::f64::consts::PI)
-                } else {
-                    (0.0, 0.0)
+        // Every hit gathers light; one, chosen uniformly, carries the path on (weight n).
+        let carrier = rng.below(set.len() as u32) as usize;
+        let mut next = None;
+        for (k, ph) in set.iter().enumerate() {
+            let x_i = ph.hit;
+            let n_i = x_i.ns;
+            let ld = self.direct(
+                x_i.p,
+                |wi| x_i.spawn_origin(wi),
+                |wi| {
+                    let cos = wi.dot(n_i);
+                    if cos > 0.0 {
+                        (sw(cos) * cos, cos / std::f64::consts::PI)
+                    } else {
+                        (0.0, 0.0)
+                    }
+                },
+                0,
+                rng,
+                counters,
+            );
+            if ld.is_zero() && k != carrier {
+                continue; // nothing to gather: skip the (costly) estimate
+            }
+            let est = b
+                .estimator
+                .estimate(&surface, &material.medium, &x_i, hit, rng);
+            counters.estimates += 1;
+            counters.estimator_samples += est.diagnostics.samples as u64;
+            counters.projection_misses += est.diagnostics.misses as u64;
+            counters.short_circuits += est.diagnostics.short_circuit as u64;
+            counters.estimator_fallbacks += est.diagnostics.fallback as u64;
+            let r = (x_i.p - hit.p).length();
+            let c = est.coefficients;
+            let mut rd = Rgb::ZERO;
+            for ch in 0..3 {
+                if let Ok(profile) = b.family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
+                    rd[ch] = profile.eval(r);
                 }
-            },
-            0,
-            rng,
-            counters,
-        );
-        st.l += st.beta * ld;
+            }
+            let w = rd * ph.weight;
+            st.l += st.beta * w * ld;
+            if k == carrier {
+                next = Some((x_i, w * set.len() as f64));
+            }
+        }
+        let Some((x_i, w)) = next else {
+            return Step::Stop;
+        };
+        st.beta *= w;
+        if st.beta.is_zero() {
+            return Step::Stop;
+        }
         let u = rng.uniform2();
         let cos = u[0].sqrt();
         if cos <= 0.0 {
             return Step::Stop;
         }
-        let wi = direction_about(n_i, cos, std::f64::consts::TAU * u[1]);
+        let wi = direction_about(x_i.ns, cos, std::f64::consts::TAU * u[1]);
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= sw(cos) * std::f64::consts::PI;
         st.prev = Prev::Sampled {

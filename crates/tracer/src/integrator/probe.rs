@@ -1,20 +1,26 @@
 //! Importance sampling of incident points x_i around an exitant point x_o with probe rays
-//! (pbrt-v4 §11.4.3, `TabulatedBSSRDF::Sample` / `PdfSp`; pbrt-v3 §15.4.1).
+//! (after pbrt-v4 §11.4.3, `TabulatedBSSRDF::Sample` / `PdfSp`, with two variance reductions).
 //!
-//! A probe picks a projection axis in x_o's shading frame (the normal with probability 1/2,
-//! each tangent with 1/4) and a colour channel (1/3 each), samples a radius r from that
-//! channel's radial profile (the homogeneous profile of the coefficients at x_o, via the
-//! profile table), an angle φ uniformly, and traces the chord of the sphere of radius r_max
-//! (the radius holding 99.9 % of the profile's energy) along the axis at that (r, φ). One of
-//! the chord's intersections with the object is chosen uniformly. The area density of the
-//! chosen point sums every (axis, channel) way it could have been produced:
+//! A probe along axis `a` of x_o's shading frame (the normal or one of the two tangents) picks
+//! a colour channel `c` uniformly, samples a radius r from that channel's radial profile (the
+//! homogeneous profile of the coefficients at x_o, from the profile table), an angle φ
+//! uniformly, and traces the chord of the sphere of radius `r_max,c` (holding
+//! [`PROBE_ENERGY_FRACTION`] of the profile's energy) along the axis at (r, φ).
 //!
-//! `pdf(x_i) = (1/n_hits) Σ_axes Σ_channels P(axis) P(ch) · p_r,ch(r_axis) / (2π r_axis) · |n_i · axis|`
+//! pbrt traces one probe along a randomly chosen axis and keeps one of its hits at random.
+//! Here every camera sample traces **one probe per axis and keeps every hit**: a multi-sample
+//! estimator with balance-heuristic weights over the three axes (Veach 1997, §9.2), so each
+//! hit x contributes `f(x) / p(x)` with
 //!
-//! with `r_axis` the distance from x_o to x_i projected on the plane perpendicular to the axis
-//! and `p_r` the radial density (per unit length) of the channel's profile.
+//! `p(x) = Σ_axes (1/3) Σ_c [|x − x_o| < r_max,c] · p_r,c(r_a) / (2π r_a) · |n(x) · axis|`,
+//!
+//! `r_a` the distance from x_o to x projected on the plane perpendicular to the axis and
+//! `p_r,c` the channel's radial density (per unit length). `E[Σ_hits f/p] = ∫ f dA` over the
+//! surface inside the largest probe sphere: on a flat surface the normal probe then always
+//! finds x_i instead of succeeding one time in four, and the random choice between the top and
+//! the bottom of a thin slab disappears.
 
-use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile};
+use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, TableSampler};
 use glam::DVec3;
 use het_estimate::Coefficients;
 
@@ -25,10 +31,8 @@ use crate::volume::orthonormal_basis;
 
 /// Fraction of the profile's energy inside the probe sphere.
 pub const PROBE_ENERGY_FRACTION: f64 = 0.999;
-/// Most intersections of one probe chord that are kept.
-pub const MAX_PROBE_HITS: usize = 32;
-/// Probability of each projection axis: tangent s, tangent t, normal.
-const AXIS_PROB: [f64; 3] = [0.25, 0.25, 0.5];
+/// Most intersections kept per probe chord.
+pub const MAX_PROBE_HITS: usize = 16;
 
 /// The profile table and fallback coefficients of one translucent material.
 pub struct ProbeSampler {
@@ -46,102 +50,125 @@ impl ProbeSampler {
             fallback,
         }
     }
+
+    /// The largest probe radius over the channels at coefficients `c` (0 if none scatters).
+    pub fn probe_radius(&self, c: Coefficients) -> f64 {
+        self.channels(c)
+            .iter()
+            .flatten()
+            .map(|(_, r)| *r)
+            .fold(0.0, f64::max)
+    }
+
+    /// The radial samplers and probe radii of the three channels at coefficients `c`.
+    fn channels(&self, c: Coefficients) -> [Option<(TableSampler<'_>, f64)>; 3] {
+        let c = if c.sigma_s.max_component() > 0.0 {
+            c
+        } else {
+            self.fallback
+        };
+        std::array::from_fn(|ch| {
+            let s = self.table.sampler(c.sigma_a[ch], c.sigma_s[ch]).ok()?;
+            let r_max = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
+            (r_max.is_finite() && r_max > 0.0).then_some((s, r_max))
+        })
+    }
 }
 
-/// A sampled incident point and its area density (1/length²).
+/// A found incident point and its estimator weight `1/p(x)` (length², see the module docs).
 #[derive(Debug, Clone, Copy)]
-pub struct ProbeSample {
+pub struct ProbeHit {
     /// The incident point.
     pub hit: Hit,
-    /// Area density of choosing it.
-    pub pdf: f64,
+    /// `1 / p(x)`.
+    pub weight: f64,
 }
 
-/// Samples x_i around `x_o` on `object` (see the module docs); `coeffs` are the coefficients
-/// at x_o that shape the sampling density. `None` when the probe finds no point.
-pub fn sample_probe(
+/// The incident points found by the three probes of one camera sample.
+pub struct ProbeSet {
+    hits: [Option<ProbeHit>; 3 * MAX_PROBE_HITS],
+    len: usize,
+}
+
+impl ProbeSet {
+    /// The hits.
+    pub fn iter(&self) -> impl Iterator<Item = &ProbeHit> {
+        self.hits[..self.len].iter().flatten()
+    }
+    /// Number of hits.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// True when no probe found anything.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// Traces one probe per axis around `x_o` on `object` (see the module docs); `coeffs` are the
+/// coefficients at x_o that shape the sampling density.
+pub fn probe(
     geometry: &Geometry,
     object: u32,
     x_o: &Hit,
     coeffs: Coefficients,
     sampler: &ProbeSampler,
     rng: &mut Rng,
-) -> Option<ProbeSample> {
-    let coeffs = if coeffs.sigma_s.max_component() > 0.0 {
-        coeffs
-    } else {
-        sampler.fallback
-    };
-    let radial: [_; 3] = std::array::from_fn(|c| {
-        sampler
-            .table
-            .sampler(coeffs.sigma_a[c], coeffs.sigma_s[c])
-            .ok()
-    });
+) -> ProbeSet {
+    let channels = sampler.channels(coeffs);
     let frame = Frame::new(x_o.ns);
-    let u = rng.uniform();
-    let axis = if u < AXIS_PROB[0] {
-        0
-    } else if u < AXIS_PROB[0] + AXIS_PROB[1] {
-        1
-    } else {
-        2
+    let mut set = ProbeSet {
+        hits: [None; 3 * MAX_PROBE_HITS],
+        len: 0,
     };
-    let ch = rng.below(3) as usize;
-    let prof = radial[ch].as_ref()?;
-    let r = prof.sample_r(rng.uniform())?;
-    let r_max = prof.radius_for_fraction(PROBE_ENERGY_FRACTION);
-    if r.is_nan() || r >= r_max || !r_max.is_finite() {
-        return None;
-    }
-    let phi = std::f64::consts::TAU * rng.uniform();
-    let (vx, vy, vz) = frame.axes(axis);
-    let half = (r_max * r_max - r * r).sqrt();
-    let base = x_o.p + r * (phi.cos() * vx + phi.sin() * vy) - half * vz;
-    let probe = Ray::with_range(base, vz, 0.0, 2.0 * half);
-    let mut hits = [None; MAX_PROBE_HITS];
-    let mut n = 0;
-    geometry.for_each_object_hit(object, &probe, |h| {
-        if n < MAX_PROBE_HITS {
-            hits[n] = Some(*h);
-            n += 1;
+    for axis in 0..3 {
+        let ch = rng.below(3) as usize;
+        let (u_r, u_phi) = (rng.uniform(), rng.uniform());
+        let Some((prof, r_max)) = channels[ch].as_ref() else {
+            continue;
+        };
+        let Some(r) = prof.sample_r(u_r) else {
+            continue;
+        };
+        if r.is_nan() || r >= *r_max {
+            continue;
         }
-    });
-    if n == 0 {
-        return None;
+        let phi = std::f64::consts::TAU * u_phi;
+        let (vx, vy, vz) = frame.axes(axis);
+        let half = (r_max * r_max - r * r).sqrt();
+        let base = x_o.p + r * (phi.cos() * vx + phi.sin() * vy) - half * vz;
+        let chord = Ray::with_range(base, vz, 0.0, 2.0 * half);
+        let mut kept = 0;
+        geometry.for_each_object_hit(object, &chord, |h| {
+            if kept < MAX_PROBE_HITS {
+                let p = density(x_o.p, &frame, h, &channels);
+                if p > 0.0 && p.is_finite() {
+                    set.hits[set.len] = Some(ProbeHit {
+                        hit: *h,
+                        weight: 1.0 / p,
+                    });
+                    set.len += 1;
+                    kept += 1;
+                }
+            }
+        });
     }
-    let hit = hits[rng.below(n as u32) as usize]?;
-    let pdf = pdf_area(x_o.p, &frame, &hit, &radial) / n as f64;
-    (pdf > 0.0 && pdf.is_finite()).then_some(ProbeSample { hit, pdf })
+    set
 }
 
-/// Area density (1/length²) with which one probe from `x_o` (coefficients `coeffs` there)
-/// reaches the surface point `x_i` along some chord, before the uniform choice among the
-/// chord's hits: [`sample_probe`] returns `x_i` with this density divided by the number of
-/// hits on the chord it traced.
+/// `p(x)` of the module docs, for a surface point `x_i` and coefficients `coeffs` at x_o.
 pub fn probe_density(x_o: &Hit, coeffs: Coefficients, sampler: &ProbeSampler, x_i: &Hit) -> f64 {
-    let coeffs = if coeffs.sigma_s.max_component() > 0.0 {
-        coeffs
-    } else {
-        sampler.fallback
-    };
-    let radial: [_; 3] = std::array::from_fn(|c| {
-        sampler
-            .table
-            .sampler(coeffs.sigma_a[c], coeffs.sigma_s[c])
-            .ok()
-    });
-    pdf_area(x_o.p, &Frame::new(x_o.ns), x_i, &radial)
+    density(x_o.p, &Frame::new(x_o.ns), x_i, &sampler.channels(coeffs))
 }
 
-/// Area density of producing `x_i` from `x_o` with one probe, before the 1/n_hits choice.
-fn pdf_area<P: RadialProfile>(
+fn density<P: RadialProfile>(
     x_o: DVec3,
     frame: &Frame,
     x_i: &Hit,
-    radial: &[Option<P>; 3],
+    channels: &[Option<(P, f64)>; 3],
 ) -> f64 {
     let d = x_i.p - x_o;
+    let dist = d.length();
     let dl = DVec3::new(d.dot(frame.s), d.dot(frame.t), d.dot(frame.n));
     let nl = DVec3::new(
         x_i.ng.dot(frame.s),
@@ -154,14 +181,15 @@ fn pdf_area<P: RadialProfile>(
         (dl.x * dl.x + dl.y * dl.y).sqrt(),
     ];
     let mut pdf = 0.0;
-    for axis in 0..3 {
-        let r = r_proj[axis];
-        if r.is_nan() || r <= 0.0 {
+    for (prof, r_max) in channels.iter().flatten() {
+        if dist >= *r_max {
             continue;
         }
-        for prof in radial.iter().flatten() {
-            pdf += AXIS_PROB[axis] / 3.0 * prof.pdf_r(r) / (std::f64::consts::TAU * r)
-                * nl[axis].abs();
+        for axis in 0..3 {
+            let r = r_proj[axis];
+            if r > 0.0 {
+                pdf += prof.pdf_r(r) / (3.0 * std::f64::consts::TAU * r) * nl[axis].abs();
+            }
         }
     }
     pdf

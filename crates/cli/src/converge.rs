@@ -1,0 +1,296 @@
+//! `het-bssrdf converge`: error against run time for several methods, on a scene file or on
+//! the beam experiment (`--beam`), against a path-traced reference; writes
+//! `convergence.csv`, `convergence.png` (+ `.svg`), `summary.json` with the speed-up of each
+//! BSSRDF method over path tracing, and the largest run of every method as an image.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use bssrdf_core::ProfileModel;
+use tracer::experiment::beam::{PhotonBudget, write_beam_map};
+use tracer::experiment::converge::{MethodSummary, check_dir, summarize, write_outputs};
+use tracer::experiment::run::{RenderJob, write_render};
+use tracer::experiment::study::{
+    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, reference_path, scene_reference, scene_study,
+};
+use tracer::integrator::Method;
+use tracer::output::read_exr;
+use tracer::scene::Scene;
+
+use crate::beam::{SetupArgs, run_method};
+use crate::common::{parse_method, parse_positive};
+
+/// Arguments of `het-bssrdf converge`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The scene file (TOML); omit it with `--beam`.
+    #[arg(required_unless_present = "beam")]
+    scene: Option<PathBuf>,
+    /// Study the beam experiment instead of a scene (with the `beam` set-up flags).
+    #[arg(long)]
+    beam: bool,
+    #[command(flatten)]
+    setup: SetupArgs,
+    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
+    #[arg(long, value_delimiter = ',', value_parser = parse_method, default_value = "pt,jensen-out,endpoints,sone")]
+    methods: Vec<Method>,
+    /// Profile model of the BSSRDF methods (scene: default each material's).
+    #[arg(long)]
+    profile: Option<ProfileModel>,
+    /// A reference image (EXR). Default: path traced at `--reference-spp` (scene, cached beside
+    /// it with its spp and seed in the name) or `--reference-photons` (beam, in --out).
+    #[arg(long)]
+    reference: Option<PathBuf>,
+    /// Samples per pixel of the rendered reference.
+    #[arg(long, value_parser = parse_positive, default_value_t = 1024)]
+    reference_spp: u64,
+    /// Largest spp of the scene runs (doubling from 1).
+    #[arg(long, value_parser = parse_positive, default_value_t = 64)]
+    max_spp: u64,
+    /// Beam: photons of the rendered reference.
+    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 24)]
+    reference_photons: u64,
+    /// Beam: largest photon count of the `pt` runs (doubling from 2^16).
+    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 22)]
+    max_photons: u64,
+    /// Beam: largest K of the BSSRDF runs (K × K points per pixel, doubling from 1).
+    #[arg(long, value_parser = parse_positive, default_value_t = 4)]
+    max_subsamples: u64,
+    /// Beam: ignore pixels closer than R to the beam (the singular peak).
+    #[arg(long = "min-radius", default_value_t = 1.0)]
+    min_radius: f64,
+    /// Seed of the runs (the reference uses a different one).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+fn doubling(from: u64, to: u64) -> Vec<u64> {
+    std::iter::successors(Some(from), |&v| Some(v * 2))
+        .take_while(|&v| v <= to)
+        .collect()
+}
+
+fn print_summary(summary: &[MethodSummary]) {
+    for s in summary {
+        let pt = match (s.pt_time_to_same_error, s.speedup) {
+            (Some(t), Some(x)) => format!(
+                "path tracing needs {t:.3} s{} -> speed-up {x:.1}x",
+                if s.pt_extrapolated {
+                    " (extrapolated)"
+                } else {
+                    ""
+                }
+            ),
+            _ => "no path-tracing runs".into(),
+        };
+        eprintln!(
+            "{:>24}: converged rel. L2 {:.4} after {:.3} s; {pt}",
+            s.method, s.converged_error, s.time_to_converge
+        );
+    }
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    if args.methods.is_empty() {
+        bail!("--methods: give at least one method");
+    }
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = match &args.scene {
+            Some(s) if !args.beam => s
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            _ => format!("beam-{}", args.setup.tag()),
+        };
+        PathBuf::from(format!("converge-{stem}"))
+    });
+    std::fs::create_dir_all(&out)
+        .with_context(|| format!("cannot create the output directory `{}`", out.display()))?;
+    check_dir(&out)?;
+    if args.beam {
+        run_beam(&args, &out)
+    } else {
+        run_scene(&args, &out)
+    }
+}
+
+fn run_scene(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
+    let file = args
+        .scene
+        .as_ref()
+        .expect("clap requires a scene without --beam");
+    let scene = Scene::load(file)?;
+    let base = RenderJob::from_scene(&scene, Method::PathTraced);
+    let reference = match &args.reference {
+        Some(r) => read_exr(r)?,
+        None => {
+            let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
+            let cache = reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
+            if !cache.is_file() {
+                eprintln!(
+                    "rendering the path-traced reference at {spp} spp into {}",
+                    cache.display()
+                );
+            }
+            let mut job = base.clone();
+            job.progress = true;
+            let (film, _) = scene_reference(&scene, &job, spp, &cache)
+                .with_context(|| format!("cannot make the reference `{}`", cache.display()))?;
+            film
+        }
+    };
+    let spp: Vec<u32> = doubling(1, args.max_spp)
+        .into_iter()
+        .map(|s| s as u32)
+        .collect();
+    let methods: Vec<Method> = args
+        .methods
+        .iter()
+        .map(|m| m.with_profile(args.profile))
+        .collect();
+    let bar = crate::common::progress((methods.len() * spp.len()) as u64, "converge", "runs");
+    let mut last_written = Vec::new();
+    let runs = scene_study(
+        &scene,
+        &RenderJob {
+            seed: args.seed,
+            ..base.clone()
+        },
+        &methods,
+        &spp,
+        &reference,
+        |run, outcome| {
+            bar.inc(1);
+            if run.budget == *spp.last().expect("at least spp 1") as u64 {
+                last_written.push((run.method.clone(), outcome.clone()));
+            }
+        },
+    )?;
+    bar.finish_and_clear();
+    for (name, outcome) in &last_written {
+        let mut job = base.clone();
+        job.seed = args.seed;
+        job.method = name.parse().map_err(|e: String| anyhow::anyhow!(e))?;
+        write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
+    }
+    let summary = summarize(&runs);
+    let title = format!("{} — error against time", scene.display_name);
+    write_outputs(
+        out,
+        &title,
+        &runs,
+        &summary,
+        serde_json::json!({ "scene": file.display().to_string(), "reference_spp": args.reference_spp }),
+    )?;
+    print_summary(&summary);
+    eprintln!(
+        "wrote {}/convergence.csv, convergence.png, summary.json",
+        out.display()
+    );
+    Ok(())
+}
+
+fn run_beam(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
+    let setup = args.setup.setup()?;
+    let profile = args.profile.unwrap_or(ProfileModel::Dipole);
+    let reference: Vec<f64> = match &args.reference {
+        Some(r) => {
+            let film = read_exr(r)?;
+            film.pixels.iter().map(|p| p[0]).collect()
+        }
+        None => {
+            let path = out.join(format!(
+                "reference-pt-{}photons.exr",
+                args.reference_photons
+            ));
+            if path.is_file() {
+                read_exr(&path)?.pixels.iter().map(|p| p[0]).collect()
+            } else {
+                let map = run_method(
+                    &setup,
+                    Method::PathTraced,
+                    profile,
+                    PhotonBudget::Count(args.reference_photons),
+                    1,
+                    args.seed.wrapping_add(REFERENCE_SEED_OFFSET),
+                    true,
+                )?;
+                write_beam_map(
+                    &map,
+                    &setup,
+                    &path,
+                    serde_json::json!({"seed": args.seed.wrapping_add(REFERENCE_SEED_OFFSET)}),
+                )?;
+                map.values
+            }
+        }
+    };
+    let budgets = BeamBudgets {
+        photons: doubling(1 << 16, args.max_photons.max(1 << 16)),
+        subsamples: doubling(1, args.max_subsamples)
+            .into_iter()
+            .map(|k| k as u32)
+            .collect(),
+    };
+    let runs_total: usize = args
+        .methods
+        .iter()
+        .map(|m| {
+            if *m == Method::PathTraced {
+                budgets.photons.len()
+            } else {
+                budgets.subsamples.len()
+            }
+        })
+        .sum();
+    let bar = crate::common::progress(runs_total as u64, "converge", "runs");
+    let mut finals = Vec::new();
+    let runs = beam_study(
+        &setup,
+        &args.methods,
+        profile,
+        &budgets,
+        args.seed,
+        &reference,
+        args.min_radius,
+        |run, map| {
+            bar.inc(1);
+            let last = if run.unit == "photons" {
+                run.budget >= *budgets.photons.last().expect("non-empty")
+            } else {
+                run.budget == (*budgets.subsamples.last().expect("non-empty") as u64).pow(2)
+            };
+            if last {
+                finals.push((run.method.clone(), map.clone()));
+            }
+        },
+    )?;
+    bar.finish_and_clear();
+    for (name, map) in &finals {
+        write_beam_map(
+            map,
+            &setup,
+            &out.join(format!("{name}.exr")),
+            serde_json::json!({"seed": args.seed}),
+        )?;
+    }
+    let summary = summarize(&runs);
+    let title = format!("beam ({}) — error against time", args.setup.tag());
+    write_outputs(
+        out,
+        &title,
+        &runs,
+        &summary,
+        serde_json::json!({ "setup": setup, "min_radius": args.min_radius }),
+    )?;
+    print_summary(&summary);
+    eprintln!(
+        "wrote {}/convergence.csv, convergence.png, summary.json",
+        out.display()
+    );
+    Ok(())
+}
