@@ -262,3 +262,12 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
     // On a unit sphere the cap within chord distance R has area π R² (a check of the reference).
     assert!((area - std::f64::consts::PI * r_max * r_max).abs() < 0.02 * area);
 }
+
+#[test]
+fn built_in_checker_slab_equals_the_example_file() {
+    assert_eq!(
+        tracer::experiment::scenes::CHECKER_SLAB,
+        include_str!("../examples/scenes/checker-slab.toml"),
+        "crates/tracer/src/experiment/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
+    );
+}

@@ -10,6 +10,7 @@ mod compare;
 mod converge;
 mod profile;
 mod render;
+mod reproduce;
 
 use std::process::ExitCode;
 
@@ -36,6 +37,8 @@ enum Command {
     Compare(compare::Args),
     /// Error against run time of several methods, and their speed-up over path tracing.
     Converge(converge::Args),
+    /// Run the paper's experiments end to end and write report.md.
+    Reproduce(reproduce::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -45,6 +48,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Beam(args) => beam::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Converge(args) => converge::run(args),
+        Command::Reproduce(args) => reproduce::run(args),
     }
 }
 

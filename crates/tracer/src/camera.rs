@@ -168,6 +168,18 @@ impl Camera {
         }
     }
 
+    /// The same camera with another resolution (the view itself is unchanged; a perspective
+    /// camera keeps its vertical field of view).
+    pub fn with_resolution(&self, width: u32, height: u32) -> Result<Camera, CameraError> {
+        check_resolution(width, height)?;
+        let mut c = self.clone();
+        match &mut c {
+            Camera::Perspective(p) => (p.width, p.height) = (width, height),
+            Camera::Orthographic(o) => (o.width, o.height) = (width, height),
+        }
+        Ok(c)
+    }
+
     /// The primary ray through film position `(film_x, film_y)` (pixels, see the module docs).
     #[inline]
     pub fn ray(&self, film_x: f64, film_y: f64) -> Ray {

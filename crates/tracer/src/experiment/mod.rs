@@ -4,5 +4,7 @@
 pub mod beam;
 pub mod converge;
 pub mod metrics;
+pub mod reproduce;
 pub mod run;
+pub mod scenes;
 pub mod study;

@@ -1,0 +1,69 @@
+//! `het-bssrdf reproduce`: the paper's experiments end to end, summarised in `report.md`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use tracer::experiment::reproduce::{Scale, reproduce};
+
+/// How much work to do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ScaleArg {
+    /// A few seconds (used by the tests).
+    Tiny,
+    /// About 5 minutes on 2 cores.
+    Quick,
+    /// The full run (about 45 minutes on 2 cores).
+    Full,
+}
+
+/// Arguments of `het-bssrdf reproduce`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Shorthand for `--scale quick`.
+    #[arg(long, conflicts_with = "scale")]
+    quick: bool,
+    /// How much work to do (default full).
+    #[arg(long, value_enum)]
+    scale: Option<ScaleArg>,
+    /// Output directory (created if missing).
+    #[arg(long, default_value = "reproduce-out")]
+    out: PathBuf,
+    /// Seed of the runs (references use a different one).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+/// Runs the subcommand.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let scale = match (args.quick, args.scale) {
+        (true, _) | (false, Some(ScaleArg::Quick)) => Scale::QUICK,
+        (false, Some(ScaleArg::Tiny)) => Scale::TINY,
+        (false, Some(ScaleArg::Full)) | (false, None) => Scale::FULL,
+    };
+    eprintln!(
+        "reproduce ({} scale): expected time {}; writing into {}",
+        scale.name,
+        scale.expected,
+        args.out.display()
+    );
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    let start = Instant::now();
+    let mut step = |msg: &str| {
+        bar.set_message(format!("[{:>5.0} s] {msg}", start.elapsed().as_secs_f64()));
+        if !bar.is_hidden() {
+            return;
+        }
+        eprintln!("[{:>5.0} s] {msg}", start.elapsed().as_secs_f64());
+    };
+    let report = reproduce(&args.out, &scale, args.seed, &mut step)
+        .with_context(|| format!("reproduce into `{}` failed", args.out.display()))?;
+    bar.finish_and_clear();
+    eprintln!(
+        "done in {:.0} s; report: {}",
+        start.elapsed().as_secs_f64(),
+        report.display()
+    );
+    Ok(())
+}
