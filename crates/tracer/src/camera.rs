@@ -172,7 +172,7 @@ impl Camera {
     /// camera keeps its vertical field of view).
     pub fn with_resolution(&self, width: u32, height: u32) -> Result<Camera, CameraError> {
         check_resolution(width, height)?;
-        let mut c = self.clone();
+        let mut c = *self;
         match &mut c {
             Camera::Perspective(p) => (p.width, p.height) = (width, height),
             Camera::Orthographic(o) => (o.width, o.height) = (width, height),
