@@ -14,21 +14,28 @@
 //!   σa 0.005 / 0.1, σs 1), x_i at the origin and x_o uniform in the paper's plot region
 //!   [−15, 15]² (the beam experiment);
 //! * `plane-constant`: the same pairs over a constant field (the short-circuit: every estimator
-//!   should cost about the same as a point lookup, or less).
+//!   should cost about the same as a point lookup, or less);
+//! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
+//!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
+//!   pairs of surface points at most 8 apart: every projection is two BVH rays.
 //!
-//! To add a scene (e.g. the tracer's BVH mesh once it exists), build its surface, field and
-//! pairs and call [`bench_scene`] and [`print_std_table`] with them; nothing else changes.
+//! To add a scene, build its surface, field and pairs and call [`bench_scene`] and
+//! [`print_std_table`] with them; nothing else changes.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use glam::DVec3;
+use het_bssrdf::bssrdf_core::Rgb;
 use het_bssrdf::het_estimate::analytic::{ConstantField, Plane, PlanePoint, StripeField};
 use het_bssrdf::het_estimate::pattern::Stripe;
 use het_bssrdf::het_estimate::{
     CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams, SplitMix64,
     SurfaceQuery, UniformSource,
 };
+use het_bssrdf::tracer::field::{Field, MediumField, PlanarProjection};
+use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives};
 
 /// Sample counts benchmarked (per averaging stage: Sone uses N for the disk and N for the
 /// ellipse).
@@ -176,6 +183,42 @@ fn print_std_table<S, F>(
     println!();
 }
 
+/// The BVH-mesh scene: sphere, stripe field, pairs of nearby surface points.
+fn mesh_scene() -> (Geometry, MediumField, Vec<(Hit, Hit)>) {
+    let geometry = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 10.0, 6)]);
+    let stripe = Field::stripe(
+        4.0,
+        std::f64::consts::FRAC_PI_4,
+        [Rgb::splat(0.005), Rgb::splat(0.1)],
+        PlanarProjection::default(),
+    )
+    .expect("valid stripe");
+    let field = MediumField::new(stripe, Field::constant(Rgb::ONE).expect("valid constant"));
+    let mut rng = SplitMix64::new(3);
+    let on_sphere = |rng: &mut SplitMix64, around: Option<DVec3>| loop {
+        let d = DVec3::new(
+            rng.next_f64() - 0.5,
+            rng.next_f64() - 0.5,
+            rng.next_f64() - 0.5,
+        );
+        let d = match around {
+            Some(a) => (a + 0.8 * d).normalize(),
+            None => d.normalize(),
+        };
+        if let Some(h) = geometry.intersect(&Ray::new(DVec3::ZERO, d)) {
+            return h;
+        }
+    };
+    let pairs = (0..1024)
+        .map(|_| {
+            let x_i = on_sphere(&mut rng, None);
+            let x_o = on_sphere(&mut rng, Some(x_i.p / 10.0));
+            (x_i, x_o)
+        })
+        .collect();
+    (geometry, field, pairs)
+}
+
 fn averaging(c: &mut Criterion) {
     let pairs = beam_pairs(1024, 1);
     let stripe = stripe_preset();
@@ -183,6 +226,10 @@ fn averaging(c: &mut Criterion) {
     bench_scene(c, "plane-stripe", &Plane, &stripe, &pairs);
     let constant = ConstantField(Coefficients::grey(0.05, 1.0));
     bench_scene(c, "plane-constant", &Plane, &constant, &pairs);
+    let (geometry, field, mesh_pairs) = mesh_scene();
+    let surface = ObjectSurface::new(&geometry, 0);
+    print_std_table("mesh-stripe", &surface, &field, &mesh_pairs[..64], 64);
+    bench_scene(c, "mesh-stripe", &surface, &field, &mesh_pairs);
 }
 
 criterion_group!(benches, averaging);
