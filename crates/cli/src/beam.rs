@@ -45,25 +45,25 @@ pub struct SetupArgs {
     #[arg(long, value_enum, default_value = "const")]
     pub texture: TextureKind,
     /// σa value(s): `A` for const, `A,B` for stripe and check (1/length, ≥ 0).
-    #[arg(long, value_delimiter = ',', default_values_t = [0.01])]
+    #[arg(long, value_delimiter = ',', default_values_t = [0.01], allow_hyphen_values = true)]
     pub values: Vec<f64>,
     /// Stripe or check width (length).
-    #[arg(long, default_value_t = 4.0)]
+    #[arg(long, default_value_t = 4.0, allow_hyphen_values = true)]
     pub width: f64,
     /// Stripe orientation in degrees.
     #[arg(long, default_value_t = 45.0, allow_hyphen_values = true)]
     pub angle: f64,
     /// Constant σs (1/length).
-    #[arg(long = "sigma-s", default_value_t = 1.0)]
+    #[arg(long = "sigma-s", default_value_t = 1.0, allow_hyphen_values = true)]
     pub sigma_s: f64,
     /// Henyey–Greenstein g.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub g: f64,
     /// Half-width E of the mapped square [−E, E]².
-    #[arg(long, default_value_t = 15.0)]
+    #[arg(long, default_value_t = 15.0, allow_hyphen_values = true)]
     pub extent: f64,
     /// N: the map is N × N pixels.
-    #[arg(long, value_parser = parse_positive, default_value_t = 120)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 120, allow_hyphen_values = true)]
     pub resolution: u64,
     /// Scattering orders: multiple (the paper), single or all.
     #[arg(long, default_value = "multiple")]
@@ -159,17 +159,21 @@ pub struct Args {
     /// Profile model for BSSRDF methods.
     #[arg(long, default_value = "dipole")]
     profile: ProfileModel,
+    /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
+    /// segment; 16 in the disk and 32 in the ellipse for Sone).
+    #[arg(long, value_parser = parse_positive)]
+    estimator_samples: Option<u64>,
     /// Photons for `pt` (rounded up to batches of 8192).
-    #[arg(long, value_parser = parse_positive, conflicts_with = "time")]
+    #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     photons: Option<u64>,
     /// Time budget in seconds for `pt` instead of a photon count.
-    #[arg(long, value_parser = parse_seconds)]
+    #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     time: Option<Duration>,
     /// BSSRDF methods: K×K stratified points x_o per pixel.
-    #[arg(long, value_parser = parse_positive, default_value_t = 4)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 4, allow_hyphen_values = true)]
     subsamples: u64,
     /// Seed.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
     #[arg(long)]

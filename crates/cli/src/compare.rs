@@ -18,7 +18,7 @@ pub struct Args {
     /// Ignore pixels whose centres are closer than R (scene units) to the map centre (beam
     /// maps: r < 1 is dominated by the singular peak). Needs the map extent, read from the
     /// JSON sidecar that `het-bssrdf beam` writes beside the reference.
-    #[arg(long = "min-radius")]
+    #[arg(long = "min-radius", allow_hyphen_values = true)]
     min_radius: Option<f64>,
     /// Print the metrics as JSON.
     #[arg(long)]
@@ -46,8 +46,8 @@ fn extent_of(exr: &Path) -> anyhow::Result<f64> {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let test = read_exr(&args.test)?;
-    let reference = read_exr(&args.reference)?;
+    let test = read_exr(&args.test).context("the image under test (first argument)")?;
+    let reference = read_exr(&args.reference).context("the reference (second argument)")?;
     let exclusion = match args.min_radius {
         None => None,
         Some(r) if r.is_finite() && r >= 0.0 => Some((r, extent_of(&args.reference)?)),

@@ -3,7 +3,7 @@
 //! `convergence.csv`, `convergence.png` (+ `.svg`), `summary.json` with the speed-up of each
 //! BSSRDF method over path tracing, and the largest run of every method as an image.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
@@ -37,30 +37,33 @@ pub struct Args {
     /// Profile model of the BSSRDF methods (scene: default each material's).
     #[arg(long)]
     profile: Option<ProfileModel>,
+    /// Averaging samples per region of the segment and Sone estimators.
+    #[arg(long, value_parser = parse_positive)]
+    estimator_samples: Option<u64>,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene, cached beside
     /// it with its spp and seed in the name) or `--reference-photons` (beam, in --out).
     #[arg(long)]
     reference: Option<PathBuf>,
     /// Samples per pixel of the rendered reference.
-    #[arg(long, value_parser = parse_positive, default_value_t = 1024)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 1024, allow_hyphen_values = true)]
     reference_spp: u64,
     /// Largest spp of the scene runs (doubling from 1).
-    #[arg(long, value_parser = parse_positive, default_value_t = 64)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 64, allow_hyphen_values = true)]
     max_spp: u64,
     /// Beam: photons of the rendered reference.
-    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 24)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 24, allow_hyphen_values = true)]
     reference_photons: u64,
     /// Beam: largest photon count of the `pt` runs (doubling from 2^16).
-    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 22)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 1 << 22, allow_hyphen_values = true)]
     max_photons: u64,
     /// Beam: largest K of the BSSRDF runs (K × K points per pixel, doubling from 1).
-    #[arg(long, value_parser = parse_positive, default_value_t = 4)]
+    #[arg(long, value_parser = parse_positive, default_value_t = 4, allow_hyphen_values = true)]
     max_subsamples: u64,
     /// Beam: ignore pixels closer than R to the beam (the singular peak).
-    #[arg(long = "min-radius", default_value_t = 1.0)]
+    #[arg(long = "min-radius", default_value_t = 1.0, allow_hyphen_values = true)]
     min_radius: f64,
     /// Seed of the runs (the reference uses a different one).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output directory (created if missing).
     #[arg(long)]
@@ -108,9 +111,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         };
         PathBuf::from(format!("converge-{stem}"))
     });
-    std::fs::create_dir_all(&out)
-        .with_context(|| format!("cannot create the output directory `{}`", out.display()))?;
-    check_dir(&out)?;
     if args.beam {
         run_beam(&args, &out)
     } else {
@@ -118,15 +118,30 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
 }
 
-fn run_scene(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
+/// Creates the output directory and checks that it accepts files. Called once the inputs have
+/// been read and validated, so that a bad input leaves nothing behind, and before any long run.
+fn prepare_out(out: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out).with_context(|| {
+        format!(
+            "invalid --out: cannot create the output directory `{}`",
+            out.display()
+        )
+    })?;
+    check_dir(out).context("invalid --out")?;
+    Ok(())
+}
+
+fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
     let file = args
         .scene
         .as_ref()
         .expect("clap requires a scene without --beam");
     let scene = Scene::load(file)?;
     let base = RenderJob::from_scene(&scene, Method::PathTraced);
-    let reference = match &args.reference {
-        Some(r) => read_exr(r)?,
+    let given = args.reference.as_deref().map(read_exr).transpose()?;
+    prepare_out(out)?;
+    let reference = match given {
+        Some(film) => film,
         None => {
             let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
             let cache = reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
@@ -194,14 +209,13 @@ fn run_scene(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run_beam(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
+fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     let setup = args.setup.setup()?;
     let profile = args.profile.unwrap_or(ProfileModel::Dipole);
-    let reference: Vec<f64> = match &args.reference {
-        Some(r) => {
-            let film = read_exr(r)?;
-            film.pixels.iter().map(|p| p[0]).collect()
-        }
+    let given = args.reference.as_deref().map(read_exr).transpose()?;
+    prepare_out(out)?;
+    let reference: Vec<f64> = match given {
+        Some(film) => film.pixels.iter().map(|p| p[0]).collect(),
         None => {
             let path = out.join(format!(
                 "reference-pt-{}photons.exr",
@@ -249,9 +263,17 @@ fn run_beam(args: &Args, out: &std::path::Path) -> anyhow::Result<()> {
         .sum();
     let bar = crate::common::progress(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
+    let samples = args
+        .estimator_samples
+        .map(|n| n.min(u32::MAX as u64) as u32);
+    let methods: Vec<Method> = args
+        .methods
+        .iter()
+        .map(|m| m.with_estimator_samples(samples))
+        .collect();
     let runs = beam_study(
         &setup,
-        &args.methods,
+        &methods,
         profile,
         &budgets,
         args.seed,

@@ -3,6 +3,9 @@
 //!
 //! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
 //! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap).
+//!
+//! Numeric flags accept values starting with `-`, so that `--photons -5` is reported as an
+//! invalid value of `--photons` rather than as an unknown argument `-5`.
 
 mod beam;
 mod common;
@@ -52,12 +55,31 @@ fn run(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// The error and its causes joined by `: `, outermost first, like `{err:#}`, except that a
+/// cause whose text the message already contains is skipped: the library's error types print
+/// their source in their own message (`cannot read `x`: No such file…`) and also return it
+/// from `source()`, which `{err:#}` would print a second time.
+fn message(err: &anyhow::Error) -> String {
+    let mut msg = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if msg.contains(&text) {
+            continue;
+        }
+        if !msg.is_empty() {
+            msg.push_str(": ");
+        }
+        msg.push_str(&text);
+    }
+    msg
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", message(&err));
             ExitCode::from(1)
         }
     }

@@ -25,21 +25,25 @@ pub struct Args {
     /// Profile model for BSSRDF methods (default: each material's, else dipole).
     #[arg(long)]
     profile: Option<ProfileModel>,
+    /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
+    /// segment; 16 in the disk and 32 in the ellipse for Sone).
+    #[arg(long, value_parser = parse_positive)]
+    estimator_samples: Option<u64>,
     /// Samples per pixel (default: the scene's `render.spp`).
-    #[arg(long, value_parser = parse_positive, conflicts_with = "time")]
+    #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     spp: Option<u64>,
     /// Time budget in seconds instead of a sample count (doubling passes while they fit).
-    #[arg(long, value_parser = parse_seconds)]
+    #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     time: Option<Duration>,
     /// Seed (default: the scene's `render.seed`).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     seed: Option<u64>,
     /// Scattering orders inside media: multiple, single or all (default: the scene's, else
     /// multiple, as in the paper).
     #[arg(long)]
     scattering: Option<Scattering>,
     /// Most surface interactions per path (default: the scene's, else 8).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     max_depth: Option<u64>,
     /// Output EXR (default: `<scene>-<method>.exr` in the current directory); the PNG preview
     /// and JSON sidecar are written beside it.
@@ -62,7 +66,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             None => "sone".parse().expect("built-in estimator name"),
         },
     }
-    .with_profile(args.profile);
+    .with_profile(args.profile)
+    .with_estimator_samples(
+        args.estimator_samples
+            .map(|n| n.min(u32::MAX as u64) as u32),
+    );
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);

@@ -30,7 +30,7 @@ pub struct Args {
     #[arg(long, default_value = "reproduce-out")]
     out: PathBuf,
     /// Seed of the runs (references use a different one).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
 }
 
@@ -41,6 +41,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (false, Some(ScaleArg::Tiny)) => Scale::TINY,
         (false, Some(ScaleArg::Full)) | (false, None) => Scale::FULL,
     };
+    // Fail now, not after the first experiments, if the output directory is unusable.
+    std::fs::create_dir_all(&args.out).with_context(|| {
+        format!(
+            "invalid --out: cannot create the output directory `{}`",
+            args.out.display()
+        )
+    })?;
+    tracer::experiment::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
+        .context("invalid --out")?;
     eprintln!(
         "reproduce ({} scale): expected time {}; writing into {}",
         scale.name,

@@ -46,6 +46,8 @@ pub struct MethodSummary {
     pub method: String,
     /// Relative L2 error at the largest budget.
     pub converged_error: f64,
+    /// Mean |log10(T/R)| at the largest budget (less dominated by the brightest pixels).
+    pub converged_mean_abs_log10: f64,
     /// Seconds of the first run within `CONVERGED_TOLERANCE` of the converged error.
     pub time_to_converge: f64,
     /// Seconds path tracing needs to reach the same error (None without path-tracing runs).
@@ -102,6 +104,7 @@ pub fn summarize(runs: &[Run]) -> Vec<MethodSummary> {
             let mut own: Vec<&Run> = runs.iter().filter(|r| r.method == m).collect();
             own.sort_by_key(|r| r.budget);
             let converged = own.last()?.metrics.rel_l2;
+            let converged_log = own.last()?.metrics.mean_abs_log10;
             let time = own
                 .iter()
                 .find(|r| r.metrics.rel_l2 <= CONVERGED_TOLERANCE * converged)
@@ -110,6 +113,7 @@ pub fn summarize(runs: &[Run]) -> Vec<MethodSummary> {
             Some(MethodSummary {
                 method: m.to_string(),
                 converged_error: converged,
+                converged_mean_abs_log10: converged_log,
                 time_to_converge: time,
                 pt_time_to_same_error: pt_time.map(|p| p.0),
                 pt_extrapolated: pt_time.is_some_and(|p| p.1),
@@ -176,16 +180,9 @@ pub fn write_outputs(
     Ok(())
 }
 
-/// Checks that `dir` exists and is a directory (before a long study).
+/// Checks that `dir` exists, is a directory and accepts new files (before a long study).
 pub fn check_dir(dir: &Path) -> Result<(), OutputError> {
-    if dir.is_dir() {
-        Ok(())
-    } else {
-        Err(OutputError::MissingDirectory {
-            path: dir.join("convergence.csv"),
-            dir: dir.to_path_buf(),
-        })
-    }
+    crate::experiment::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
 }
 
 #[cfg(test)]

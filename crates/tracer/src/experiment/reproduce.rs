@@ -428,15 +428,16 @@ fn error_table<'a>(rows: impl Iterator<Item = &'a ErrorRow>) -> String {
 
 fn summary_table(summary: &[MethodSummary]) -> String {
     let mut s = String::from(
-        "| method | converged rel. L2 | time (s) | PT time (s) | speed-up |\n|---|---:|---:|---:|---:|\n",
+        "| method | converged rel. L2 | mean abs log10 | time (s) | PT time (s) | speed-up |\n|---|---:|---:|---:|---:|---:|\n",
     );
     for m in summary {
         let star = if m.pt_extrapolated { "\\*" } else { "" };
         let _ = writeln!(
             s,
-            "| {} | {:.4} | {:.3} | {} | {} |",
+            "| {} | {:.4} | {:.4} | {:.3} | {} | {} |",
             m.method,
             m.converged_error,
+            m.converged_mean_abs_log10,
             m.time_to_converge,
             m.pt_time_to_same_error
                 .map(|t| format!("{t:.3}{star}"))

@@ -37,6 +37,30 @@ impl FromStr for Method {
 }
 
 impl Method {
+    /// The method with `n` averaging samples per region (segment: on the chord; Sone: in the
+    /// disk and in the ellipse); other methods are unchanged.
+    pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
+        let Some(n) = n else { return self };
+        let budget = het_estimate::SampleBudget::fixed(n.max(1));
+        match self {
+            Method::Bssrdf {
+                estimator: Estimator::Segment(p),
+                profile,
+            } => Method::Bssrdf {
+                estimator: Estimator::Segment(p.with_samples(budget)),
+                profile,
+            },
+            Method::Bssrdf {
+                estimator: Estimator::Sone(p),
+                profile,
+            } => Method::Bssrdf {
+                estimator: Estimator::Sone(p.with_samples(budget)),
+                profile,
+            },
+            m => m,
+        }
+    }
+
     /// The method with its profile model overridden (BSSRDF methods only).
     pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
         match self {
@@ -140,8 +164,8 @@ pub fn sidecar_paths(exr: &Path) -> (PathBuf, PathBuf) {
     (exr.with_extension("png"), exr.with_extension("json"))
 }
 
-/// Checks before a long run that `path` can be written: its directory exists and it is not
-/// itself a directory.
+/// Checks before a long run that `path` can be written: its directory exists and accepts new
+/// files (see [`check_dir_accepts_files`]), and `path` is not itself a directory.
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
     if path.is_dir() {
         return Err(OutputError::IsDirectory {
@@ -152,12 +176,36 @@ pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    check_dir_accepts_files(&dir, path)
+}
+
+/// Checks that `dir` exists and that a file can be created in it, by creating and removing an
+/// empty probe file (`.het-bssrdf-probe.<pid>.<n>`): a read-only or foreign directory fails
+/// here, before a long run, instead of when its results are written. `path` is the output the
+/// error names.
+pub fn check_dir_accepts_files(dir: &Path, path: &Path) -> Result<(), OutputError> {
+    static PROBE_COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     if !dir.is_dir() {
         return Err(OutputError::MissingDirectory {
             path: path.to_path_buf(),
-            dir,
+            dir: dir.to_path_buf(),
         });
     }
+    let probe = dir.join(format!(
+        ".het-bssrdf-probe.{}.{}",
+        std::process::id(),
+        PROBE_COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    std::fs::OpenOptions::new()
+        .write(true)
+        .create_new(true)
+        .open(&probe)
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            action: "create files in the directory of",
+            source,
+        })?;
+    let _ = std::fs::remove_file(&probe);
     Ok(())
 }
 
