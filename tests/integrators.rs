@@ -107,14 +107,15 @@ fn path_tracer_emergent_radiance_matches_chandrasekhar() {
 #[test]
 fn bssrdf_render_of_a_homogeneous_half_space_matches_the_profile_total() {
     // Under uniform normal irradiance E = 1 on an index-matched half-space, the BSSRDF renderer
-    // computes L = (1/π) ∫ R(r) E dA = ρ_tot/π, where ρ_tot is the profile's total. The probe
-    // only reaches r < r_max (99.9 % of the energy of the sampling profile), so the render may
-    // fall short by at most ~0.1 %.
+    // computes L = (1/π) ∫ R(r) E dA = ρ_tot/π, where ρ_tot is the profile's total, times the
+    // fraction of the energy inside the probe sphere (PROBE_ENERGY_FRACTION of the tabulated
+    // sampling profile, which approximates the exact one to well under 0.03 %).
     let (sigma_a, sigma_s) = (0.05, 1.0);
     let scene = half_space_scene(sigma_a, sigma_s, DVec3::Z, 1.0);
     for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
         let family = ProfileFamily::new(model, Scattering::Multiple, 0.0, 1.0).unwrap();
-        let want = family.profile(sigma_a, sigma_s).unwrap().total() / std::f64::consts::PI;
+        let want = family.profile(sigma_a, sigma_s).unwrap().total() / std::f64::consts::PI
+            * tracer::integrator::probe::PROBE_ENERGY_FRACTION;
         for name in ["jensen-out", "sone"] {
             let estimator: Estimator = name.parse().unwrap();
             let method = Method::Bssrdf {
@@ -122,7 +123,7 @@ fn bssrdf_render_of_a_homogeneous_half_space_matches_the_profile_total() {
                 profile: Some(model),
             };
             let (m, se) = mean_and_se(&scene, method, Scattering::Multiple, 64, 8);
-            let tol = 4.0 * se + 1.5e-3 * want;
+            let tol = 4.0 * se + 3e-4 * want;
             assert!(
                 (m - want).abs() < tol,
                 "{model} {name}: {m} ± {se}, predicted {want}"
