@@ -272,3 +272,91 @@ fn built_in_checker_slab_equals_the_example_file() {
         "crates/tracer/src/experiment/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
     );
 }
+
+#[test]
+fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
+    // On a flat surface only the normal-axis probe can hit (tangent chords run parallel to it,
+    // and the half-space is far deeper and wider than the probe sphere), so the distances of
+    // the hits from x_o must follow the sampling profile's radial density p_r truncated at
+    // r_max, and each hit's weight must be 2πr/p_r(r). 20 bins of equal expected probability
+    // (from the density, integrated independently by the midpoint rule); critical value of
+    // χ²(19) at the 0.001 level: 43.82.
+    use bssrdf_core::ProfileTable;
+    use tracer::geometry::Ray;
+    use tracer::integrator::probe::{PROBE_ENERGY_FRACTION, ProbeSampler, probe};
+    use tracer::rng::Rng;
+    let (sa, ss) = (0.05, 1.0);
+    let scene = half_space_scene(sa, ss, DVec3::Z, 1.0);
+    let Material::Translucent(t) = &scene.objects[0].material else {
+        unreachable!()
+    };
+    let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.0).unwrap();
+    let sampler = ProbeSampler::new(family, &t.medium);
+    let table = ProfileTable::new(family);
+    let radial = table.sampler(sa, ss).unwrap();
+    let r_max = radial.radius_for_fraction(PROBE_ENERGY_FRACTION);
+    let x_o = scene
+        .geometry
+        .intersect(&Ray::new(DVec3::new(0.3, -0.2, 1.0), DVec3::NEG_Z))
+        .unwrap();
+    // Equal-probability bin edges of p_r on [0, r_max], by a fine midpoint rule.
+    let fine = 200_000;
+    let dr = r_max / fine as f64;
+    let cum: Vec<f64> = std::iter::once(0.0)
+        .chain((0..fine).scan(0.0, |acc, k| {
+            *acc += radial.pdf_r((k as f64 + 0.5) * dr) * dr;
+            Some(*acc)
+        }))
+        .collect();
+    let total = *cum.last().unwrap();
+    assert!(
+        (total - PROBE_ENERGY_FRACTION).abs() < 1e-3,
+        "mass inside r_max: {total}"
+    );
+    let bins = 20;
+    let edges: Vec<f64> = (0..=bins)
+        .map(|k| cum.partition_point(|&c| c < total * k as f64 / bins as f64) as f64 * dr)
+        .collect();
+    let mut rng = Rng::from_keys(91, &[]);
+    let mut counts = vec![0u64; bins];
+    let n = 100_000;
+    for _ in 0..n {
+        let set = probe(
+            &scene.geometry,
+            0,
+            &x_o,
+            Coefficients::grey(sa, ss),
+            &sampler,
+            &mut rng,
+        );
+        assert!(
+            set.len() <= 1,
+            "a plane gives at most the normal probe's hit"
+        );
+        for h in set.iter() {
+            assert!(h.hit.ng.z > 0.99, "hit off the top face");
+            let r = (h.hit.p - x_o.p).length();
+            let want = std::f64::consts::TAU * r / radial.pdf_r(r);
+            assert!(
+                (h.weight / want - 1.0).abs() < 1e-6,
+                "weight {} vs 2πr/p_r = {want}",
+                h.weight
+            );
+            let k = edges.partition_point(|&e| e <= r).clamp(1, bins) - 1;
+            counts[k] += 1;
+        }
+    }
+    let hits: u64 = counts.iter().sum();
+    // Each call traces one probe per axis; the normal one hits whenever r < r_max (99.9 %).
+    let p_hit = hits as f64 / n as f64;
+    assert!(
+        (p_hit - 1.0).abs() < 4.0 * (PROBE_ENERGY_FRACTION * 0.001 / n as f64).sqrt() + 2e-3,
+        "{p_hit}"
+    );
+    let expected = hits as f64 / bins as f64;
+    let chi2: f64 = counts
+        .iter()
+        .map(|&o| (o as f64 - expected).powi(2) / expected)
+        .sum();
+    assert!(chi2 < 43.82, "chi2 = {chi2}, counts {counts:?}");
+}
