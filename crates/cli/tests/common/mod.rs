@@ -1,0 +1,282 @@
+//! Helpers shared by the CLI integration tests: running the built binary in a scratch
+//! directory, listing directories (hidden files included), and the scene and image fixtures.
+
+#![allow(dead_code)] // each test crate uses a different subset
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use bssrdf_core::Rgb;
+use tracer::film::Film;
+
+/// What one run of the binary did.
+#[derive(Debug)]
+pub struct Run {
+    /// Exit code (`None` when killed by a signal).
+    pub code: Option<i32>,
+    /// Standard output.
+    pub stdout: String,
+    /// Standard error.
+    pub stderr: String,
+}
+
+/// Runs `het-bssrdf args…` with `dir` as the working directory.
+pub fn run_in(dir: &Path, args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run het-bssrdf");
+    Run {
+        code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// Every path under `dir` (files and directories, hidden ones included: the atomic writers'
+/// temporary files start with a dot), relative to `dir`, sorted, directories marked `/`.
+pub fn listing(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).expect("read_dir") {
+            let p = e.expect("dir entry").path();
+            let rel = p.strip_prefix(root).unwrap().display().to_string();
+            // Do not follow links; descend into real directories only.
+            let meta = std::fs::symlink_metadata(&p).expect("metadata");
+            if meta.is_dir() {
+                out.push(format!("{rel}/"));
+                walk(root, &p, out);
+            } else {
+                out.push(rel);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// A scratch directory: the working directory of the runs, holding their inputs.
+pub struct Scratch {
+    dir: tempfile::TempDir,
+}
+
+impl Scratch {
+    /// An empty scratch directory.
+    pub fn new() -> Self {
+        Self {
+            dir: tempfile::tempdir().expect("tempdir"),
+        }
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// `path()/rel`.
+    pub fn join(&self, rel: &str) -> PathBuf {
+        self.dir.path().join(rel)
+    }
+
+    /// Writes `bytes` to `rel` (creating parent directories) and returns the full path.
+    pub fn write(&self, rel: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+        let p = self.join(rel);
+        if let Some(parent) = p.parent() {
+            std::fs::create_dir_all(parent).expect("create_dir_all");
+        }
+        std::fs::write(&p, bytes).expect("write input");
+        p
+    }
+
+    /// Runs the binary here.
+    pub fn run(&self, args: &[&str]) -> Run {
+        run_in(self.path(), args)
+    }
+
+    /// Runs `args`, which must be rejected: exit code `code` (1: a run-time error, 2: a usage
+    /// error from clap), no panic, the error line printed once without a repeated cause, every
+    /// `needle` in stderr, and nothing created, changed or left behind (temporary files
+    /// included) in the scratch directory. Returns stderr.
+    #[track_caller]
+    pub fn assert_rejected(&self, args: &[&str], code: i32, needles: &[&str]) -> String {
+        let before = snapshot(self.path());
+        let r = self.run(args);
+        let after = snapshot(self.path());
+        let what = format!("het-bssrdf {}", args.join(" "));
+        assert_eq!(
+            r.code,
+            Some(code),
+            "{what}: expected exit code {code}\nstderr:\n{}",
+            r.stderr
+        );
+        assert!(
+            !r.stderr.contains("panicked"),
+            "{what} panicked:\n{}",
+            r.stderr
+        );
+        for n in needles {
+            assert!(
+                r.stderr.contains(n),
+                "{what}: `{n}` missing from stderr:\n{}",
+                r.stderr
+            );
+        }
+        assert_no_repeated_cause(&r.stderr, &what);
+        let names = |v: &Snapshot| v.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>();
+        assert_eq!(
+            names(&before),
+            names(&after),
+            "{what} created or removed files in {}",
+            self.path().display()
+        );
+        for ((name, a), (_, b)) in before.iter().zip(&after) {
+            assert!(a == b, "{what} changed {name}");
+        }
+        r.stderr
+    }
+}
+
+/// A directory listing with each file's contents.
+type Snapshot = Vec<(String, Option<Vec<u8>>)>;
+
+/// The listing of `dir` with each file's contents, to detect created, removed or rewritten
+/// files.
+fn snapshot(dir: &Path) -> Snapshot {
+    listing(dir)
+        .into_iter()
+        .map(|rel| {
+            let p = dir.join(&rel);
+            let bytes = if rel.ends_with('/') {
+                None
+            } else {
+                std::fs::read(&p).ok()
+            };
+            (rel, bytes)
+        })
+        .collect()
+}
+
+/// The `error: …` line must not print the same cause twice in a row (`a: b: b`).
+#[track_caller]
+fn assert_no_repeated_cause(stderr: &str, what: &str) {
+    for line in stderr.lines().filter(|l| l.starts_with("error:")) {
+        let parts: Vec<&str> = line.split(": ").collect();
+        for w in parts.windows(2) {
+            assert!(w[0] != w[1], "{what}: repeated cause in `{line}`");
+        }
+    }
+}
+
+/// True when this process can write into a directory without write permission (root, or a
+/// container that ignores permissions); then read-only checks cannot be tested.
+pub fn permissions_ignored(dir: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    let probe_dir = dir.join(".perm-probe");
+    std::fs::create_dir(&probe_dir).unwrap();
+    std::fs::set_permissions(&probe_dir, std::fs::Permissions::from_mode(0o555)).unwrap();
+    let ignored = std::fs::write(probe_dir.join("x"), b"x").is_ok();
+    let _ = std::fs::remove_file(probe_dir.join("x"));
+    std::fs::set_permissions(&probe_dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    std::fs::remove_dir(&probe_dir).unwrap();
+    ignored
+}
+
+/// A small valid scene: an index-matched translucent box lit from above, seen by an
+/// orthographic camera, 8 × 8 pixels at 1 spp.
+pub const MINIMAL: &str = r#"[render]
+width = 8
+height = 8
+spp = 1
+
+[camera]
+type = "orthographic"
+centre = [0.0, 0.0, 5.0]
+direction = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+width = 10.0
+height = 10.0
+
+[[material]]
+name = "m"
+type = "translucent"
+sigma_a = 0.1
+sigma_s = 1.0
+
+[[light]]
+type = "directional"
+direction = [0.0, 0.0, -1.0]
+irradiance = 1.0
+
+[[shape]]
+type = "box"
+material = "m"
+min = [-1.0, -1.0, -1.0]
+max = [1.0, 1.0, 0.0]
+"#;
+
+/// `text` with `from` replaced by `to`; panics if `from` is absent (so that a test can never
+/// silently run the unmodified scene).
+#[track_caller]
+pub fn edit(text: &str, from: &str, to: &str) -> String {
+    assert!(text.contains(from), "`{from}` not found in the scene");
+    text.replacen(from, to, 1)
+}
+
+/// [`MINIMAL`] with its box replaced by an OBJ shape named `blob` reading `path`.
+pub fn with_obj(path: &str) -> String {
+    edit(
+        MINIMAL,
+        "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
+        &format!("type = \"obj\"\nname = \"blob\"\nmaterial = \"m\"\npath = \"{path}\""),
+    )
+}
+
+/// [`MINIMAL`] with σa read from the image `path` (texture `t`, planar, 2 × 2 units).
+pub fn with_texture(path: &str) -> String {
+    let s = edit(
+        MINIMAL,
+        "sigma_a = 0.1",
+        "sigma_a = { type = \"image\", texture = \"t\", size = [2.0, 2.0], scale = 0.1 }",
+    );
+    format!("{s}\n[[texture]]\nname = \"t\"\npath = \"{path}\"\n")
+}
+
+/// A unit cube as six quads (closed, outward-facing).
+pub const CUBE_OBJ: &str = "\
+o cube
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 4 8 7 3
+f 1 5 8 4
+f 2 3 7 6
+";
+
+/// A `w × h` film with a smooth positive gradient.
+pub fn gradient(w: u32, h: u32) -> Film {
+    let mut f = Film::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            f.set(
+                x,
+                y,
+                Rgb::new(
+                    0.1 + x as f64 / w as f64,
+                    0.2 + y as f64 / h as f64,
+                    0.3 + ((x * 7 + y * 13) % 17) as f64 / 17.0,
+                ),
+            );
+        }
+    }
+    f
+}
