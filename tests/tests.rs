@@ -1,6 +1,7 @@
 //! Workspace integration tests: one binary, one module per theme.
 
 mod common;
+mod fuzz_regressions;
 mod integrators;
 mod precision;
 mod stability;

@@ -79,9 +79,19 @@ impl Case {
             Shape::Cube => "cube",
             Shape::Sphere => "sphere",
         };
+        let short = |v: f64| {
+            if v == 0.0 || (1e-2..1e3).contains(&v) {
+                format!("{v}")
+            } else {
+                format!("{v:e}")
+            }
+        };
         format!(
-            "{shape}, σs = {:e}, σa = {:e}, η = {}, {}² px",
-            self.sigma_s, self.sigma_a, self.eta, self.resolution
+            "{shape}, σs = {}, σa = {}, η = {}, {}² px",
+            short(self.sigma_s),
+            short(self.sigma_a),
+            self.eta,
+            self.resolution
         )
     }
 
