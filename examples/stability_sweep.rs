@@ -152,7 +152,8 @@ fn document(report: &Report, stiff: &[(cube::Case, cube::Measurement)]) -> Strin
              at the origin, x_o at distance d (every d, 0 included) at 30°; Sone variants at \
              every g. Every channel of the estimate must be finite, ≥ 0 and inside the \
              field's bounds, and the Sone width finite and ≥ 0. The adaptive-budget Sone \
-             variant runs on a deterministic quarter of the pairs.",
+             variant runs on a deterministic quarter of the pairs. Evaluations count checked values: \
+             six per estimate (σa, σs × 3 channels).",
         ),
         (
             sweep::section::DEGENERATE,
@@ -162,7 +163,7 @@ fn document(report: &Report, stiff: &[(cube::Case, cube::Measurement)]) -> Strin
              (1e9 + 0.5, −1e9); chords along x, at 30° and along a boundary; normals +z, −z, \
              n_i ∥ chord (FHK14's modified normal undefined), n_i and n_o ∥ chord, opposite \
              normals, a 1e-300 normal and the zero vector (outside the trait's contract, \
-             swept anyway); every d.",
+             swept anyway); every d. Six checked values per estimate.",
         ),
     ];
     for (sec, heading) in headings {

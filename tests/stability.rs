@@ -36,8 +36,8 @@ fn sweep_finds_no_nan_inf_or_negative_value() {
     assert_clean(&report);
 }
 
-/// The full sweep (what `examples/stability_sweep.rs` runs; ~25 s in the test profile on 2
-/// cores): `cargo test --release --test tests stability::full_sweep -- --ignored --nocapture`.
+/// The full sweep (what `examples/stability_sweep.rs` runs; ~30 s in the test profile on 2
+/// busy cores, ~16 s in release): `cargo test --release --test tests stability::full_sweep -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn full_sweep_finds_no_nan_inf_or_negative_value() {
