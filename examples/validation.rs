@@ -14,81 +14,15 @@
 #[path = "../tests/common/chandrasekhar.rs"]
 #[allow(dead_code)]
 mod chandrasekhar;
+#[path = "../tests/common/half_space.rs"]
+mod half_space;
 
-use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
 use glam::DVec3;
-use het_bssrdf::het_estimate;
 use het_bssrdf::{bssrdf_core, tracer};
-use het_estimate::Coefficients;
-use tracer::camera::Camera;
 use tracer::experiment::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
-use tracer::field::MediumField;
-use tracer::geometry::primitives;
+use tracer::integrator::Method;
 use tracer::integrator::probe::PROBE_ENERGY_FRACTION;
-use tracer::integrator::{Method, PathIntegrator, PathOptions};
-use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, render};
-use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
-
-fn half_space(sigma_a: f64, sigma_s: f64, light_to: DVec3) -> Scene {
-    let camera = Camera::orthographic(
-        DVec3::new(0.0, 0.0, 1.0),
-        DVec3::NEG_Z,
-        DVec3::Y,
-        0.5,
-        0.5,
-        4,
-        4,
-    )
-    .unwrap();
-    let medium = MediumField::homogeneous(Coefficients::grey(sigma_a, sigma_s)).unwrap();
-    SceneBuilder::new(RenderSettings::new(4, 4, 1), camera)
-        .light(Light::directional(-light_to.normalize(), Rgb::ONE).unwrap())
-        .object(
-            "half-space",
-            primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
-            Material::Translucent(Translucent::new("m", medium, 0.0, 1.0)),
-        )
-        .build()
-        .unwrap()
-}
-
-fn mean_se(
-    scene: &Scene,
-    method: Method,
-    scattering: Scattering,
-    spp: u32,
-    seeds: u64,
-) -> (f64, f64) {
-    let integrator = PathIntegrator::new(
-        scene,
-        method,
-        PathOptions {
-            scattering,
-            max_depth: 8,
-        },
-    )
-    .unwrap();
-    let v: Vec<f64> = (0..seeds)
-        .map(|s| {
-            let r = render(
-                4,
-                4,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(spp),
-                    seed: 500 + s,
-                    progress: false,
-                    label: String::new(),
-                },
-            );
-            r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
-        })
-        .collect();
-    let m = v.iter().sum::<f64>() / v.len() as f64;
-    let var = v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (v.len() - 1) as f64;
-    (m, (var / v.len() as f64).sqrt())
-}
 
 fn row(name: &str, got: (f64, f64), want: f64) {
     let z = (got.0 - want) / got.1;
@@ -130,7 +64,7 @@ fn main() {
     println!("\n## Camera path tracer: radiance toward the normal, directional light\n");
     println!("| case | measured ± 1 SE | exact | z |\n|---|---:|---:|---:|");
     for (omega, light) in [(0.9, DVec3::Z), (0.99, DVec3::new(0.6, 0.0, 0.8))] {
-        let scene = half_space(1.0 - omega, omega, light);
+        let scene = half_space::half_space_scene(1.0 - omega, omega, light, 1.0);
         let mu0 = light.normalize().z;
         let (all, single) = chandrasekhar::emergent_radiance(omega, 1.0, mu0);
         for (s, want) in [
@@ -140,7 +74,7 @@ fn main() {
         ] {
             row(
                 &format!("ϖ = {omega}, μ0 = {mu0}, {s}"),
-                mean_se(&scene, Method::PathTraced, s, 1024, 16),
+                half_space::mean_and_se(&scene, Method::PathTraced, s, 1024, 16),
                 want,
             );
         }
@@ -151,7 +85,7 @@ fn main() {
          ({PROBE_ENERGY_FRACTION}; the truncation is by design, as pbrt's r_max).\n"
     );
     println!("| case | measured ± 1 SE | expected | z |\n|---|---:|---:|---:|");
-    let scene = half_space(0.05, 1.0, DVec3::Z);
+    let scene = half_space::half_space_scene(0.05, 1.0, DVec3::Z, 1.0);
     for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
         let family = ProfileFamily::new(model, Scattering::Multiple, 0.0, 1.0).unwrap();
         let want = family.profile(0.05, 1.0).unwrap().total() / std::f64::consts::PI
@@ -163,7 +97,7 @@ fn main() {
             };
             row(
                 &format!("{model}, {est}"),
-                mean_se(&scene, method, Scattering::Multiple, 256, 16),
+                half_space::mean_and_se(&scene, method, Scattering::Multiple, 256, 16),
                 want,
             );
         }

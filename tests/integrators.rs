@@ -2,84 +2,18 @@
 //! radiance from a half-space (Chandrasekhar), the BSSRDF renderer against its own profile's
 //! analytic prediction, determinism across thread counts, and the probe sampler's density.
 
-use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
 use glam::DVec3;
 use het_estimate::{Coefficients, Estimator};
 use tracer::camera::Camera;
 use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
-use tracer::light::Light;
 use tracer::render::{Budget, RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
-
-/// A huge index-matched half-space (top z = 0) seen from above over a small central patch,
-/// lit by a directional light travelling along `-light_to` (unit irradiance).
-fn half_space_scene(sigma_a: f64, sigma_s: f64, light_to: DVec3, eta: f64) -> Scene {
-    let n = 4;
-    let camera = Camera::orthographic(
-        DVec3::new(0.0, 0.0, 1.0),
-        DVec3::NEG_Z,
-        DVec3::Y,
-        0.5,
-        0.5,
-        n,
-        n,
-    )
-    .unwrap();
-    let medium = MediumField::homogeneous(Coefficients::grey(sigma_a, sigma_s)).unwrap();
-    SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
-        .light(Light::directional(-light_to.normalize(), Rgb::ONE).unwrap())
-        .object(
-            "half-space",
-            primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
-            Material::Translucent(Translucent::new("m", medium, 0.0, eta)),
-        )
-        .build()
-        .unwrap()
-}
-
-/// Mean image value and its standard error from `seeds` independent renders.
-fn mean_and_se(
-    scene: &Scene,
-    method: Method,
-    scattering: Scattering,
-    spp: u32,
-    seeds: u64,
-) -> (f64, f64) {
-    let integrator = PathIntegrator::new(
-        scene,
-        method,
-        PathOptions {
-            scattering,
-            max_depth: 8,
-        },
-    )
-    .unwrap();
-    let (w, h) = scene.camera.resolution();
-    let means: Vec<f64> = (0..seeds)
-        .map(|seed| {
-            let r = render(
-                w,
-                h,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(spp),
-                    seed: 1000 + seed,
-                    progress: false,
-                    label: String::new(),
-                },
-            );
-            assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);
-            r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
-        })
-        .collect();
-    let m = means.iter().sum::<f64>() / seeds as f64;
-    let var = means.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (seeds - 1) as f64;
-    (m, (var / seeds as f64).sqrt())
-}
+use crate::common::half_space::{half_space_scene, mean_and_se};
 
 #[test]
 fn path_tracer_emergent_radiance_matches_chandrasekhar() {

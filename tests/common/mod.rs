@@ -1,3 +1,4 @@
 //! Independent reference computations for the workspace tests (never the code under test).
 
 pub mod chandrasekhar;
+pub mod half_space;

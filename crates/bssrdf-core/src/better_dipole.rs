@@ -32,9 +32,8 @@
 //! Finite at `r = 0`; `r⁻³` tail at `σa = 0`; zero profile for `σs' = 0`. Radius sampling
 //! inverts the closed-form CDF, so `pdf_r = 2πr R / R_tot` exactly.
 
-use crate::dipole_pair::DipolePair;
+use crate::dipole_pair::{DipolePair, radial_profile_from_pair};
 use crate::fresnel::FresnelMoments;
-use crate::profile::{RadialProfile, clean_f, clean_u, optical};
 
 /// The better-dipole profile for one set of coefficients.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,22 +73,4 @@ impl BetterDipole {
     }
 }
 
-impl RadialProfile for BetterDipole {
-    fn eval(&self, r: f64) -> f64 {
-        let x = optical(r, self.scale);
-        self.scale * self.scale * self.pair.eval(x)
-    }
-    fn total(&self) -> f64 {
-        self.pair.total()
-    }
-    fn sample_r(&self, u: f64) -> Option<f64> {
-        let u = clean_u(u)?;
-        (self.pair.total() > 0.0).then(|| self.pair.quantile(u) / self.scale)
-    }
-    fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.pair.pdf(optical(r, self.scale))
-    }
-    fn radius_for_fraction(&self, f: f64) -> f64 {
-        self.pair.quantile(clean_f(f)) / self.scale
-    }
-}
+radial_profile_from_pair!(BetterDipole);

@@ -26,8 +26,7 @@
 //! zero profile (handled by [`crate::family::ProfileFamily::profile`]).
 //! Radius sampling inverts the closed-form CDF, so `pdf_r = 2πr R_d / R_d,tot` exactly.
 
-use crate::dipole_pair::DipolePair;
-use crate::profile::{RadialProfile, clean_f, clean_u, optical};
+use crate::dipole_pair::{DipolePair, radial_profile_from_pair};
 
 /// The classical dipole profile for one set of coefficients (construct through
 /// [`crate::family::ProfileFamily::profile`], or [`Dipole::new`]).
@@ -70,22 +69,4 @@ impl Dipole {
     }
 }
 
-impl RadialProfile for Dipole {
-    fn eval(&self, r: f64) -> f64 {
-        let x = optical(r, self.scale);
-        self.scale * self.scale * self.pair.eval(x)
-    }
-    fn total(&self) -> f64 {
-        self.pair.total()
-    }
-    fn sample_r(&self, u: f64) -> Option<f64> {
-        let u = clean_u(u)?;
-        (self.pair.total() > 0.0).then(|| self.pair.quantile(u) / self.scale)
-    }
-    fn pdf_r(&self, r: f64) -> f64 {
-        self.scale * self.pair.pdf(optical(r, self.scale))
-    }
-    fn radius_for_fraction(&self, f: f64) -> f64 {
-        self.pair.quantile(clean_f(f)) / self.scale
-    }
-}
+radial_profile_from_pair!(Dipole);

@@ -18,6 +18,35 @@
 //! far-field cancellation (notes §7); `(1 − e^{−σΔ})/σ` has the finite limit `Δ` at `σ = 0`.
 
 use crate::profile::{TWO_PI, invert_survival, one_minus_exp_over};
+
+/// Implements [`crate::RadialProfile`] for a model that is a [`DipolePair`] in optical units
+/// (field `pair`) scaled to scene units by `scale` (σ of the optical unit): the scaling law
+/// `R(r) = scale² R₁(scale·r)` of notes §0, with exact sampling by inverting the survival
+/// function.
+macro_rules! radial_profile_from_pair {
+    ($model:ty) => {
+        impl $crate::profile::RadialProfile for $model {
+            fn eval(&self, r: f64) -> f64 {
+                let x = $crate::profile::optical(r, self.scale);
+                self.scale * self.scale * self.pair.eval(x)
+            }
+            fn total(&self) -> f64 {
+                self.pair.total()
+            }
+            fn sample_r(&self, u: f64) -> Option<f64> {
+                let u = $crate::profile::clean_u(u)?;
+                (self.pair.total() > 0.0).then(|| self.pair.quantile(u) / self.scale)
+            }
+            fn pdf_r(&self, r: f64) -> f64 {
+                self.scale * self.pair.pdf($crate::profile::optical(r, self.scale))
+            }
+            fn radius_for_fraction(&self, f: f64) -> f64 {
+                self.pair.quantile($crate::profile::clean_f(f)) / self.scale
+            }
+        }
+    };
+}
+pub(crate) use radial_profile_from_pair;
 use std::f64::consts::PI;
 
 /// A real/image source pair in optical units (lengths in units of a model-chosen mean free

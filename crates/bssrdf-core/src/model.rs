@@ -52,22 +52,29 @@ pub struct UnknownName {
     pub expected: String,
 }
 
+impl UnknownName {
+    /// The element of `all` whose `name` is `given`, or an error listing the accepted names.
+    pub fn find<T: Copy>(
+        given: &str,
+        what: &'static str,
+        all: &[T],
+        name: impl Fn(T) -> &'static str,
+    ) -> Result<T, UnknownName> {
+        all.iter()
+            .copied()
+            .find(|&m| name(m) == given)
+            .ok_or_else(|| UnknownName {
+                what,
+                given: given.to_string(),
+                expected: all.iter().map(|&m| name(m)).collect::<Vec<_>>().join(", "),
+            })
+    }
+}
+
 impl FromStr for ProfileModel {
     type Err = UnknownName;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| UnknownName {
-                what: "profile model",
-                given: s.to_string(),
-                expected: Self::ALL
-                    .iter()
-                    .map(|m| m.name())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        UnknownName::find(s, "profile model", Self::ALL, |m| m.name())
     }
 }
 
@@ -124,19 +131,7 @@ impl fmt::Display for Scattering {
 impl FromStr for Scattering {
     type Err = UnknownName;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| UnknownName {
-                what: "scattering selection",
-                given: s.to_string(),
-                expected: Self::ALL
-                    .iter()
-                    .map(|m| m.name())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+        UnknownName::find(s, "scattering selection", Self::ALL, |m| m.name())
     }
 }
 

@@ -16,19 +16,7 @@ pub trait Named: Copy + 'static {
 
 /// Parses one of `T::ALL` by exact name.
 pub(crate) fn parse_named<T: Named>(s: &str) -> Result<T, UnknownName> {
-    T::ALL
-        .iter()
-        .copied()
-        .find(|v| v.name() == s)
-        .ok_or_else(|| UnknownName {
-            what: T::WHAT,
-            given: s.to_string(),
-            expected: T::ALL
-                .iter()
-                .map(|v| v.name())
-                .collect::<Vec<_>>()
-                .join(", "),
-        })
+    UnknownName::find(s, T::WHAT, T::ALL, T::name)
 }
 
 /// Checks that `value` is finite and `>= 0`.

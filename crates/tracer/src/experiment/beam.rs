@@ -456,11 +456,7 @@ pub fn bssrdf_map(
                         continue;
                     };
                     let est = prepared.estimate(&surface, &t.medium, &x_i, &x_o, &mut rng);
-                    c.estimates += 1;
-                    c.estimator_samples += est.diagnostics.samples as u64;
-                    c.projection_misses += est.diagnostics.misses as u64;
-                    c.short_circuits += est.diagnostics.short_circuit as u64;
-                    c.estimator_fallbacks += est.diagnostics.fallback as u64;
+                    c.record_estimate(&est.diagnostics);
                     sum += eval_grey(&family, est.coefficients, (x_o.p - x_i.p).length());
                 }
                 *value = sum / (sub * sub) as f64;

@@ -41,6 +41,15 @@ pub struct PathCounters {
 }
 
 impl PathCounters {
+    /// Records one parameter estimate and its diagnostics.
+    pub fn record_estimate(&mut self, d: &het_estimate::Diagnostics) {
+        self.estimates += 1;
+        self.estimator_samples += d.samples as u64;
+        self.projection_misses += d.misses as u64;
+        self.short_circuits += d.short_circuit as u64;
+        self.estimator_fallbacks += d.fallback as u64;
+    }
+
     /// Adds tracking work.
     pub fn add_tracking(&mut self, t: &TrackingCounters) {
         self.delta_steps += t.delta_steps;

@@ -661,11 +661,7 @@ impl<'s> PathIntegrator<'s> {
             let est = b
                 .estimator
                 .estimate(&surface, &material.medium, &x_i, hit, rng);
-            counters.estimates += 1;
-            counters.estimator_samples += est.diagnostics.samples as u64;
-            counters.projection_misses += est.diagnostics.misses as u64;
-            counters.short_circuits += est.diagnostics.short_circuit as u64;
-            counters.estimator_fallbacks += est.diagnostics.fallback as u64;
+            counters.record_estimate(&est.diagnostics);
             let r = (x_i.p - hit.p).length();
             let c = est.coefficients;
             let mut rd = Rgb::ZERO;
