@@ -14,7 +14,6 @@ pub mod light;
 pub mod output;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod plot_or_output;
 pub mod render;
 pub mod rng;
 pub mod scene;

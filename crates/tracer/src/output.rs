@@ -211,6 +211,7 @@ pub fn write_grey_exr(
     }
 }
 
+#[cfg(feature = "exr")]
 fn check_size(width: u32, height: u32, n: usize, path: &Path) -> Result<(), OutputError> {
     if width == 0 || height == 0 || width as usize * height as usize != n {
         return Err(OutputError::Encode {
@@ -248,6 +249,7 @@ pub fn read_exr(path: &Path) -> Result<Film, OutputError> {
 
 /// Why an EXR could not be read.
 #[derive(Debug)]
+#[cfg_attr(not(feature = "exr"), allow(dead_code))]
 pub(crate) enum ExrReadError {
     Io(std::io::Error),
     Decode(String),

@@ -501,7 +501,7 @@ pub fn write_beam_map(
     setup: &BeamSetup,
     exr: &std::path::Path,
     extra: serde_json::Value,
-) -> Result<(), crate::plot_or_output::WriteError> {
+) -> Result<(), crate::error::WriteError> {
     let n = map.resolution;
     crate::output::write_grey_exr(n, n, &map.values, exr)?;
     #[cfg(feature = "plot")]

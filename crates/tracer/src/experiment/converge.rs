@@ -17,9 +17,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::error::OutputError;
+use crate::error::WriteError;
 use crate::experiment::metrics::Metrics;
 use crate::output::{write_atomic, write_json};
-use crate::plot_or_output::WriteError;
 
 /// A run counts as converged once its error is within this factor of the final error.
 pub const CONVERGED_TOLERANCE: f64 = 1.1;

@@ -10,6 +10,7 @@ use std::time::Instant;
 use bssrdf_core::{ProfileModel, Scattering};
 use serde::Serialize;
 
+use crate::error::WriteError;
 use crate::experiment::beam::{
     BeamMap, BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map,
 };
@@ -22,7 +23,6 @@ use crate::experiment::study::{
 };
 use crate::integrator::Method;
 use crate::output::{write_atomic, write_exr};
-use crate::plot_or_output::WriteError;
 use crate::render::Budget;
 use crate::scene::Scene;
 

@@ -12,7 +12,6 @@
 use std::path::Path;
 
 use crate::error::TextureError;
-use crate::output::srgb_decode;
 
 /// How lookups outside `[0, 1]²` behave.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -146,7 +145,11 @@ impl Texture {
                 let lut: Vec<f32> = (0..256)
                     .map(|i| {
                         let x = i as f64 / 255.0;
-                        (if linear { x } else { srgb_decode(x) }) as f32
+                        (if linear {
+                            x
+                        } else {
+                            crate::output::srgb_decode(x)
+                        }) as f32
                     })
                     .collect();
                 img.to_rgb8()
@@ -163,7 +166,11 @@ impl Texture {
                 .map(|p| {
                     p.0.map(|s| {
                         let x = s as f64 / 65535.0;
-                        (if linear { x } else { srgb_decode(x) }) as f32
+                        (if linear {
+                            x
+                        } else {
+                            crate::output::srgb_decode(x)
+                        }) as f32
                     })
                 })
                 .collect(),
