@@ -11,9 +11,9 @@ use tracer::experiment::reproduce::{Scale, reproduce};
 pub enum ScaleArg {
     /// A few seconds (used by the tests).
     Tiny,
-    /// About 5 minutes on 2 cores.
+    /// About 3 minutes on 2 cores.
     Quick,
-    /// The full run (about 45 minutes on 2 cores).
+    /// The full run (about 15 minutes on 2 cores).
     Full,
 }
 
