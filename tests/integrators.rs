@@ -294,3 +294,35 @@ fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
         .sum();
     assert!(chi2 < 43.82, "chi2 = {chi2}, counts {counts:?}");
 }
+
+#[test]
+fn path_tracer_warns_when_delta_lights_hide_behind_a_refractive_boundary() {
+    let pt = |scene: &Scene| {
+        PathIntegrator::new(
+            scene,
+            Method::PathTraced,
+            PathOptions {
+                scattering: Scattering::All,
+                max_depth: 4,
+            },
+        )
+        .unwrap()
+        .warnings()
+        .len()
+    };
+    // η = 1.3 and only a directional light: warned, naming the object.
+    let refractive = half_space_scene(0.1, 1.0, DVec3::Z, 1.3);
+    assert_eq!(pt(&refractive), 1);
+    // Index-matched: no warning; and the BSSRDF methods never warn.
+    assert_eq!(pt(&half_space_scene(0.1, 1.0, DVec3::Z, 1.0)), 0);
+    let sone = PathIntegrator::new(
+        &refractive,
+        "sone".parse().unwrap(),
+        PathOptions {
+            scattering: Scattering::All,
+            max_depth: 4,
+        },
+    )
+    .unwrap();
+    assert!(sone.warnings().is_empty());
+}

@@ -111,6 +111,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         png.display(),
         json.display()
     );
+    for w in &outcome.warnings {
+        eprintln!("warning: {w}");
+    }
     warn_counters(&outcome.counters);
     Ok(())
 }

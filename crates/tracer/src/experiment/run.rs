@@ -116,6 +116,8 @@ pub struct RenderOutcome {
     pub counters: PathCounters,
     /// The method's name.
     pub method: String,
+    /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// Renders `scene` with `job`.
@@ -156,6 +158,7 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         rays: scene.geometry.rays_traced() - rays_before,
         counters,
         method: job.method.name().to_string(),
+        warnings: integrator.warnings().to_vec(),
     })
 }
 

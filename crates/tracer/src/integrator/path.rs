@@ -165,6 +165,7 @@ pub struct PathIntegrator<'s> {
     objects: Vec<ObjectKind<'s>>,
     lights: LightSet,
     channels_grey: bool,
+    warnings: Vec<String>,
 }
 
 struct PathState {
@@ -248,6 +249,25 @@ impl<'s> PathIntegrator<'s> {
                 _ => ObjectKind::Opaque,
             });
         }
+        let mut warnings = Vec::new();
+        if method == Method::PathTraced {
+            let all_delta = scene
+                .lights
+                .iter()
+                .filter(|l| !matches!(l, Light::Beam(_)))
+                .all(|l| l.is_delta());
+            for (object, t) in scene.translucent_objects() {
+                if t.eta != 1.0 && all_delta {
+                    warnings.push(format!(
+                        "object `{}` has a refractive boundary (eta = {}) and every light is a \
+                         delta light (directional or point): a path tracer cannot connect to them \
+                         through the boundary, so light scattered inside is lost; use a quad or \
+                         environment light",
+                        scene.objects[object as usize].name, t.eta
+                    ));
+                }
+            }
+        }
         Ok(Self {
             scene,
             method,
@@ -255,7 +275,13 @@ impl<'s> PathIntegrator<'s> {
             objects,
             lights: LightSet::new(&scene.lights),
             channels_grey,
+            warnings,
         })
+    }
+
+    /// Things about the scene that make this method's image misleading (printed by the CLI).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// The method rendered.
