@@ -250,6 +250,7 @@ pub fn write_render(
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,
+        "warnings": outcome.warnings,
         "mean_rgb": outcome.film.mean().0,
     });
     write_json(&value, &json_path)
