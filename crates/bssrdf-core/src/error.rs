@@ -43,3 +43,22 @@ pub fn check_non_negative(name: &'static str, value: f64) -> Result<f64, ParamEr
     }
     Ok(value)
 }
+
+/// Checks a Henyey–Greenstein mean cosine: finite with `|g| < 1` (the phase function is 0/0 at
+/// `|g| = 1`).
+pub fn check_g(g: f64) -> Result<f64, ParamError> {
+    if !g.is_finite() {
+        return Err(ParamError::NotFinite {
+            name: "g",
+            value: g,
+        });
+    }
+    if g.abs() >= 1.0 {
+        return Err(ParamError::OutOfRange {
+            name: "g",
+            range: "(-1, 1)",
+            value: g,
+        });
+    }
+    Ok(g)
+}

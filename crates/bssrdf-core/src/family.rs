@@ -10,6 +10,7 @@ use crate::beam_diffusion::BeamDiffusionMs;
 use crate::better_dipole::BetterDipole;
 use crate::dipole::Dipole;
 use crate::directional_dipole::DirectionalDipole;
+use crate::error::check_g;
 use crate::error::{ParamError, check_non_negative};
 use crate::fresnel::{DiffuseFresnel, FresnelMoments};
 use crate::model::{ProfileModel, Scattering};
@@ -79,19 +80,7 @@ impl ProfileFamily {
         eta: f64,
         options: FamilyOptions,
     ) -> Result<Self, ParamError> {
-        if !g.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "g",
-                value: g,
-            });
-        }
-        if g.abs() >= 1.0 {
-            return Err(ParamError::OutOfRange {
-                name: "g",
-                range: "(-1, 1)",
-                value: g,
-            });
-        }
+        check_g(g)?;
         if !eta.is_finite() {
             return Err(ParamError::NotFinite {
                 name: "eta",

@@ -1,6 +1,7 @@
 //! Validated single-channel optical parameters of a homogeneous medium and the quantities
 //! derived from them.
 
+use crate::error::check_g;
 use crate::error::{ParamError, check_non_negative};
 
 /// Largest |g| accepted. The Henyey–Greenstein phase function is 0/0 at |g| = 1 and the
@@ -25,19 +26,7 @@ impl MediumParams {
     pub fn new(sigma_a: f64, sigma_s: f64, g: f64, eta: f64) -> Result<Self, ParamError> {
         check_non_negative("sigma_a", sigma_a)?;
         check_non_negative("sigma_s", sigma_s)?;
-        if !g.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "g",
-                value: g,
-            });
-        }
-        if g.abs() >= G_LIMIT {
-            return Err(ParamError::OutOfRange {
-                name: "g",
-                range: "(-1, 1)",
-                value: g,
-            });
-        }
+        check_g(g)?;
         if !eta.is_finite() {
             return Err(ParamError::NotFinite {
                 name: "eta",

@@ -36,6 +36,7 @@
 //! absurd case where w itself overflows).
 
 use bssrdf_core::ParamError;
+use bssrdf_core::error::check_g;
 use bssrdf_core::hg;
 
 use crate::names::{Named, check_non_negative};
@@ -53,19 +54,7 @@ pub enum MeanSquareAngle {
 impl MeanSquareAngle {
     /// ⟨θ²⟩ in rad² for the HG parameter `g`. Errors when `g` is not finite or `|g| ≥ 1`.
     pub fn evaluate(self, g: f64) -> Result<f64, ParamError> {
-        if !g.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "g",
-                value: g,
-            });
-        }
-        if g.abs() >= 1.0 {
-            return Err(ParamError::OutOfRange {
-                name: "g",
-                range: "(-1, 1)",
-                value: g,
-            });
-        }
+        check_g(g)?;
         Ok(match self {
             MeanSquareAngle::Exact => hg::mean_square_angle(g),
             MeanSquareAngle::SmallAngle => hg::mean_square_angle_small_angle(g),
