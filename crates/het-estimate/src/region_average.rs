@@ -224,6 +224,23 @@ where
         sanitise(self.field.coefficients(p))
     }
 
+    /// The chord x_i → x_o and its averaging-plane normal, recording the normal fallback in the
+    /// diagnostics; `None` (recorded as [`crate::Region::Endpoints`]) when x_i and x_o coincide,
+    /// in which case the caller returns [`Probe::endpoints`].
+    pub fn chord(&mut self) -> Option<crate::chord::Chord> {
+        let (x_i, x_o) = (self.x_i, self.x_o);
+        match crate::chord::Chord::new(x_i.position(), x_i.normal(), x_o.position(), x_o.normal()) {
+            Some(chord) => {
+                self.diag.normal_fallback = chord.normal_fallback;
+                Some(chord)
+            }
+            None => {
+                self.diag.region = crate::estimate::Region::Endpoints;
+                None
+            }
+        }
+    }
+
     /// ½(σ(x_i) + σ(x_o)), looked up once per pair (the d'Eon–Irving endpoint reading and the
     /// fallback of the region estimators).
     pub fn endpoints(&mut self) -> Coefficients {

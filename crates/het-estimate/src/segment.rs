@@ -4,14 +4,13 @@
 //! to be dEI11's rule (physics notes §4).
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::chord::Chord;
 use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::Known;
 use crate::region_average::{Probe, average};
 use crate::sampler::UniformSource;
 use crate::sampling::SegmentPoints;
-use crate::surface::{SurfacePoint, SurfaceQuery};
+use crate::surface::SurfaceQuery;
 use bssrdf_core::Rgb;
 
 /// Parameters of the `segment` estimator.
@@ -61,13 +60,10 @@ where
     F: CoefficientField<S::Point> + ?Sized,
     U: UniformSource + ?Sized,
 {
-    let (x_i, x_o) = (probe.x_i, probe.x_o);
-    let Some(chord) = Chord::new(x_i.position(), x_i.normal(), x_o.position(), x_o.normal()) else {
-        probe.diag.region = Region::Endpoints;
+    let Some(chord) = probe.chord() else {
         return probe.endpoints();
     };
     probe.diag.region = Region::Segment;
-    probe.diag.normal_fallback = chord.normal_fallback;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
     let averaged = average::<SegmentPoints, _>(params.samples, known.varying(), rng, |t, acc| {
         probe.project_and_add(chord.point(t), chord.normal, Rgb::ONE, miss_endpoints, acc)

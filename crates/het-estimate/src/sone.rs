@@ -35,7 +35,6 @@ use std::num::NonZeroU32;
 use bssrdf_core::Rgb;
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::chord::Chord;
 use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
@@ -43,7 +42,7 @@ use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::region_average::{Accumulator, Channels, Probe, average};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
-use crate::surface::{SurfacePoint, SurfaceQuery};
+use crate::surface::SurfaceQuery;
 
 /// Parameters of the `sone` estimator. Defaults follow the paper's reading
 /// ([`SoneParams::paper`]).
@@ -146,12 +145,9 @@ where
     F: CoefficientField<S::Point> + ?Sized,
     U: UniformSource + ?Sized,
 {
-    let (x_i, x_o) = (probe.x_i, probe.x_o);
-    let Some(chord) = Chord::new(x_i.position(), x_i.normal(), x_o.position(), x_o.normal()) else {
-        probe.diag.region = Region::Endpoints;
+    let Some(chord) = probe.chord() else {
         return probe.endpoints();
     };
-    probe.diag.normal_fallback = chord.normal_fallback;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
     let wanted: [bool; 3] = std::array::from_fn(|c| !known.channel_constant(c));
     let wanted_rgb = Rgb(wanted.map(|w| if w { 1.0 } else { 0.0 }));

@@ -154,15 +154,7 @@ pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
             (p[0] as f32, p[1] as f32, p[2] as f32)
         });
         let image = Image::from_channels((film.width as usize, film.height as usize), channels);
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        image
-            .write()
-            .to_buffered(&mut bytes)
-            .map_err(|e| OutputError::Encode {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?;
-        write_atomic(path, &bytes.into_inner())
+        encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
     {
@@ -191,15 +183,7 @@ pub fn write_grey_exr(
             .with_channel("Y")
             .with_pixel_fn(|Vec2(x, y): Vec2<usize>| (values[y * w + x] as f32,));
         let image = Image::from_channels((width as usize, height as usize), channels);
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        image
-            .write()
-            .to_buffered(&mut bytes)
-            .map_err(|e| OutputError::Encode {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })?;
-        write_atomic(path, &bytes.into_inner())
+        encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
     {
@@ -209,6 +193,20 @@ pub fn write_grey_exr(
             feature: "exr",
         })
     }
+}
+
+/// Encodes an EXR into memory with `write` and writes it atomically to `path`.
+#[cfg(feature = "exr")]
+fn encode_exr(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::Cursor<Vec<u8>>) -> exr::error::UnitResult,
+) -> Result<(), OutputError> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    write(&mut bytes).map_err(|e| OutputError::Encode {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    write_atomic(path, &bytes.into_inner())
 }
 
 #[cfg(feature = "exr")]
