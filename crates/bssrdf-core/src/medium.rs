@@ -4,14 +4,10 @@
 use crate::error::check_g;
 use crate::error::{ParamError, check_non_negative};
 
-/// Largest |g| accepted. The Henyey–Greenstein phase function is 0/0 at |g| = 1 and the
-/// reduced coefficients degenerate there (pbrt clamps likewise), so |g| must stay below 1.
-pub const G_LIMIT: f64 = 1.0;
-
 /// Optical parameters of one colour channel of a homogeneous medium.
 ///
 /// Invariants (checked by [`MediumParams::new`]): `sigma_a`, `sigma_s` finite and `>= 0`;
-/// `g` finite with `|g| < 1`; `eta` finite with `eta >= 1` (models that support `eta < 1`
+/// `g` finite with `|g| < 1` ([`crate::error::check_g`]); `eta` finite with `eta >= 1` (models that support `eta < 1`
 /// may relax this through their own constructors).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MediumParams {

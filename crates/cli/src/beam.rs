@@ -233,7 +233,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sub = u32::try_from(args.subsamples).context("--subsamples is too large")?;
     let map = run_method(
         &setup,
-        args.method,
+        args.method.with_estimator_samples(
+            args.estimator_samples
+                .map(|n| n.min(u32::MAX as u64) as u32),
+        ),
         args.profile,
         photons,
         sub,

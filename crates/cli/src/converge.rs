@@ -70,6 +70,21 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
+/// Keeps the latest item of each method: runs come in increasing budget per method, so this
+/// is the largest one, whatever the budget's unit or rounding.
+fn keep_latest<T>(finals: &mut Vec<(String, T)>, method: &str, item: T) {
+    match finals.last_mut() {
+        Some((m, latest)) if m == method => *latest = item,
+        _ => finals.push((method.to_string(), item)),
+    }
+}
+
+/// `--estimator-samples`, saturated to `u32`.
+fn estimator_samples(args: &Args) -> Option<u32> {
+    args.estimator_samples
+        .map(|n| n.min(u32::MAX as u64) as u32)
+}
+
 fn doubling(from: u64, to: u64) -> Vec<u64> {
     std::iter::successors(Some(from), |&v| Some(v * 2))
         .take_while(|&v| v <= to)
@@ -165,10 +180,13 @@ fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
     let methods: Vec<Method> = args
         .methods
         .iter()
-        .map(|m| m.with_profile(args.profile))
+        .map(|m| {
+            m.with_profile(args.profile)
+                .with_estimator_samples(estimator_samples(args))
+        })
         .collect();
     let bar = crate::common::progress((methods.len() * spp.len()) as u64, "converge", "runs");
-    let mut last_written = Vec::new();
+    let mut finals = Vec::new();
     let runs = scene_study(
         &scene,
         &RenderJob {
@@ -180,16 +198,20 @@ fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
         &reference,
         |run, outcome| {
             bar.inc(1);
-            if run.budget == *spp.last().expect("at least spp 1") as u64 {
-                last_written.push((run.method.clone(), outcome.clone()));
-            }
+            keep_latest(&mut finals, &run.method, outcome.clone());
         },
     )?;
     bar.finish_and_clear();
-    for (name, outcome) in &last_written {
-        let mut job = base.clone();
-        job.seed = args.seed;
-        job.method = name.parse().map_err(|e: String| anyhow::anyhow!(e))?;
+    for (name, outcome) in &finals {
+        let method = *methods
+            .iter()
+            .find(|m| m.name() == name)
+            .expect("every run comes from one of the methods");
+        let job = RenderJob {
+            method,
+            seed: args.seed,
+            ..base.clone()
+        };
         write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
     }
     let summary = summarize(&runs);
@@ -263,9 +285,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         .sum();
     let bar = crate::common::progress(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
-    let samples = args
-        .estimator_samples
-        .map(|n| n.min(u32::MAX as u64) as u32);
+    let samples = estimator_samples(args);
     let methods: Vec<Method> = args
         .methods
         .iter()
@@ -281,14 +301,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         args.min_radius,
         |run, map| {
             bar.inc(1);
-            let last = if run.unit == "photons" {
-                run.budget >= *budgets.photons.last().expect("non-empty")
-            } else {
-                run.budget == (*budgets.subsamples.last().expect("non-empty") as u64).pow(2)
-            };
-            if last {
-                finals.push((run.method.clone(), map.clone()));
-            }
+            keep_latest(&mut finals, &run.method, map.clone());
         },
     )?;
     bar.finish_and_clear();

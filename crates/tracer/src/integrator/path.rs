@@ -27,7 +27,7 @@ use crate::integrator::lighting::{LightSet, power_heuristic};
 use crate::integrator::probe::{ProbeSampler, probe};
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::Light;
-use crate::render::PixelEstimator;
+use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
 use crate::scene::{Material, Scene, Translucent};
 use crate::volume::{ChannelMedium, direction_about, transmittance};
@@ -589,10 +589,7 @@ impl<'s> PathIntegrator<'s> {
                 }
             },
         );
-        counters.add_tracking(&crate::volume::TrackingCounters {
-            delta_steps: 0,
-            ratio_steps: nee_counters.ratio_steps,
-        });
+        counters.merge(&nee_counters);
         st.l += st.mask(added);
         st.order = order;
         match end {

@@ -1,0 +1,93 @@
+//! Method overrides (`--profile`, `--estimator-samples`) reach the runs and their sidecars, for
+//! `converge` (on a tiny scene) and `beam`.
+
+use std::process::Command;
+
+#[test]
+fn converge_writes_each_methods_largest_render_with_its_real_parameters() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
+        .replace("width = 128", "width = 8")
+        .replace("height = 128", "height = 8");
+    let scene_path = dir.path().join("slab.toml");
+    std::fs::write(&scene_path, scene).unwrap();
+    let out = dir.path().join("study");
+    let status = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args([
+            "converge",
+            scene_path.to_str().unwrap(),
+            "--methods",
+            "pt,sone",
+        ])
+        .args(["--profile", "pbd", "--estimator-samples", "3"])
+        .args([
+            "--reference-spp",
+            "2",
+            "--max-spp",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    for name in ["pt", "sone"] {
+        assert!(
+            out.join(format!("{name}.exr")).is_file(),
+            "{name}.exr missing"
+        );
+    }
+    let sone: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sone.json")).unwrap()).unwrap();
+    assert_eq!(sone["profile"], "pbd");
+    assert_eq!(sone["spp"], 2, "the largest run is the one written");
+    let params = sone["estimator_parameters"].as_str().unwrap();
+    assert!(
+        params.contains("Fixed(3)"),
+        "estimator parameters lost: {params}"
+    );
+    let csv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 2 * 2, "{csv}");
+}
+
+#[test]
+fn beam_uses_the_requested_estimator_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("map.exr");
+    let status = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args([
+            "beam",
+            "--preset",
+            "stripe",
+            "--method",
+            "sone",
+            "--estimator-samples",
+            "3",
+        ])
+        .args([
+            "--resolution",
+            "6",
+            "--subsamples",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+            .unwrap();
+    let c = &v["map"]["counters"];
+    let (samples, estimates) = (
+        c["estimator_samples"].as_u64().unwrap(),
+        c["estimates"].as_u64().unwrap(),
+    );
+    assert!(estimates > 0);
+    // Sone draws N points in the disk and N in the ellipse.
+    assert_eq!(
+        samples,
+        6 * estimates,
+        "{samples} samples for {estimates} estimates"
+    );
+}
