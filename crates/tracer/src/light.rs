@@ -95,6 +95,14 @@ pub struct LightSample {
     pub wi: DVec3,
     /// Distance to the sampled point (`f64::INFINITY` for directional and environment).
     pub dist: f64,
+    /// The sampled point on the light (point and quad lights), or `None` at infinity. A
+    /// shadow ray must end here, measured from wherever the ray actually starts (an origin
+    /// offset off the surface is not the shading point).
+    pub point: Option<DVec3>,
+    /// The scene object holding the light's geometry (quad lights in a scene): a shadow ray
+    /// that hits this object has reached the light, since a planar emitter cannot occlude
+    /// its own front.
+    pub object: Option<u32>,
     /// Incident radiance along `−wi` divided by `pdf` (see the module docs).
     pub li: Rgb,
     /// Solid-angle pdf of `wi` (1 for delta lights).
@@ -230,6 +238,8 @@ impl Light {
             Light::Directional(l) => Some(LightSample {
                 wi: -l.direction,
                 dist: f64::INFINITY,
+                point: None,
+                object: None,
                 li: l.irradiance,
                 pdf: 1.0,
                 delta: true,
@@ -244,6 +254,8 @@ impl Light {
                 Some(LightSample {
                     wi: d / dist,
                     dist,
+                    point: Some(l.position),
+                    object: None,
                     li: l.intensity / dist2,
                     pdf: 1.0,
                     delta: true,
@@ -269,6 +281,8 @@ impl Light {
                 Some(LightSample {
                     wi,
                     dist,
+                    point: Some(y),
+                    object: q.object,
                     li: q.radiance / pdf,
                     pdf,
                     delta: false,
@@ -280,6 +294,8 @@ impl Light {
                 Some(LightSample {
                     wi,
                     dist: f64::INFINITY,
+                    point: None,
+                    object: None,
                     li: e.radiance / pdf,
                     pdf,
                     delta: false,

@@ -20,13 +20,13 @@ use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator, PreparedEstimator};
 
 use crate::field::MediumField;
-use crate::geometry::{Hit, ObjectSurface, Ray};
+use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
 use crate::integrator::probe::{ProbeSampler, probe};
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
-use crate::light::Light;
+use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
 use crate::scene::{Material, Scene, Translucent};
@@ -144,6 +144,60 @@ impl Channels {
         match self {
             Channels::All => 0,
             Channels::One(c) => c,
+        }
+    }
+}
+
+/// A shadow ray toward a light sample, measured from the ray's actual origin.
+///
+/// The origin is the shading point moved off its surface ([`Hit::spawn_origin`]), which on a
+/// large triangle is far more than any relative shortening of the light's distance: a segment
+/// sized from the shading point would overshoot the light and hit the light's own geometry.
+/// So the segment is aimed from the origin at the sampled point and:
+/// * toward an area light with geometry (a quad), runs a little *past* the point, and a hit on
+///   the light's own object counts as reaching it;
+/// * toward a point light, stops just short of it (as [`Ray::between`]);
+/// * toward a light at infinity, is unbounded.
+struct ShadowSegment {
+    origin: DVec3,
+    dir: DVec3,
+    t_max: f64,
+    light_object: Option<u32>,
+}
+
+impl ShadowSegment {
+    fn toward(origin: DVec3, ls: &LightSample) -> Option<Self> {
+        let Some(y) = ls.point else {
+            return Some(Self {
+                origin,
+                dir: ls.wi,
+                t_max: f64::INFINITY,
+                light_object: None,
+            });
+        };
+        match ls.object {
+            Some(object) => {
+                let d = y - origin;
+                let dist = d.length();
+                if !(dist > 0.0 && dist.is_finite()) {
+                    return None;
+                }
+                Some(Self {
+                    origin,
+                    dir: d / dist,
+                    t_max: dist * (1.0 + 1e-3) + OFFSET_REL * y.abs().max_element(),
+                    light_object: Some(object),
+                })
+            }
+            None => {
+                let r = Ray::between(origin, y)?;
+                Some(Self {
+                    origin,
+                    dir: r.dir,
+                    t_max: r.t_max,
+                    light_object: None,
+                })
+            }
         }
     }
 }
@@ -412,12 +466,11 @@ impl<'s> PathIntegrator<'s> {
         if f.is_nan() || f <= 0.0 {
             return Rgb::ZERO;
         }
-        let t_max = if ls.dist.is_finite() {
-            ls.dist * (1.0 - 1e-6)
-        } else {
-            f64::INFINITY
+        let origin = origin_for(ls.wi);
+        let Some(seg) = ShadowSegment::toward(origin, &ls) else {
+            return Rgb::ZERO;
         };
-        let tr = self.shadow(origin_for(ls.wi), ls.wi, t_max, channel, rng, counters);
+        let tr = self.shadow(&seg, channel, rng, counters);
         if tr == 0.0 {
             return Rgb::ZERO;
         }
@@ -429,25 +482,28 @@ impl<'s> PathIntegrator<'s> {
         ls.li * (f * tr * w / self.lights.select_pdf())
     }
 
-    /// Transmittance of the segment `origin + t·dir`, `t < t_max`: 0 if anything opaque is in
-    /// the way; through index-matched media (path tracing only) by ratio tracking.
+    /// Transmittance of the shadow segment `seg`: 0 if anything opaque is in the way; through
+    /// index-matched media (path tracing only) by ratio tracking. A hit on the sampled light's
+    /// own object ends the segment: the light is reached.
     fn shadow(
         &self,
-        origin: DVec3,
-        dir: DVec3,
-        t_max: f64,
+        seg: &ShadowSegment,
         channel: usize,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> f64 {
-        let mut origin = origin;
-        let mut remaining = t_max;
+        let dir = seg.dir;
+        let mut origin = seg.origin;
+        let mut remaining = seg.t_max;
         let mut tr = 1.0;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let ray = Ray::with_range(origin, dir, 0.0, remaining);
             let Some(h) = self.scene.geometry.intersect(&ray) else {
                 return tr;
             };
+            if Some(h.object) == seg.light_object {
+                return tr;
+            }
             let ObjectKind::Translucent {
                 material,
                 bssrdf: None,
