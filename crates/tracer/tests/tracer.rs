@@ -4,6 +4,8 @@
 
 #[path = "tracer/common.rs"]
 mod common;
+#[path = "tracer/direct_lighting.rs"]
+mod direct_lighting;
 #[path = "tracer/geometry.rs"]
 mod geometry;
 #[path = "tracer/lights.rs"]

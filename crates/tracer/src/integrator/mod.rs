@@ -9,7 +9,7 @@ pub mod probe;
 pub mod walk;
 
 pub use counters::PathCounters;
-pub use path::{Method, PathIntegrator, PathOptions};
+pub use path::{LightStrategy, Method, PathIntegrator, PathOptions};
 
 /// Why a render could not start.
 #[derive(Debug, thiserror::Error)]

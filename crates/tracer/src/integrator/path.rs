@@ -220,6 +220,59 @@ pub struct PathIntegrator<'s> {
     lights: LightSet,
     channels_grey: bool,
     warnings: Vec<String>,
+    strategy: LightStrategy,
+}
+
+/// How light sources are found: the two strategies of multiple importance sampling (Veach
+/// 1997, "Vea97", §9.2), or one of them alone.
+///
+/// Only [`LightStrategy::Mis`] is unbiased for every scene; the single strategies exist to
+/// test it (each is unbiased exactly where it can reach every light, and the three must
+/// agree there):
+/// * [`LightStrategy::LightOnly`] counts only next-event estimation for lights it can sample,
+///   so light that NEE cannot connect to (through a refractive boundary) is lost;
+/// * [`LightStrategy::DirectionOnly`] counts only lights hit by direction-sampled rays, so
+///   delta lights (directional, point) are lost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LightStrategy {
+    /// Next-event estimation and direction sampling, combined by the power heuristic.
+    #[default]
+    Mis,
+    /// Next-event estimation alone (weight 1); lights hit by chance count only when NEE could
+    /// not have sampled them.
+    LightOnly,
+    /// Direction sampling alone: no next-event estimation; lights hit by chance count fully.
+    DirectionOnly,
+}
+
+impl LightStrategy {
+    /// Weight of a next-event sample with light pdf `light` against direction pdf `dir` (both
+    /// solid angle, the light pdf including the light-selection probability).
+    #[inline]
+    fn nee_weight(self, light: f64, dir: f64) -> f64 {
+        match self {
+            LightStrategy::Mis => power_heuristic(light, dir),
+            LightStrategy::LightOnly => 1.0,
+            LightStrategy::DirectionOnly => 0.0,
+        }
+    }
+
+    /// Weight of a light reached by a direction-sampled ray (pdf `dir`) that next-event
+    /// estimation would have sampled with pdf `light` (0 when it cannot).
+    #[inline]
+    fn hit_weight(self, dir: f64, light: f64) -> f64 {
+        match self {
+            LightStrategy::Mis => power_heuristic(dir, light),
+            LightStrategy::LightOnly => {
+                if light > 0.0 {
+                    0.0
+                } else {
+                    1.0
+                }
+            }
+            LightStrategy::DirectionOnly => 1.0,
+        }
+    }
 }
 
 struct PathState {
@@ -330,7 +383,15 @@ impl<'s> PathIntegrator<'s> {
             lights: LightSet::new(&scene.lights),
             channels_grey,
             warnings,
+            strategy: LightStrategy::Mis,
         })
+    }
+
+    /// Uses `strategy` to find lights instead of multiple importance sampling (for tests and
+    /// diagnostics: see [`LightStrategy`]).
+    pub fn with_light_strategy(mut self, strategy: LightStrategy) -> Self {
+        self.strategy = strategy;
+        self
     }
 
     /// Things about the scene that make this method's image misleading (printed by the CLI).
@@ -408,7 +469,7 @@ impl<'s> PathIntegrator<'s> {
                     Prev::Specular => 1.0,
                     Prev::Sampled { p, pdf } => {
                         let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
-                        power_heuristic(pdf, pl)
+                        self.strategy.hit_weight(pdf, pl)
                     }
                 };
                 le += light.le(ray.dir) * w;
@@ -428,7 +489,7 @@ impl<'s> PathIntegrator<'s> {
             Prev::Specular => le,
             Prev::Sampled { p, pdf } => {
                 let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
-                le * power_heuristic(pdf, pl)
+                le * self.strategy.hit_weight(pdf, pl)
             }
         }
     }
@@ -455,6 +516,9 @@ impl<'s> PathIntegrator<'s> {
     ) -> Rgb {
         let u = rng.uniform();
         let u2 = rng.uniform2();
+        if self.strategy == LightStrategy::DirectionOnly {
+            return Rgb::ZERO;
+        }
         let Some(i) = self.lights.select(u) else {
             return Rgb::ZERO;
         };
@@ -477,7 +541,8 @@ impl<'s> PathIntegrator<'s> {
         let w = if ls.delta {
             1.0
         } else {
-            power_heuristic(ls.pdf * self.lights.select_pdf(), pdf_dir)
+            self.strategy
+                .nee_weight(ls.pdf * self.lights.select_pdf(), pdf_dir)
         };
         ls.li * (f * tr * w / self.lights.select_pdf())
     }

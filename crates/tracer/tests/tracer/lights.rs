@@ -8,19 +8,7 @@ use glam::DVec3;
 use tracer::light::Light;
 use tracer::rng::Rng;
 
-/// Irradiance at `p` (receiver normal `n`) from a Lambertian polygon of radiance 1:
-/// E = ½ Σ θ_i · n·(R_i × R_{i+1})/|R_i × R_{i+1}| (Lambert 1760; e.g. Arvo 1995, eq. 1),
-/// R_i the unit vectors toward the vertices and θ_i the angle between consecutive ones.
-fn lambert_irradiance(p: DVec3, n: DVec3, verts: &[DVec3]) -> f64 {
-    let r: Vec<DVec3> = verts.iter().map(|v| (*v - p).normalize()).collect();
-    let mut e = 0.0;
-    for i in 0..r.len() {
-        let (a, b) = (r[i], r[(i + 1) % r.len()]);
-        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
-        e += theta * n.dot(a.cross(b).normalize());
-    }
-    (0.5 * e).abs()
-}
+use crate::common::{lambert_irradiance, mc};
 
 /// Solid angle of triangle (a, b, c) seen from p (Van Oosterom & Strackee 1983).
 fn triangle_solid_angle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
@@ -29,19 +17,6 @@ fn triangle_solid_angle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let num = a.dot(b.cross(c)).abs();
     let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
     2.0 * num.atan2(den)
-}
-
-/// Mean and standard error of `n` draws of `f`.
-fn mc(n: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
-    let (mut s, mut s2) = (0.0, 0.0);
-    for _ in 0..n {
-        let x = f();
-        s += x;
-        s2 += x * x;
-    }
-    let mean = s / n as f64;
-    let var = (s2 / n as f64 - mean * mean).max(0.0);
-    (mean, (var / n as f64).sqrt())
 }
 
 #[test]
