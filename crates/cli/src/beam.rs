@@ -12,7 +12,8 @@ use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, wr
 use tracer::integrator::Method;
 
 use crate::common::{
-    check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
+    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, progress,
+    warn_counters,
 };
 
 /// Texture kinds.
@@ -176,7 +177,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
 }
 

@@ -11,7 +11,9 @@ use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
-use crate::common::{check_writable, parse_method, parse_positive, parse_seconds, warn_counters};
+use crate::common::{
+    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, warn_counters,
+};
 
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
@@ -47,7 +49,7 @@ pub struct Args {
     max_depth: Option<u64>,
     /// Output EXR (default: `<scene>-<method>.exr` in the current directory); the PNG preview
     /// and JSON sidecar are written beside it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]

@@ -36,6 +36,7 @@
 mod builder;
 mod load;
 mod locate;
+mod overlap;
 
 pub mod desc;
 
