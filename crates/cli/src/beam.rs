@@ -11,6 +11,7 @@ use bssrdf_core::{ProfileModel, Scattering};
 use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
+use crate::flags::{Given, check_method_flags};
 use crate::common::{
     check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, progress,
     warn_counters,
@@ -157,9 +158,9 @@ pub struct Args {
     /// endpoints, segment, sone.
     #[arg(long, value_parser = parse_method, default_value = "sone")]
     method: Method,
-    /// Profile model for BSSRDF methods.
-    #[arg(long, default_value = "dipole")]
-    profile: ProfileModel,
+    /// Profile model for BSSRDF methods (default: dipole).
+    #[arg(long)]
+    profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
     #[arg(long, value_parser = parse_positive)]
@@ -216,11 +217,17 @@ pub fn run_method(
 }
 
 /// Runs the subcommand.
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
+    check_method_flags(
+        &[args.method],
+        given.has("profile"),
+        args.estimator_samples.is_some(),
+    )?;
     let setup = args.setup.setup()?;
+    let profile = args.profile.unwrap_or(ProfileModel::Dipole);
     let name = match args.method {
         Method::PathTraced => "pt".to_string(),
-        m => format!("{}-{}", m.name(), args.profile),
+        m => format!("{}-{}", m.name(), profile),
     };
     let out = args
         .out
@@ -238,7 +245,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.estimator_samples
                 .map(|n| n.min(u32::MAX as u64) as u32),
         ),
-        args.profile,
+        profile,
         photons,
         sub,
         args.seed,

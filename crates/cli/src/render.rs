@@ -11,6 +11,7 @@ use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
+use crate::flags::check_method_flags;
 use crate::common::{
     check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, warn_counters,
 };
@@ -68,6 +69,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             None => "sone".parse().expect("built-in estimator name"),
         },
     }
+    ;
+    check_method_flags(
+        &[method],
+        args.profile.is_some(),
+        args.estimator_samples.is_some(),
+    )?;
+    let method = method
     .with_profile(args.profile)
     .with_estimator_samples(
         args.estimator_samples
