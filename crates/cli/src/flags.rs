@@ -54,7 +54,7 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
     };
     if profile && !methods.iter().any(|m| matches!(m, Method::Bssrdf { .. })) {
         bail!(
-            "--profile applies only to BSSRDF methods, not to `{}`",
+            "--profile does not apply to `{}`: it selects the profile of BSSRDF methods",
             names()
         );
     }
@@ -69,7 +69,8 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
     };
     if samples && !methods.iter().any(sampled) {
         bail!(
-            "--estimator-samples applies only to the segment and sone estimators, not to `{}`",
+            "--estimator-samples does not apply to `{}`: only the segment and sone estimators \
+             take averaging samples",
             names()
         );
     }

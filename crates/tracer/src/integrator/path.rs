@@ -222,6 +222,16 @@ enum Prev {
     Sampled { p: DVec3, pdf: f64 },
 }
 
+impl Prev {
+    /// The light-sampled vertex and its direction pdf, if any.
+    fn sampled(self) -> Option<(DVec3, f64)> {
+        match self {
+            Prev::Sampled { p, pdf } => Some((p, pdf)),
+            Prev::Specular => None,
+        }
+    }
+}
+
 /// The integrator: a [`PixelEstimator`] over a scene.
 pub struct PathIntegrator<'s> {
     scene: &'s Scene,
@@ -646,10 +656,7 @@ impl<'s> PathIntegrator<'s> {
         let ObjectKind::Translucent { material, grey, .. } = &self.objects[object as usize] else {
             unreachable!("a path's medium is a translucent object");
         };
-        let from = match st.prev {
-            Prev::Sampled { p, pdf } => Some((p, pdf)),
-            Prev::Specular => None,
-        };
+        let from = st.prev.sampled();
         self.traverse(object, material, *grey, ray.origin, ray.dir, from, st, rng, counters)
     }
 
@@ -679,13 +686,21 @@ impl<'s> PathIntegrator<'s> {
             Crossing::Transmit(t) => t,
         };
         st.entered = true;
+        // Through an index-matched boundary the direction is unchanged: the vertex before the
+        // entry still is the one an unscattered exit is weighed against (its light sample saw
+        // through the medium).
+        let from = if interface.is_index_matched() {
+            st.prev.sampled()
+        } else {
+            None
+        };
         self.traverse(
             hit.object,
             material,
             grey,
             hit.spawn_origin(dir),
             dir,
-            None,
+            from,
             st,
             rng,
             counters,
