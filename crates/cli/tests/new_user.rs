@@ -362,3 +362,85 @@ fn flags_that_do_not_apply_are_refused() {
         &["--estimator-samples"],
     );
 }
+
+/// A diffuse floor (albedo 0.5) seen directly, lit by a directional light (irradiance 1 at
+/// 45°) through a purely absorbing chromatic slab: every light path crosses the slab over a
+/// length √2, so each pixel is exactly (0.5/π)·cos 45°·exp(−σa·√2) per channel (delta light,
+/// exact transmittance of a constant medium). The camera paths never enter the medium, so they
+/// stay RGB and their shadow rays must carry each channel's own transmittance. Tolerance: ray
+/// origins are moved off surfaces by about 4e-6 × the scene's scale (10 here), which changes
+/// the length inside the slab by ~1e-4 and the transmittance by up to σa × that.
+#[test]
+fn rgb_shadow_rays_through_a_chromatic_medium_are_exact_per_channel() {
+    let s = Scratch::new();
+    let scene = r#"[render]
+width = 8
+height = 8
+spp = 2
+
+[camera]
+type = "orthographic"
+centre = [0.0, 0.0, 5.0]
+direction = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+width = 0.8
+height = 0.8
+
+[[material]]
+name = "filter"
+type = "translucent"
+sigma_a = [0.1, 0.5, 1.0]
+sigma_s = 0.0
+
+[[material]]
+name = "floor"
+type = "diffuse"
+albedo = 0.5
+
+[[light]]
+type = "directional"
+direction = [-0.70710678118654752, 0.0, -0.70710678118654752]
+irradiance = 1.0
+
+[[shape]]
+type = "box"
+material = "floor"
+min = [-5.0, -5.0, -1.0]
+max = [5.0, 5.0, 0.0]
+
+[[shape]]
+type = "box"
+material = "filter"
+min = [0.5, -5.0, 1.0]
+max = [3.0, 5.0, 2.0]
+"#;
+    s.write("filter.toml", scene);
+    let (film, _) = render_ok(&s, "filter.toml", "filter.exr", &[]);
+    let sigma_a = [0.1, 0.5, 1.0];
+    for p in &film.pixels {
+        for c in 0..3 {
+            let expected = 0.5 / std::f64::consts::PI
+                * std::f64::consts::FRAC_1_SQRT_2
+                * (-sigma_a[c] * std::f64::consts::SQRT_2).exp();
+            assert!(
+                (p[c] - expected).abs() < 1e-3 * expected,
+                "channel {c}: {} vs {expected}",
+                p[c]
+            );
+        }
+    }
+}
+
+/// The BSSRDF methods do not see an opaque core: they say so.
+#[test]
+fn bssrdf_renders_warn_about_an_opaque_core() {
+    let s = Scratch::new();
+    s.write("core.toml", core_in_clear_sphere(0.0, 0.5));
+    let r = s.run(&["render", "core.toml", "--method", "sone", "--spp", "1", "--out", "c.exr"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("`core`") && r.stderr.contains("`shell`") && r.stderr.contains("BSSRDF"),
+        "{}",
+        r.stderr
+    );
+}
