@@ -11,11 +11,11 @@ use bssrdf_core::{ProfileModel, Scattering};
 use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::flags::{Given, check_method_flags};
 use crate::common::{
     check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, progress,
     warn_counters,
 };
+use crate::flags::{Given, check_method_flags};
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -11,10 +11,10 @@ use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
-use crate::flags::check_method_flags;
 use crate::common::{
     check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, warn_counters,
 };
+use crate::flags::check_method_flags;
 
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
@@ -68,16 +68,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             })?,
             None => "sone".parse().expect("built-in estimator name"),
         },
-    }
-    ;
+    };
     check_method_flags(
         &[method],
         args.profile.is_some(),
         args.estimator_samples.is_some(),
     )?;
-    let method = method
-    .with_profile(args.profile)
-    .with_estimator_samples(
+    let method = method.with_profile(args.profile).with_estimator_samples(
         args.estimator_samples
             .map(|n| n.min(u32::MAX as u64) as u32),
     );

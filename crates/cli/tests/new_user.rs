@@ -40,7 +40,7 @@ fn core_in_clear_sphere(x0: f64, x_max: f64) -> String {
     let view = header(16, 16, 0.8);
     let view = edit(&view, "[0.0, 0.0, 5.0]", &format!("[{x0}, 0.0, 5.0]"));
     view + &format!(
-            r#"
+        r#"
 [[material]]
 name = "clear"
 type = "translucent"
@@ -67,7 +67,7 @@ material = "grey"
 min = [-0.5, -0.5, -0.5]
 max = [{x_max}, 0.5, 0.5]
 "#
-        )
+    )
 }
 
 /// Mean and standard error of the per-pixel values of channel 0 (pixels are independent
@@ -102,12 +102,7 @@ fn a_diffuse_core_inside_a_clear_medium_renders_its_albedo() {
         s.write(&scene, core_in_clear_sphere(x0, x_max));
         // Light reaching the camera off the core has scattered 0 times in the medium: count
         // every order.
-        let (film, _) = render_ok(
-            &s,
-            &scene,
-            &format!("{name}.exr"),
-            &["--scattering", "all"],
-        );
+        let (film, _) = render_ok(&s, &scene, &format!("{name}.exr"), &["--scattering", "all"]);
         let (mean, se) = mean_and_se(&film);
         assert!(se < 0.01, "{name}: too noisy to test (se {se})");
         assert!(
@@ -130,7 +125,11 @@ centre = [0.5, 0.5, 0.0]
 radius = 0.8
 subdivisions = 2
 "#;
-    let two = edit(&two, "type = \"box\"\n", "type = \"box\"\nname = \"first\"\n");
+    let two = edit(
+        &two,
+        "type = \"box\"\n",
+        "type = \"box\"\nname = \"first\"\n",
+    );
     s.write("bad.toml", &two);
     s.assert_rejected(
         &["render", "bad.toml", "--out", "out.exr"],
@@ -189,9 +188,9 @@ subdivisions = 3
     }
     assert!(background > 100);
     // The ball itself is still traced one channel at a time, and absorbs more in blue.
-    let mean = ball.iter().fold([0.0; 3], |a, v| {
-        [a[0] + v[0], a[1] + v[1], a[2] + v[2]]
-    });
+    let mean = ball
+        .iter()
+        .fold([0.0; 3], |a, v| [a[0] + v[0], a[1] + v[1], a[2] + v[2]]);
     assert!(mean[0] > mean[2], "{mean:?}");
 }
 
@@ -199,7 +198,11 @@ subdivisions = 3
 fn refractive_objects_warn_for_each_delta_light_with_its_share_of_the_power() {
     let s = Scratch::new();
     let scene = edit(MINIMAL, "sigma_s = 1.0", "sigma_s = 1.0\neta = 1.3");
-    let scene = edit(&scene, "type = \"box\"\n", "type = \"box\"\nname = \"ball\"\n");
+    let scene = edit(
+        &scene,
+        "type = \"box\"\n",
+        "type = \"box\"\nname = \"ball\"\n",
+    );
     let scene = scene + "\n[[light]]\ntype = \"environment\"\nradiance = 0.001\n";
     s.write("refr.toml", &scene);
     let r = s.run(&["render", "refr.toml", "--method", "pt", "--out", "refr.exr"]);
@@ -218,7 +221,8 @@ fn refractive_objects_warn_for_each_delta_light_with_its_share_of_the_power() {
 #[test]
 fn scenes_with_nothing_to_render_warn() {
     let s = Scratch::new();
-    let light = "[[light]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n";
+    let light =
+        "[[light]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n";
     let beam = "[[light]]\ntype = \"beam\"\norigin = [0.0, 0.0, 2.0]\ndirection = [0.0, 0.0, -1.0]\npower = 1.0\n";
     let shape = "[[shape]]\ntype = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]\n";
     for (name, scene, needle) in [
@@ -244,7 +248,15 @@ fn out_must_name_an_exr() {
     for out in ["x.png", "x.json", "x"] {
         s.assert_rejected(&["render", "ok.toml", "--out", out], 2, &["--out", ".exr"]);
         s.assert_rejected(
-            &["beam", "--method", "endpoints", "--resolution", "4", "--out", out],
+            &[
+                "beam",
+                "--method",
+                "endpoints",
+                "--resolution",
+                "4",
+                "--out",
+                out,
+            ],
             2,
             &["--out", ".exr"],
         );
@@ -256,7 +268,11 @@ fn out_must_name_an_exr() {
 #[test]
 fn exr_bytes_do_not_depend_on_the_thread_count() {
     let s = Scratch::new();
-    let scene = edit(MINIMAL, "width = 8\nheight = 8", "width = 160\nheight = 120");
+    let scene = edit(
+        MINIMAL,
+        "width = 8\nheight = 8",
+        "width = 160\nheight = 120",
+    );
     let scene = edit(&scene, "height = 10.0", "height = 7.5");
     s.write("wide.toml", scene);
     let mut files = Vec::new();
@@ -278,8 +294,15 @@ fn exr_bytes_do_not_depend_on_the_thread_count() {
         .windows(key.len())
         .position(|w| w == key)
         .expect("lineOrder attribute");
-    assert_eq!(files[0][at + key.len()], 0, "line order is not INCREASING_Y");
-    assert!(files[0] == files[1], "EXR bytes differ between 1 and 2 threads");
+    assert_eq!(
+        files[0][at + key.len()],
+        0,
+        "line order is not INCREASING_Y"
+    );
+    assert!(
+        files[0] == files[1],
+        "EXR bytes differ between 1 and 2 threads"
+    );
 }
 
 #[test]
@@ -304,8 +327,7 @@ fn converge_on_a_scene_takes_scattering_and_max_depth() {
     ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(s.join("study/pt.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(s.join("study/pt.json")).unwrap()).unwrap();
     assert_eq!(json["scattering"], "single");
     assert_eq!(json["max_depth"], 5);
 }
@@ -323,7 +345,10 @@ fn flags_that_do_not_apply_are_refused() {
         (converge(&["--sigma-s", "2"]), "--sigma-s"),
         (converge(&["--preset", "stripe"]), "--preset"),
         (converge(&["--min-radius", "2"]), "--min-radius"),
-        (converge(&["--methods", "pt", "--profile", "pbd"]), "--profile"),
+        (
+            converge(&["--methods", "pt", "--profile", "pbd"]),
+            "--profile",
+        ),
         (
             converge(&["--methods", "pt,jensen-out", "--estimator-samples", "4"]),
             "--estimator-samples",
@@ -436,7 +461,16 @@ max = [3.0, 5.0, 2.0]
 fn bssrdf_renders_warn_about_an_opaque_core() {
     let s = Scratch::new();
     s.write("core.toml", core_in_clear_sphere(0.0, 0.5));
-    let r = s.run(&["render", "core.toml", "--method", "sone", "--spp", "1", "--out", "c.exr"]);
+    let r = s.run(&[
+        "render",
+        "core.toml",
+        "--method",
+        "sone",
+        "--spp",
+        "1",
+        "--out",
+        "c.exr",
+    ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
         r.stderr.contains("`core`") && r.stderr.contains("`shell`") && r.stderr.contains("BSSRDF"),

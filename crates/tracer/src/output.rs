@@ -186,8 +186,11 @@ pub fn write_grey_exr(
         let channels = SpecificChannels::build()
             .with_channel("Y")
             .with_pixel_fn(|Vec2(x, y): Vec2<usize>| (values[y * w + x] as f32,));
-        let image =
-            Image::from_encoded_channels((width as usize, height as usize), fixed_order(), channels);
+        let image = Image::from_encoded_channels(
+            (width as usize, height as usize),
+            fixed_order(),
+            channels,
+        );
         encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]

@@ -533,7 +533,7 @@ impl<'s> PathIntegrator<'s> {
                 // finds no boundary inside a closed object has leaked and is left as it is.
                 let t = hit.map_or(remaining, |h| h.t);
                 if t.is_finite() {
-                    tr = tr * self.medium_transmittance(m, origin, dir, t, channels, rng, counters);
+                    tr *= self.medium_transmittance(m, origin, dir, t, channels, rng, counters);
                     if tr.is_zero() {
                         return Rgb::ZERO;
                     }
@@ -649,7 +649,13 @@ impl<'s> PathIntegrator<'s> {
 
     /// Continues a path along `ray`: outside any medium, the caller traces it; inside one, the
     /// walk carries it to the boundary or to the next surface in the medium.
-    fn go_on(&self, ray: Ray, st: &mut PathState, rng: &mut Rng, counters: &mut PathCounters) -> Step {
+    fn go_on(
+        &self,
+        ray: Ray,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
         let Some(object) = st.medium else {
             return Step::Continue(ray);
         };
@@ -657,7 +663,9 @@ impl<'s> PathIntegrator<'s> {
             unreachable!("a path's medium is a translucent object");
         };
         let from = st.prev.sampled();
-        self.traverse(object, material, *grey, ray.origin, ray.dir, from, st, rng, counters)
+        self.traverse(
+            object, material, *grey, ray.origin, ray.dir, from, st, rng, counters,
+        )
     }
 
     /// Path tracing inside a translucent object hit at `hit` by `ray`: refraction in, then the
