@@ -11,7 +11,8 @@
 //! the other. The test:
 //! * *surfaces cross*: some edge of A passes through a triangle of B strictly between its end
 //!   points, or an edge of B through a triangle of A (a transversal intersection curve of two
-//!   triangle meshes has its end points on such edge crossings);
+//!   triangle meshes has its end points on such edge crossings), and a point next to the
+//!   crossing lies inside both (so that faces that only touch do not count);
 //! * *containment* (surfaces that do not cross): a point just inside A, next to the centroid
 //!   of A's largest triangle, lies inside B (ray parity, majority of three directions), or the
 //!   same with A and B swapped. Stepping inside A keeps a face shared with B from counting.
@@ -93,26 +94,49 @@ pub(crate) fn volumes_overlap(geometry: &Geometry, a: u32, b: u32, closed: [bool
     if alo.cmpgt(bhi).any() || blo.cmpgt(ahi).any() {
         return false;
     }
-    if edges_cross(geometry, a, b) || edges_cross(geometry, b, a) {
+    if edges_cross(geometry, a, b, closed) || edges_cross(geometry, b, a, [closed[1], closed[0]]) {
         return true;
     }
     (closed[1] && inside(geometry, b, interior_point(geometry, a, closed[0])))
         || (closed[0] && inside(geometry, a, interior_point(geometry, b, closed[1])))
 }
 
-/// Some edge of `from`'s mesh passes through a triangle of `to` away from its end points.
-fn edges_cross(geometry: &Geometry, from: u32, to: u32) -> bool {
+/// Some edge of `from`'s mesh passes through a triangle of `to`, from one side of its plane to
+/// the other, away from the edge's end points, and (when both meshes are closed) a point next to
+/// the crossing, just inside both meshes, confirms it. The confirmation keeps touching objects
+/// apart: an edge lying in a shared face, or grazing the border of the other mesh's face, is
+/// "crossed" numerically but has no point inside both next to it.
+fn edges_cross(geometry: &Geometry, from: u32, to: u32, closed: [bool; 2]) -> bool {
     let mesh = geometry.mesh(from);
     (0..mesh.triangle_count()).any(|i| {
         let v = mesh.triangle_vertices(i);
+        let centroid = (v[0] + v[1] + v[2]) / 3.0;
+        // Outward for closed meshes (oriented at load).
+        let n_from = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
         (0..3).any(|k| {
             let (p, q) = (v[k], v[(k + 1) % 3]);
             let len = (q - p).length();
             if len.is_nan() || len <= 0.0 {
                 return false;
             }
-            let ray = Ray::with_range(p, (q - p) / len, MARGIN * len, (1.0 - MARGIN) * len);
-            geometry.intersect_object(to, &ray).is_some()
+            let s = MARGIN * len;
+            let ray = Ray::with_range(p, (q - p) / len, s, len - s);
+            let mut crosses = false;
+            geometry.for_each_object_hit(to, &ray, |h| {
+                let (dp, dq) = ((p - h.p).dot(h.ng), (q - h.p).dot(h.ng));
+                if crosses || dp * dq >= 0.0 || dp.abs().min(dq.abs()) <= s {
+                    return;
+                }
+                if !(closed[0] && closed[1]) {
+                    crosses = true;
+                    return;
+                }
+                // Into `from`'s triangle, off its plane inward, and inside `to`'s face.
+                let c =
+                    h.p + s * (centroid - h.p).normalize_or_zero() - 2.0 * s * n_from - s * h.ng;
+                crosses = inside(geometry, from, c) && inside(geometry, to, c);
+            });
+            crosses
         })
     })
 }
@@ -180,8 +204,21 @@ mod tests {
         assert!(overlap(unit(), boxed([0.0, 0.2, 0.2], [0.5, 0.8, 0.8])));
         // Crossing.
         assert!(overlap(unit(), boxed([0.5, 0.5, -0.5], [1.5, 1.5, 0.5])));
-        // Sharing a face, and apart.
+        // Curved surfaces crossing.
+        let ball = |c: [f64; 3], r: f64| {
+            let mut m = primitives::icosphere(DVec3::from_array(c), r, 2);
+            m.prepare("<test ball>").unwrap();
+            m
+        };
+        assert!(overlap(ball([0.0; 3], 1.0), ball([1.5, 0.0, 0.0], 1.0)));
+        assert!(overlap(unit(), ball([0.5, 0.5, 1.2], 0.5)));
+        assert!(!overlap(ball([0.0; 3], 1.0), ball([2.5, 0.0, 0.0], 1.0)));
+        // Sharing a face (also a part of one, and on a subdivided face), and apart.
         assert!(!overlap(unit(), boxed([1.0, 0.0, 0.0], [2.0, 1.0, 1.0])));
+        assert!(!overlap(unit(), boxed([0.2, 0.3, 1.0], [0.7, 0.6, 1.5])));
+        let mut slab = primitives::half_space(0.0, [0.0, 0.0], 200.0, 100.0, 15);
+        slab.prepare("<test slab>").unwrap();
+        assert!(!overlap(slab, boxed([18.0, -2.0, 0.0], [22.0, 2.0, 4.0])));
         assert!(!overlap(unit(), boxed([3.0; 3], [4.0; 3])));
     }
 }
