@@ -12,6 +12,11 @@ use tracer::output::read_exr;
 /// An orthographic camera looking down −z at a `size` × `size` window, and a uniform
 /// environment of radiance 1.
 fn header(pixels: u32, spp: u32, size: f64) -> String {
+    view(pixels, spp, size) + "\n[[light]]\ntype = \"environment\"\nradiance = 1.0\n"
+}
+
+/// `[render]` and an orthographic camera looking down −z at a `size` × `size` window.
+fn view(pixels: u32, spp: u32, size: f64) -> String {
     format!(
         r#"[render]
 width = {pixels}
@@ -26,10 +31,6 @@ direction = [0.0, 0.0, -1.0]
 up = [0.0, 1.0, 0.0]
 width = {size}
 height = {size}
-
-[[light]]
-type = "environment"
-radiance = 1.0
 "#
     )
 }
@@ -398,19 +399,8 @@ fn flags_that_do_not_apply_are_refused() {
 #[test]
 fn rgb_shadow_rays_through_a_chromatic_medium_are_exact_per_channel() {
     let s = Scratch::new();
-    let scene = r#"[render]
-width = 8
-height = 8
-spp = 2
-
-[camera]
-type = "orthographic"
-centre = [0.0, 0.0, 5.0]
-direction = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-width = 0.8
-height = 0.8
-
+    let scene = view(8, 2, 0.8)
+        + r#"
 [[material]]
 name = "filter"
 type = "translucent"
@@ -439,7 +429,7 @@ material = "filter"
 min = [0.5, -5.0, 1.0]
 max = [3.0, 5.0, 2.0]
 "#;
-    s.write("filter.toml", scene);
+    s.write("filter.toml", &scene);
     let (film, _) = render_ok(&s, "filter.toml", "filter.exr", &[]);
     let sigma_a = [0.1, 0.5, 1.0];
     for p in &film.pixels {
