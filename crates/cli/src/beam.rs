@@ -67,7 +67,8 @@ pub struct SetupArgs {
     /// N: the map is N × N pixels.
     #[arg(long, value_parser = parse_positive, default_value_t = 120, allow_hyphen_values = true)]
     pub resolution: u64,
-    /// Scattering orders: multiple (the paper), single or all.
+    /// Scattering orders: multiple (the paper), single or all. (`converge` on a scene: as for
+    /// `render`, default the scene's.)
     #[arg(long, default_value = "multiple")]
     pub scattering: Scattering,
 }
