@@ -103,6 +103,7 @@ fn diffuse_transfer(
         if let WalkEnd::Exited { hit, .. } = walk.walk(
             entry.spawn_origin(dir),
             dir,
+            None,
             &mut order,
             &mut rng,
             &mut counters,

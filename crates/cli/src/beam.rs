@@ -12,8 +12,10 @@ use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, wr
 use tracer::integrator::Method;
 
 use crate::common::{
-    check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
+    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, progress,
+    warn_counters,
 };
+use crate::flags::{Given, check_method_flags};
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -65,7 +67,8 @@ pub struct SetupArgs {
     /// N: the map is N × N pixels.
     #[arg(long, value_parser = parse_positive, default_value_t = 120, allow_hyphen_values = true)]
     pub resolution: u64,
-    /// Scattering orders: multiple (the paper), single or all.
+    /// Scattering orders: multiple (the paper), single or all. (`converge` on a scene: as for
+    /// `render`, default the scene's.)
     #[arg(long, default_value = "multiple")]
     pub scattering: Scattering,
 }
@@ -156,9 +159,9 @@ pub struct Args {
     /// endpoints, segment, sone.
     #[arg(long, value_parser = parse_method, default_value = "sone")]
     method: Method,
-    /// Profile model for BSSRDF methods.
-    #[arg(long, default_value = "dipole")]
-    profile: ProfileModel,
+    /// Profile model for BSSRDF methods (default: dipole).
+    #[arg(long)]
+    profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
     #[arg(long, value_parser = parse_positive)]
@@ -176,7 +179,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
 }
 
@@ -215,11 +218,17 @@ pub fn run_method(
 }
 
 /// Runs the subcommand.
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
+    check_method_flags(
+        &[args.method],
+        given.has("profile"),
+        args.estimator_samples.is_some(),
+    )?;
     let setup = args.setup.setup()?;
+    let profile = args.profile.unwrap_or(ProfileModel::Dipole);
     let name = match args.method {
         Method::PathTraced => "pt".to_string(),
-        m => format!("{}-{}", m.name(), args.profile),
+        m => format!("{}-{}", m.name(), profile),
     };
     let out = args
         .out
@@ -237,7 +246,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.estimator_samples
                 .map(|n| n.min(u32::MAX as u64) as u32),
         ),
-        args.profile,
+        profile,
         photons,
         sub,
         args.seed,

@@ -1,6 +1,6 @@
 //! Helpers shared by the subcommands: method names, output paths, progress bars, summaries.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
@@ -30,6 +30,20 @@ pub fn parse_positive(s: &str) -> Result<u64, String> {
     match s.parse::<u64>() {
         Ok(v) if v > 0 => Ok(v),
         _ => Err(format!("expected a positive whole number, got `{s}`")),
+    }
+}
+
+/// Parses the `--out` of a command that writes an EXR with its PNG preview and JSON sidecar
+/// beside it (same stem): the path must end in `.exr`, since any other extension would name
+/// the preview or the sidecar and one file would overwrite another.
+pub fn parse_exr_out(s: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(s);
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case("exr") => Ok(path),
+        _ => Err(format!(
+            "`{s}` must end in `.exr`: the image is an EXR, and its PNG preview and JSON sidecar \
+             are written beside it with the same stem"
+        )),
     }
 }
 

@@ -19,6 +19,27 @@ use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
 use crate::common::{parse_method, parse_positive};
+use crate::flags::{Given, check_method_flags};
+
+/// Flags that set up the beam experiment: they do not apply to a scene.
+const BEAM_ONLY: &[&str] = &[
+    "preset",
+    "texture",
+    "values",
+    "width",
+    "angle",
+    "sigma_s",
+    "g",
+    "extent",
+    "resolution",
+    "reference_photons",
+    "max_photons",
+    "max_subsamples",
+    "min_radius",
+];
+
+/// Flags of scene studies: they do not apply to the beam experiment.
+const SCENE_ONLY: &[&str] = &["reference_spp", "max_spp", "max_depth"];
 
 /// Arguments of `het-bssrdf converge`.
 #[derive(Debug, clap::Args)]
@@ -47,6 +68,10 @@ pub struct Args {
     /// Samples per pixel of the rendered reference.
     #[arg(long, value_parser = parse_positive, default_value_t = 1024, allow_hyphen_values = true)]
     reference_spp: u64,
+    /// Scene: most surface interactions per path (default: the scene's, else 8). The scene's
+    /// scattering orders are overridden by `--scattering`, as for `render`.
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    max_depth: Option<u64>,
     /// Largest spp of the scene runs (doubling from 1).
     #[arg(long, value_parser = parse_positive, default_value_t = 64, allow_hyphen_values = true)]
     max_spp: u64,
@@ -112,9 +137,22 @@ fn print_summary(summary: &[MethodSummary]) {
 }
 
 /// Runs the subcommand.
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     if args.methods.is_empty() {
         bail!("--methods: give at least one method");
+    }
+    check_method_flags(
+        &args.methods,
+        args.profile.is_some(),
+        args.estimator_samples.is_some(),
+    )?;
+    if args.beam {
+        given.refuse(SCENE_ONLY, "with --beam (it applies to a scene study)")?;
+    } else {
+        given.refuse(
+            BEAM_ONLY,
+            "to a scene study (it sets up the beam experiment, with --beam)",
+        )?;
     }
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = match &args.scene {
@@ -129,7 +167,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.beam {
         run_beam(&args, &out)
     } else {
-        run_scene(&args, &out)
+        run_scene(&args, given, &out)
     }
 }
 
@@ -146,20 +184,36 @@ fn prepare_out(out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
+fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     let file = args
         .scene
         .as_ref()
         .expect("clap requires a scene without --beam");
     let scene = Scene::load(file)?;
-    let base = RenderJob::from_scene(&scene, Method::PathTraced);
+    let mut base = RenderJob::from_scene(&scene, Method::PathTraced);
+    let defaults = (base.scattering, base.max_depth);
+    if given.has("scattering") {
+        base.scattering = args.setup.scattering;
+    }
+    if let Some(d) = args.max_depth {
+        base.max_depth = u32::try_from(d).context("--max-depth is too large")?;
+    }
     let given = args.reference.as_deref().map(read_exr).transpose()?;
     prepare_out(out)?;
     let reference = match given {
         Some(film) => film,
         None => {
             let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
-            let cache = reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
+            let mut cache =
+                reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
+            if (base.scattering, base.max_depth) != defaults {
+                // A reference of other settings than the scene's own has its own cache.
+                let stem = cache.file_stem().unwrap_or_default().to_string_lossy();
+                cache = cache.with_file_name(format!(
+                    "{stem}-{}-depth{}.exr",
+                    base.scattering, base.max_depth
+                ));
+            }
             if !cache.is_file() {
                 eprintln!(
                     "rendering the path-traced reference at {spp} spp into {}",

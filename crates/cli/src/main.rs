@@ -11,17 +11,18 @@ mod beam;
 mod common;
 mod compare;
 mod converge;
+mod flags;
 mod profile;
 mod render;
 mod reproduce;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Subcommand};
 
 /// Render heterogeneous translucent materials with homogeneous BSSRDFs, and measure them
 /// against a reference volumetric path tracer.
-#[derive(Debug, Parser)]
+#[derive(Debug, clap::Parser)]
 #[command(name = "het-bssrdf", version, about)]
 struct Cli {
     #[command(subcommand)]
@@ -44,13 +45,13 @@ enum Command {
     Reproduce(reproduce::Args),
 }
 
-fn run(cli: Cli) -> anyhow::Result<()> {
+fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
     match cli.command {
         Command::Profile(args) => profile::run(args),
         Command::Render(args) => render::run(args),
-        Command::Beam(args) => beam::run(args),
+        Command::Beam(args) => beam::run(args, &given),
         Command::Compare(args) => compare::run(args),
-        Command::Converge(args) => converge::run(args),
+        Command::Converge(args) => converge::run(args, &given),
         Command::Reproduce(args) => reproduce::run(args),
     }
 }
@@ -75,8 +76,10 @@ fn message(err: &anyhow::Error) -> String {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    match run(cli) {
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    let given = flags::Given::from_matches(matches.subcommand().map(|(_, m)| m));
+    match run(cli, given) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {}", message(&err));

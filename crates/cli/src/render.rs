@@ -11,7 +11,10 @@ use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
-use crate::common::{check_writable, parse_method, parse_positive, parse_seconds, warn_counters};
+use crate::common::{
+    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, warn_counters,
+};
+use crate::flags::check_method_flags;
 
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
@@ -47,7 +50,7 @@ pub struct Args {
     max_depth: Option<u64>,
     /// Output EXR (default: `<scene>-<method>.exr` in the current directory); the PNG preview
     /// and JSON sidecar are written beside it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -65,9 +68,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             })?,
             None => "sone".parse().expect("built-in estimator name"),
         },
-    }
-    .with_profile(args.profile)
-    .with_estimator_samples(
+    };
+    check_method_flags(
+        &[method],
+        args.profile.is_some(),
+        args.estimator_samples.is_some(),
+    )?;
+    let method = method.with_profile(args.profile).with_estimator_samples(
         args.estimator_samples
             .map(|n| n.min(u32::MAX as u64) as u32),
     );

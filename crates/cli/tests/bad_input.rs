@@ -427,7 +427,7 @@ fn slow_scene() -> String {
 fn unwritable_outputs_fail_before_the_run() {
     let s = Scratch::new();
     s.write("slow.toml", slow_scene());
-    std::fs::create_dir(s.join("taken")).unwrap();
+    std::fs::create_dir(s.join("taken.exr")).unwrap();
     let slow_beam = [
         "beam",
         "--method",
@@ -437,9 +437,9 @@ fn unwritable_outputs_fail_before_the_run() {
         "--photons",
         "1000000000000",
     ];
-    for out in ["/nonexistent/dir/x.exr", "taken"] {
-        let what: &[&str] = if out == "taken" {
-            &["--out", "`taken`", "is a directory"]
+    for out in ["/nonexistent/dir/x.exr", "taken.exr"] {
+        let what: &[&str] = if out == "taken.exr" {
+            &["--out", "`taken.exr`", "is a directory"]
         } else {
             &["--out", out, "does not exist"]
         };

@@ -153,7 +153,11 @@ pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
             let p = film.pixels[y * w + x];
             (p[0] as f32, p[1] as f32, p[2] as f32)
         });
-        let image = Image::from_channels((film.width as usize, film.height as usize), channels);
+        let image = Image::from_encoded_channels(
+            (film.width as usize, film.height as usize),
+            fixed_order(),
+            channels,
+        );
         encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
@@ -182,7 +186,11 @@ pub fn write_grey_exr(
         let channels = SpecificChannels::build()
             .with_channel("Y")
             .with_pixel_fn(|Vec2(x, y): Vec2<usize>| (values[y * w + x] as f32,));
-        let image = Image::from_channels((width as usize, height as usize), channels);
+        let image = Image::from_encoded_channels(
+            (width as usize, height as usize),
+            fixed_order(),
+            channels,
+        );
         encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
@@ -192,6 +200,18 @@ pub fn write_grey_exr(
             path: path.to_path_buf(),
             feature: "exr",
         })
+    }
+}
+
+/// The encoding of every EXR written: the `exr` crate's default compression and tiling, with
+/// chunks in increasing-y order. The default (unspecified order, declared RANDOM_Y) writes
+/// chunks as the compressing threads finish them, so the file's bytes would depend on the
+/// thread count and timing; in a fixed order they are reproducible.
+#[cfg(feature = "exr")]
+fn fixed_order() -> exr::prelude::Encoding {
+    exr::prelude::Encoding {
+        line_order: exr::prelude::LineOrder::Increasing,
+        ..exr::prelude::Encoding::default()
     }
 }
 

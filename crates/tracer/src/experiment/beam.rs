@@ -343,6 +343,7 @@ pub fn trace_photons(
                     let end = walk.walk(
                         entry.spawn_origin(dir),
                         dir,
+                        None,
                         &mut order,
                         &mut rng,
                         &mut c,

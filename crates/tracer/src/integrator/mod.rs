@@ -7,6 +7,7 @@ pub mod lighting;
 pub mod path;
 pub mod probe;
 pub mod walk;
+pub mod warnings;
 
 pub use counters::PathCounters;
 pub use path::{LightStrategy, Method, PathIntegrator, PathOptions};

@@ -11,9 +11,18 @@
 //!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
 //!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
 //!
-//! Radiance is RGB. Media whose coefficients are grey in every object are traced once for all
-//! three channels; otherwise each path traces one channel chosen uniformly (weight 3), so the
-//! estimator stays unbiased per channel.
+//! Radiance is RGB. A path carries all three channels until it enters a medium whose
+//! coefficients differ between channels; there it picks one channel uniformly (weight 3) and
+//! traces only that one from then on, so the estimator stays unbiased per channel and paths
+//! that never enter a chromatic medium (the background, diffuse surfaces lit directly) keep the
+//! variance of an RGB render. A grey medium is walked once for all three channels. Shadow rays
+//! of an RGB path through a chromatic medium estimate each channel's transmittance.
+//!
+//! Objects inside a medium: a path inside a translucent object (path tracing) carries that
+//! object as its current medium. The walk ends at any other object's surface
+//! ([`WalkEnd::Surface`]); a diffuse surface there is shaded as anywhere else (next-event
+//! estimation through the medium, cosine continuation) and the path walks on in the same
+//! medium. Shadow rays know the medium they start in.
 
 use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
 use glam::DVec3;
@@ -127,13 +136,15 @@ enum ObjectKind<'s> {
     Translucent {
         material: &'s Translucent,
         bssrdf: Option<Box<BssrdfObject>>,
+        /// The medium has the same coefficients in every channel.
+        grey: bool,
     },
 }
 
 /// Which colour channels a path carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Channels {
-    /// Grey media: one walk serves all three channels (coefficients of channel 0).
+    /// All three channels (a grey medium is walked with the coefficients of channel 0).
     All,
     /// Only this channel (its weight is multiplied by 3).
     One(usize),
@@ -211,6 +222,16 @@ enum Prev {
     Sampled { p: DVec3, pdf: f64 },
 }
 
+impl Prev {
+    /// The light-sampled vertex and its direction pdf, if any.
+    fn sampled(self) -> Option<(DVec3, f64)> {
+        match self {
+            Prev::Sampled { p, pdf } => Some((p, pdf)),
+            Prev::Specular => None,
+        }
+    }
+}
+
 /// The integrator: a [`PixelEstimator`] over a scene.
 pub struct PathIntegrator<'s> {
     scene: &'s Scene,
@@ -218,7 +239,6 @@ pub struct PathIntegrator<'s> {
     options: PathOptions,
     objects: Vec<ObjectKind<'s>>,
     lights: LightSet,
-    channels_grey: bool,
     warnings: Vec<String>,
     strategy: LightStrategy,
 }
@@ -283,6 +303,8 @@ struct PathState {
     order: u32,
     /// The path has been inside a medium (the scattering-order filter applies).
     entered: bool,
+    /// The translucent object the path is travelling in (path tracing).
+    medium: Option<u32>,
     prev: Prev,
 }
 
@@ -307,7 +329,11 @@ impl PathState {
 
 /// The outcome of shading one surface interaction.
 enum Step {
+    /// Trace this ray (outside any medium) next.
     Continue(Ray),
+    /// A walk inside a medium reached this surface travelling along the direction: shade it
+    /// next, without tracing.
+    Arrive(Hit, DVec3),
     Stop,
 }
 
@@ -324,11 +350,9 @@ impl<'s> PathIntegrator<'s> {
             scene.require_path_traceable()?;
         }
         let mut objects = Vec::with_capacity(scene.objects.len());
-        let mut channels_grey = true;
         for object in &scene.objects {
             objects.push(match &object.material {
                 Material::Translucent(t) => {
-                    channels_grey &= t.medium.is_grey();
                     let bssrdf = match method {
                         Method::PathTraced => None,
                         Method::Bssrdf { estimator, profile } => {
@@ -351,37 +375,19 @@ impl<'s> PathIntegrator<'s> {
                     ObjectKind::Translucent {
                         material: t,
                         bssrdf,
+                        grey: t.medium.is_grey(),
                     }
                 }
                 _ => ObjectKind::Opaque,
             });
         }
-        let mut warnings = Vec::new();
-        if method == Method::PathTraced {
-            let all_delta = scene
-                .lights
-                .iter()
-                .filter(|l| !matches!(l, Light::Beam(_)))
-                .all(|l| l.is_delta());
-            for (object, t) in scene.translucent_objects() {
-                if t.eta != 1.0 && all_delta {
-                    warnings.push(format!(
-                        "object `{}` has a refractive boundary (eta = {}) and every light is a \
-                         delta light (directional or point): a path tracer cannot connect to them \
-                         through the boundary, so light scattered inside is lost; use a quad or \
-                         environment light",
-                        scene.objects[object as usize].name, t.eta
-                    ));
-                }
-            }
-        }
+        let warnings = crate::integrator::warnings::scene_warnings(scene, method);
         Ok(Self {
             scene,
             method,
             options,
             objects,
             lights: LightSet::new(&scene.lights),
-            channels_grey,
             warnings,
             strategy: LightStrategy::Mis,
         })
@@ -407,30 +413,46 @@ impl<'s> PathIntegrator<'s> {
     /// Radiance arriving along `ray` (one sample).
     pub fn li(&self, ray: Ray, rng: &mut Rng, counters: &mut PathCounters) -> Rgb {
         counters.paths += 1;
-        let channels = if self.channels_grey || self.method != Method::PathTraced {
-            Channels::All
-        } else {
-            Channels::One(rng.below(3) as usize)
-        };
         let mut st = PathState {
             l: Rgb::ZERO,
             beta: Rgb::ONE,
-            channels,
+            channels: Channels::All,
             order: 0,
             entered: false,
+            medium: None,
             prev: Prev::Specular,
         };
         let mut ray = ray;
+        let mut arrived = None;
         let filter = self.options.scattering;
         for depth in 0..self.options.max_depth {
-            let Some(hit) = self.scene.geometry.intersect(&ray) else {
-                let le = self.escaped(&ray, st.prev);
-                st.add(st.beta * le, st.order, st.entered, filter);
-                break;
+            let hit = match arrived.take() {
+                Some((hit, dir)) => {
+                    ray = Ray::new(ray.origin, dir);
+                    hit
+                }
+                None => match self.scene.geometry.intersect(&ray) {
+                    Some(hit) => hit,
+                    None => {
+                        let le = self.escaped(&ray, st.prev);
+                        st.add(st.beta * le, st.order, st.entered, filter);
+                        break;
+                    }
+                },
             };
             let step = match &self.objects[hit.object as usize] {
-                ObjectKind::Translucent { material, bssrdf } => match bssrdf {
-                    None => self.volumetric(&hit, &ray, material, &mut st, rng, counters),
+                ObjectKind::Translucent { .. } if st.medium.is_some() => {
+                    // Another medium met from inside one: only where two objects touch
+                    // (overlaps are refused at load). Step over its face.
+                    counters.wrong_side += 1;
+                    self.go_on(hit.spawn_ray(ray.dir), &mut st, rng, counters)
+                }
+                ObjectKind::Translucent {
+                    material,
+                    bssrdf,
+                    grey,
+                } => match bssrdf {
+                    None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
                     Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
                 },
                 ObjectKind::Opaque => match &self.scene.objects[hit.object as usize].material {
@@ -447,6 +469,7 @@ impl<'s> PathIntegrator<'s> {
             };
             match step {
                 Step::Continue(next) => ray = next,
+                Step::Arrive(hit, dir) => arrived = Some((hit, dir)),
                 Step::Stop => break,
             }
             if depth + 1 >= RR_DEPTH {
@@ -504,13 +527,16 @@ impl<'s> PathIntegrator<'s> {
 
     /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
     /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
-    /// pdf), times the shadow ray's transmittance. Returns radiance (before path weight).
+    /// pdf), times the shadow ray's transmittance (per channel of `channels`; the ray starts
+    /// inside `medium`, if any). Returns radiance (before path weight).
+    #[allow(clippy::too_many_arguments)]
     fn direct(
         &self,
         p: DVec3,
         origin_for: impl Fn(DVec3) -> DVec3,
         f_and_pdf: impl Fn(DVec3) -> (f64, f64),
-        channel: usize,
+        channels: Channels,
+        medium: Option<u32>,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Rgb {
@@ -534,8 +560,8 @@ impl<'s> PathIntegrator<'s> {
         let Some(seg) = ShadowSegment::toward(origin, &ls) else {
             return Rgb::ZERO;
         };
-        let tr = self.shadow(&seg, channel, rng, counters);
-        if tr == 0.0 {
+        let tr = self.shadow(&seg, medium, channels, rng, counters);
+        if tr.is_zero() {
             return Rgb::ZERO;
         }
         let w = if ls.delta {
@@ -544,26 +570,41 @@ impl<'s> PathIntegrator<'s> {
             self.strategy
                 .nee_weight(ls.pdf * self.lights.select_pdf(), pdf_dir)
         };
-        ls.li * (f * tr * w / self.lights.select_pdf())
+        ls.li * tr * (f * w / self.lights.select_pdf())
     }
 
-    /// Transmittance of the shadow segment `seg`: 0 if anything opaque is in the way; through
-    /// index-matched media (path tracing only) by ratio tracking. A hit on the sampled light's
-    /// own object ends the segment: the light is reached.
+    /// Transmittance of the shadow segment `seg`, which starts inside `medium` (if any): 0 if
+    /// anything opaque is in the way; through index-matched media (path tracing only) by ratio
+    /// tracking, per channel of `channels`. A hit on the sampled light's own object ends the
+    /// segment: the light is reached.
     fn shadow(
         &self,
         seg: &ShadowSegment,
-        channel: usize,
+        medium: Option<u32>,
+        channels: Channels,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> f64 {
+    ) -> Rgb {
         let dir = seg.dir;
         let mut origin = seg.origin;
         let mut remaining = seg.t_max;
-        let mut tr = 1.0;
+        let mut inside = medium;
+        let mut tr = Rgb::ONE;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let ray = Ray::with_range(origin, dir, 0.0, remaining);
-            let Some(h) = self.scene.geometry.intersect(&ray) else {
+            let hit = self.scene.geometry.intersect(&ray);
+            if let Some(m) = inside {
+                // The segment up to the hit (or to its end) lies inside medium `m`; a ray that
+                // finds no boundary inside a closed object has leaked and is left as it is.
+                let t = hit.map_or(remaining, |h| h.t);
+                if t.is_finite() {
+                    tr *= self.medium_transmittance(m, origin, dir, t, channels, rng, counters);
+                    if tr.is_zero() {
+                        return Rgb::ZERO;
+                    }
+                }
+            }
+            let Some(h) = hit else {
                 return tr;
             };
             if Some(h.object) == seg.light_object {
@@ -572,33 +613,55 @@ impl<'s> PathIntegrator<'s> {
             let ObjectKind::Translucent {
                 material,
                 bssrdf: None,
+                ..
             } = &self.objects[h.object as usize]
             else {
-                return 0.0;
+                return Rgb::ZERO;
             };
             if material.eta != 1.0 {
-                return 0.0;
+                return Rgb::ZERO;
             }
-            if dir.dot(h.ng) > 0.0 {
-                // Leaving the medium: the segment so far lay inside it.
-                let view = ChannelView::new(&material.medium, channel);
-                let mut tc = crate::volume::TrackingCounters::default();
-                tr *= transmittance(&view, origin, dir, h.t, rng, &mut tc);
-                counters.add_tracking(&tc);
-                if tr == 0.0 {
-                    return 0.0;
-                }
-            }
+            inside = (dir.dot(h.ng) < 0.0).then_some(h.object);
             origin = h.spawn_origin(dir);
             remaining -= h.t;
             if remaining <= 0.0 {
                 return tr;
             }
         }
-        0.0
+        Rgb::ZERO
     }
 
-    /// A diffuse surface: NEE plus cosine-weighted continuation.
+    /// Transmittance of the medium of `object` along `origin + t·dir`, `t ∈ (0, t_max)`: one
+    /// estimate for a grey medium or a single traced channel, one per channel otherwise.
+    #[allow(clippy::too_many_arguments)]
+    fn medium_transmittance(
+        &self,
+        object: u32,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        channels: Channels,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Rgb {
+        let ObjectKind::Translucent { material, grey, .. } = &self.objects[object as usize] else {
+            return Rgb::ONE;
+        };
+        let mut tc = crate::volume::TrackingCounters::default();
+        let mut one = |c: usize| {
+            let view = ChannelView::new(&material.medium, c);
+            transmittance(&view, origin, dir, t_max, rng, &mut tc)
+        };
+        let tr = match channels {
+            Channels::All if !*grey => Rgb([one(0), one(1), one(2)]),
+            _ => Rgb::splat(one(channels.medium_channel())),
+        };
+        counters.add_tracking(&tc);
+        tr
+    }
+
+    /// A diffuse surface: NEE plus cosine-weighted continuation. Inside a medium the shadow
+    /// ray starts in it and the continuation walks on in it.
     fn diffuse(
         &self,
         hit: &Hit,
@@ -624,7 +687,8 @@ impl<'s> PathIntegrator<'s> {
                     (0.0, 0.0)
                 }
             },
-            st.channels.medium_channel(),
+            st.channels,
+            st.medium,
             rng,
             counters,
         );
@@ -645,15 +709,39 @@ impl<'s> PathIntegrator<'s> {
             p: hit.p,
             pdf: cos / std::f64::consts::PI,
         };
-        Step::Continue(hit.spawn_ray(wi))
+        self.go_on(hit.spawn_ray(wi), st, rng, counters)
     }
 
-    /// Path tracing inside a translucent object hit at `hit` by `ray`.
+    /// Continues a path along `ray`: outside any medium, the caller traces it; inside one, the
+    /// walk carries it to the boundary or to the next surface in the medium.
+    fn go_on(
+        &self,
+        ray: Ray,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
+        let Some(object) = st.medium else {
+            return Step::Continue(ray);
+        };
+        let ObjectKind::Translucent { material, grey, .. } = &self.objects[object as usize] else {
+            unreachable!("a path's medium is a translucent object");
+        };
+        let from = st.prev.sampled();
+        self.traverse(
+            object, material, *grey, ray.origin, ray.dir, from, st, rng, counters,
+        )
+    }
+
+    /// Path tracing inside a translucent object hit at `hit` by `ray`: refraction in, then the
+    /// walk ([`Self::traverse`]).
+    #[allow(clippy::too_many_arguments)]
     fn volumetric(
         &self,
         hit: &Hit,
         ray: &Ray,
         material: &Translucent,
+        grey: bool,
         st: &mut PathState,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -671,11 +759,55 @@ impl<'s> PathIntegrator<'s> {
             Crossing::Transmit(t) => t,
         };
         st.entered = true;
-        let channel = st.channels.medium_channel();
-        let view = ChannelView::new(&material.medium, channel);
+        // Through an index-matched boundary the direction is unchanged: the vertex before the
+        // entry still is the one an unscattered exit is weighed against (its light sample saw
+        // through the medium).
+        let from = if interface.is_index_matched() {
+            st.prev.sampled()
+        } else {
+            None
+        };
+        self.traverse(
+            hit.object,
+            material,
+            grey,
+            hit.spawn_origin(dir),
+            dir,
+            from,
+            st,
+            rng,
+            counters,
+        )
+    }
+
+    /// The volumetric random walk in `object` from `start` along `dir` (see [`super::walk`]),
+    /// with next-event estimation at every counted scattering vertex through an index-matched
+    /// boundary. `from` is the light-sampled vertex the walk starts from (a diffuse surface
+    /// inside the medium), for MIS if the walk leaves or reaches an emitter unscattered. An RGB
+    /// path entering a chromatic medium picks its channel here.
+    #[allow(clippy::too_many_arguments)]
+    fn traverse(
+        &self,
+        object: u32,
+        material: &Translucent,
+        grey: bool,
+        start: DVec3,
+        dir: DVec3,
+        from: Option<(DVec3, f64)>,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Step {
+        if st.channels == Channels::All && !grey {
+            st.channels = Channels::One(rng.below(3) as usize);
+        }
+        st.medium = Some(object);
+        let interface = Interface { eta: material.eta };
+        let channels = st.channels;
+        let view = ChannelView::new(&material.medium, channels.medium_channel());
         let walk = WalkMedium {
             geometry: &self.scene.geometry,
-            object: hit.object,
+            object,
             medium: &view,
             g: material.g,
             interface,
@@ -684,15 +816,18 @@ impl<'s> PathIntegrator<'s> {
         let filter = self.options.scattering;
         let beta = st.beta;
         let mut added = Rgb::ZERO;
+        let mut scattered = false;
         let mut nee_counters = PathCounters::default();
         let mut order = st.order;
         let end = walk.walk(
-            hit.spawn_origin(dir),
+            start,
             dir,
+            from,
             &mut order,
             rng,
             counters,
             |p, d_in, k, rng| {
+                scattered = true;
                 if nee && filter.counts(k) {
                     let g = material.g;
                     let ld = self.direct(
@@ -702,7 +837,8 @@ impl<'s> PathIntegrator<'s> {
                             let f = bssrdf_core::hg::phase(d_in.dot(wi), g);
                             (f, f)
                         },
-                        channel,
+                        channels,
+                        Some(object),
                         rng,
                         &mut nee_counters,
                     );
@@ -713,17 +849,28 @@ impl<'s> PathIntegrator<'s> {
         counters.merge(&nee_counters);
         st.l += st.mask(added);
         st.order = order;
+        // A scattering vertex without light sampling (η > 1) leaves nothing to weigh against.
+        let prev = |last_scatter: Option<(DVec3, f64)>| match last_scatter {
+            Some((p, pdf)) if nee || !scattered => Prev::Sampled { p, pdf },
+            _ => Prev::Specular,
+        };
         match end {
             WalkEnd::Exited {
                 hit: exit,
                 dir,
                 last_scatter,
             } => {
-                st.prev = match last_scatter {
-                    Some((p, pdf)) if nee => Prev::Sampled { p, pdf },
-                    _ => Prev::Specular,
-                };
+                st.prev = prev(last_scatter);
+                st.medium = None;
                 Step::Continue(exit.spawn_ray(dir))
+            }
+            WalkEnd::Surface {
+                hit,
+                dir,
+                last_scatter,
+            } => {
+                st.prev = prev(last_scatter);
+                Step::Arrive(hit, dir)
             }
             WalkEnd::Absorbed | WalkEnd::Capped | WalkEnd::Leaked => Step::Stop,
         }
@@ -795,7 +942,8 @@ impl<'s> PathIntegrator<'s> {
                         (0.0, 0.0)
                     }
                 },
-                0,
+                Channels::All,
+                None,
                 rng,
                 counters,
             );

@@ -5,6 +5,12 @@
 //! pbrt-v4 §9.5). Shared by the camera path tracer and the light tracer of the beam
 //! experiment.
 //!
+//! Other objects inside or crossing the medium: the walk intersects the whole scene, and a
+//! surface of another object met before the boundary ends the walk ([`WalkEnd::Surface`]); the
+//! caller shades it (an opaque core, a floor the object is sunk into) and may walk on from it in
+//! the same medium. Overlapping translucent objects are refused when the scene is built
+//! (`Scene::require_disjoint_media`).
+//!
 //! Termination: a path ends when it is absorbed (probability σa/σ̄ at each tentative collision)
 //! or leaves the object. With σa = 0 inside a *closed, finite* object every walk still leaves
 //! with probability 1 (the expected number of collisions grows like (size·σt)², e.g. ~1e6 for a
@@ -100,6 +106,16 @@ pub enum WalkEnd {
         /// MIS against light sampling); `None` after a specular interface event.
         last_scatter: Option<(DVec3, f64)>,
     },
+    /// The path met the surface of another object (`hit.object` ≠ the walk's object) inside
+    /// the medium, travelling along `dir`.
+    Surface {
+        /// The surface point.
+        hit: Hit,
+        /// Direction of travel when it was reached.
+        dir: DVec3,
+        /// As for [`WalkEnd::Exited`].
+        last_scatter: Option<(DVec3, f64)>,
+    },
     /// Absorbed inside.
     Absorbed,
     /// Stopped by [`MAX_COLLISIONS`] (counted).
@@ -123,15 +139,19 @@ pub struct WalkMedium<'a, M: ChannelMedium> {
 }
 
 impl<M: ChannelMedium> WalkMedium<'_, M> {
-    /// Walks from `start`, a point just inside the boundary reached through `entry` (use the
-    /// entry hit's `spawn_origin(dir)`), along the unit direction `dir`, until the path leaves,
-    /// is absorbed or is capped. `order` counts real scattering events and is incremented at
-    /// each one; `on_scatter(p, dir_in, order, rng)` is called at every real scattering vertex
-    /// before the new direction is sampled (next-event estimation goes there).
+    /// Walks from `start`, a point inside the medium (the entry hit's `spawn_origin(dir)`, or
+    /// a point just off a surface inside it), along the unit direction `dir`, until the path
+    /// leaves, meets another object's surface, is absorbed or is capped. `last_scatter` is the
+    /// vertex the walk starts from, as reported by [`WalkEnd::Exited`] if no event happens
+    /// (`None` when entering through the boundary). `order` counts real scattering events and
+    /// is incremented at each one; `on_scatter(p, dir_in, order, rng)` is called at every real
+    /// scattering vertex before the new direction is sampled (next-event estimation goes there).
+    #[allow(clippy::too_many_arguments)]
     pub fn walk(
         &self,
         start: DVec3,
         dir: DVec3,
+        mut last_scatter: Option<(DVec3, f64)>,
         order: &mut u32,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -139,14 +159,10 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
     ) -> WalkEnd {
         let mut origin = start;
         let mut d = dir;
-        let mut last_scatter = None;
         let mut collisions = 0u64;
         let mut tracking = TrackingCounters::default();
         let end = loop {
-            let Some(boundary) = self
-                .geometry
-                .intersect_object(self.object, &Ray::new(origin, d))
-            else {
+            let Some(boundary) = self.geometry.intersect(&Ray::new(origin, d)) else {
                 counters.leaks += 1;
                 break WalkEnd::Leaked;
             };
@@ -165,6 +181,13 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
                     last_scatter = Some((p, bssrdf_core::hg::phase(d.dot(nd), self.g)));
                     origin = p;
                     d = nd;
+                }
+                Interaction::Pass if boundary.object != self.object => {
+                    break WalkEnd::Surface {
+                        hit: boundary,
+                        dir: d,
+                        last_scatter,
+                    };
                 }
                 Interaction::Pass => {
                     if boundary.ng.dot(d) <= 0.0 {

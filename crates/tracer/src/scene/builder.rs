@@ -293,7 +293,7 @@ pub(crate) fn assemble(
             });
         }
     }
-    Ok(Scene {
+    let scene = Scene {
         camera,
         lights,
         objects,
@@ -301,5 +301,7 @@ pub(crate) fn assemble(
         settings,
         source_path: info.source_path,
         display_name: info.display_name,
-    })
+    };
+    scene.require_disjoint_media()?;
+    Ok(scene)
 }

@@ -32,10 +32,15 @@
 //!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
 //!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
 //!   degrees }, translate }`.
+//!
+//! Translucent objects must not overlap one another (one inside the other, or crossing): the
+//! path tracer has no nested media, so such scenes are refused when built, naming both objects
+//! ([`Scene::require_disjoint_media`]). Opaque objects may lie inside or cross a translucent one.
 
 mod builder;
 mod load;
 mod locate;
+mod overlap;
 
 pub mod desc;
 

@@ -1,0 +1,95 @@
+//! Things about a scene that make a render misleading: nothing to render, lights the path
+//! tracer cannot reach through a refractive boundary, and opaque objects inside a translucent
+//! one that the BSSRDF methods do not see. Printed by the CLI and recorded in the sidecar.
+
+use crate::integrator::Method;
+use crate::light::Light;
+use crate::scene::Scene;
+
+/// The warnings for rendering `scene` with `method`.
+pub fn scene_warnings(scene: &Scene, method: Method) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if !scene.objects.iter().any(|o| o.emitter.is_none()) {
+        warnings.push("the scene has no shapes: only lights seen directly can appear".to_string());
+    }
+    if scene.lights.is_empty() {
+        warnings.push("the scene has no lights: the image is black".to_string());
+    } else if scene.lights.iter().all(|l| matches!(l, Light::Beam(_))) {
+        warnings.push(
+            "the scene's only lights are beams, which `render` does not trace (they light the \
+             beam experiment): the image is black; add a directional, point, quad or \
+             environment light"
+                .to_string(),
+        );
+    }
+    match method {
+        Method::PathTraced => warnings.extend(unreachable_lights(scene)),
+        Method::Bssrdf { .. } => warnings.extend(hidden_cores(scene)),
+    }
+    warnings
+}
+
+/// One warning per delta light (directional, point) that cannot light the inside of a
+/// refractive (η > 1) translucent object in a path tracer, with that light's share of the
+/// power of every light `render` samples ([`Light::power`]).
+fn unreachable_lights(scene: &Scene) -> Vec<String> {
+    let refractive: Vec<String> = scene
+        .translucent_objects()
+        .filter(|(_, t)| t.eta != 1.0)
+        .map(|(i, t)| format!("`{}` (eta = {})", scene.objects[i as usize].name, t.eta))
+        .collect();
+    if refractive.is_empty() {
+        return Vec::new();
+    }
+    let (lo, hi) = scene.geometry.bounds();
+    let radius = if lo.x <= hi.x {
+        0.5 * (hi - lo).length()
+    } else {
+        1.0
+    };
+    let sampled = || scene.lights.iter().filter(|l| !matches!(l, Light::Beam(_)));
+    let total: f64 = sampled().map(|l| l.power(radius)).sum();
+    let mut warnings = Vec::new();
+    for (j, light) in scene.lights.iter().enumerate() {
+        if matches!(light, Light::Beam(_)) || !light.is_delta() {
+            continue;
+        }
+        let share = if total > 0.0 {
+            100.0 * light.power(radius) / total
+        } else {
+            0.0
+        };
+        let kind = match light {
+            Light::Directional(_) => "directional",
+            _ => "point",
+        };
+        warnings.push(format!(
+            "light[{j}] ({kind} light, {share:.3} % of the scene's light by power) cannot light \
+             the inside of {}: a path tracer cannot connect to a delta light through a \
+             refractive boundary, so its light scattered inside is lost; use a quad or \
+             environment light",
+            refractive.join(", ")
+        ));
+    }
+    warnings
+}
+
+/// One warning per opaque object inside or crossing a translucent one: the BSSRDF methods
+/// treat the translucent object as homogeneous material throughout.
+fn hidden_cores(scene: &Scene) -> Vec<String> {
+    scene
+        .opaque_inside_media()
+        .into_iter()
+        .map(|(t, o)| {
+            format!(
+                "object `{}` lies inside or crosses the translucent object `{}`: BSSRDF methods \
+                 model `{}` as filled with its medium and do not see `{}` inside it (only where \
+                 it blocks light outside); render with `--method pt` to include it",
+                scene.objects[o as usize].name,
+                scene.objects[t as usize].name,
+                scene.objects[t as usize].name,
+                scene.objects[o as usize].name
+            )
+        })
+        .collect()
+}
