@@ -202,6 +202,40 @@ impl ShadowSegment {
     }
 }
 
+/// Light reaching a vertex by next-event estimation.
+#[derive(Debug, Clone, Copy)]
+struct Direct {
+    /// Radiance (before the path weight).
+    l: Rgb,
+    /// The shadow segment crossed an index-matched medium: the light path it completes has
+    /// entered a medium (with no scattering there), which the scattering-order filter must
+    /// see exactly as it sees the direction-sampled path through the same medium.
+    through_medium: bool,
+}
+
+impl Direct {
+    const NONE: Direct = Direct {
+        l: Rgb::ZERO,
+        through_medium: false,
+    };
+}
+
+/// What a shadow segment lets through.
+#[derive(Debug, Clone, Copy)]
+struct Transmission {
+    /// Transmittance (0 when blocked).
+    tr: f64,
+    /// The segment crossed an index-matched medium.
+    through_medium: bool,
+}
+
+impl Transmission {
+    const BLOCKED: Transmission = Transmission {
+        tr: 0.0,
+        through_medium: false,
+    };
+}
+
 /// The previous vertex of a path, for MIS when the path hits an emitter by chance.
 #[derive(Debug, Clone, Copy)]
 enum Prev {
@@ -443,7 +477,8 @@ impl<'s> PathIntegrator<'s> {
 
     /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
     /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
-    /// pdf), times the shadow ray's transmittance. Returns radiance (before path weight).
+    /// pdf), times the shadow ray's transmittance. Returns radiance (before path weight) and
+    /// whether the shadow ray crossed a medium.
     fn direct(
         &self,
         p: DVec3,
@@ -452,34 +487,37 @@ impl<'s> PathIntegrator<'s> {
         channel: usize,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> Rgb {
+    ) -> Direct {
         let u = rng.uniform();
         let u2 = rng.uniform2();
         let Some(i) = self.lights.select(u) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
         let light = &self.scene.lights[i];
         let Some(ls) = light.sample_li(p, u2) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
         let (f, pdf_dir) = f_and_pdf(ls.wi);
         if f.is_nan() || f <= 0.0 {
-            return Rgb::ZERO;
+            return Direct::NONE;
         }
         let origin = origin_for(ls.wi);
         let Some(seg) = ShadowSegment::toward(origin, &ls) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
-        let tr = self.shadow(&seg, channel, rng, counters);
-        if tr == 0.0 {
-            return Rgb::ZERO;
+        let shadow = self.shadow(&seg, channel, rng, counters);
+        if shadow.tr == 0.0 {
+            return Direct::NONE;
         }
         let w = if ls.delta {
             1.0
         } else {
             power_heuristic(ls.pdf * self.lights.select_pdf(), pdf_dir)
         };
-        ls.li * (f * tr * w / self.lights.select_pdf())
+        Direct {
+            l: ls.li * (f * shadow.tr * w / self.lights.select_pdf()),
+            through_medium: shadow.through_medium,
+        }
     }
 
     /// Transmittance of the shadow segment `seg`: 0 if anything opaque is in the way; through
@@ -491,29 +529,31 @@ impl<'s> PathIntegrator<'s> {
         channel: usize,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> f64 {
+    ) -> Transmission {
         let dir = seg.dir;
         let mut origin = seg.origin;
         let mut remaining = seg.t_max;
         let mut tr = 1.0;
+        let mut through_medium = false;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let ray = Ray::with_range(origin, dir, 0.0, remaining);
             let Some(h) = self.scene.geometry.intersect(&ray) else {
-                return tr;
+                return Transmission { tr, through_medium };
             };
             if Some(h.object) == seg.light_object {
-                return tr;
+                return Transmission { tr, through_medium };
             }
             let ObjectKind::Translucent {
                 material,
                 bssrdf: None,
             } = &self.objects[h.object as usize]
             else {
-                return 0.0;
+                return Transmission::BLOCKED;
             };
             if material.eta != 1.0 {
-                return 0.0;
+                return Transmission::BLOCKED;
             }
+            through_medium = true;
             if dir.dot(h.ng) > 0.0 {
                 // Leaving the medium: the segment so far lay inside it.
                 let view = ChannelView::new(&material.medium, channel);
@@ -521,16 +561,16 @@ impl<'s> PathIntegrator<'s> {
                 tr *= transmittance(&view, origin, dir, h.t, rng, &mut tc);
                 counters.add_tracking(&tc);
                 if tr == 0.0 {
-                    return 0.0;
+                    return Transmission::BLOCKED;
                 }
             }
             origin = h.spawn_origin(dir);
             remaining -= h.t;
             if remaining <= 0.0 {
-                return tr;
+                return Transmission { tr, through_medium };
             }
         }
-        0.0
+        Transmission::BLOCKED
     }
 
     /// A diffuse surface: NEE plus cosine-weighted continuation.
@@ -563,10 +603,12 @@ impl<'s> PathIntegrator<'s> {
             rng,
             counters,
         );
+        // Light whose shadow ray crossed a medium has entered one, as the cosine-sampled path
+        // through the same medium will have (`entered` set with no scattering added).
         st.add(
-            st.beta * albedo * ld,
+            st.beta * albedo * ld.l,
             st.order,
-            st.entered,
+            st.entered || ld.through_medium,
             self.options.scattering,
         );
         let u = rng.uniform2();
@@ -641,7 +683,7 @@ impl<'s> PathIntegrator<'s> {
                         rng,
                         &mut nee_counters,
                     );
-                    added += beta * ld;
+                    added += beta * ld.l;
                 }
             },
         );
@@ -656,6 +698,10 @@ impl<'s> PathIntegrator<'s> {
             } => {
                 st.prev = match last_scatter {
                     Some((p, pdf)) if nee => Prev::Sampled { p, pdf },
+                    // Straight through an index-matched medium: the direction is still the
+                    // one sampled at the vertex before the medium, whose light sample reached
+                    // through the medium by ratio tracking; MIS must weigh against it.
+                    None if interface.is_index_matched() => st.prev,
                     _ => Prev::Specular,
                 };
                 Step::Continue(exit.spawn_ray(dir))
@@ -734,6 +780,7 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
+            let ld = ld.l;
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather: skip the (costly) estimate
             }
