@@ -232,7 +232,7 @@ fn document(report: &Report, stiff: &[(cube::Case, cube::Measurement)]) -> Strin
 
 const INTRO: &str = "\
 Every public numerical function must return finite, non-negative values for every valid input \
-(project standards; physics notes §7). This file records how that is checked and what the \
+(project standards; docs/physics.md#hazards). This file records how that is checked and what the \
 checks found.
 
 * **Sweep** (`tests/stability.rs`, module `stability`; the test runs the whole grid except \

@@ -2,7 +2,7 @@
 //! floor under a uniform environment light: light that crosses the sphere without scattering
 //! is reached both by next-event estimation from the floor (ratio-tracked shadow ray) and by
 //! the cosine-sampled continuation (a walk that passes straight through). Both strategies must
-//! weight it by MIS and classify its scattering order identically (`docs/physics.md#mis`).
+//! weight it by MIS and classify its scattering order identically (`docs/physics.md#path-tracer`).
 
 use bssrdf_core::{Rgb, Scattering};
 use glam::DVec3;

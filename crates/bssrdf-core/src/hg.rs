@@ -80,7 +80,7 @@ mod tests {
 
     #[test]
     fn mean_square_angle_matches_independent_values() {
-        // Values from the physics notes §5 [C], computed outside this repository.
+        // Values from docs/physics.md#path-width [computed], computed outside this repository.
         let table = [
             (-0.5, 5.161042),
             (0.0, 2.934802),

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 ///
 /// # Conventions
 /// * `eval(r)` is the **radiant exitance per unit area at distance `r` from the point of
-///   incidence, per unit incident power** (units 1/length², physics notes §0). No Fresnel
+///   incidence, per unit incident power** (units 1/length², docs/physics.md#conventions). No Fresnel
 ///   transmission factors and no `1/π` are included: a BSSRDF built from it multiplies by
 ///   those (e.g. JMLH01's `S_d = F_t R F_t / π`).
 /// * `total()` is `∫₀^∞ 2πr R(r) dr`, the total diffuse reflectance (dimensionless).
