@@ -59,6 +59,7 @@
 
 pub mod beam_diffusion;
 pub mod better_dipole;
+pub mod chi_square;
 pub mod dipole;
 mod dipole_pair;
 pub mod directional_dipole;
