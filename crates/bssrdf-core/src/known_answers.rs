@@ -223,18 +223,36 @@ fn better_dipole_total_matches_hery_formula_and_numeric() {
 
 #[test]
 fn better_dipole_is_pbd_integrand_at_one_depth() {
-    // dE12 as pinned down (see module docs): the PBD depth integrand without κ at z = 1/σt'.
-    // Far from the source κ → 1 and PBD's depth average is dominated by depths ~1/σt', so
-    // the two agree to within tens of % at a few mean free paths and both decay at σtr.
+    // dE12 as pinned down (see module docs and docs/physics.md#better-dipole): the PBD depth
+    // integrand without κ, at the single depth z_r = 1/σt', with Grosjean's D_G and the A_PBD
+    // boundary. Typed here from docs/physics.md#beam-diffusion (η = 1: c_φ = 1/4, c_E = 1/2,
+    // A = 1) and compared to 1e-12: a wrong depth, D, boundary or prefactor fails. (The former
+    // test only asked the ratio to PBD to lie in 0.7–1.3, which such errors could pass.)
+    use std::f64::consts::PI;
     let bd = family(ProfileModel::BetterDipole, Scattering::Multiple, 1.0);
-    let pbd = family(ProfileModel::Pbd, Scattering::Multiple, 1.0);
-    let (a, b) = (
-        bd.profile(0.01, 1.0).unwrap(),
-        pbd.profile(0.01, 1.0).unwrap(),
-    );
-    for r in [2.0, 5.0, 10.0] {
-        let q = a.eval(r) / b.eval(r);
-        assert!((0.7..1.3).contains(&q), "r={r}: ratio {q}");
+    for (sa, ss) in [(0.01, 1.0), (0.3, 0.7), (0.0, 2.0)] {
+        let p = bd.profile(sa, ss).unwrap();
+        let stp = sa + ss;
+        let alpha = ss / stp;
+        let d_g = (2.0 * sa + ss) / (3.0 * stp * stp);
+        let s = (sa / d_g).sqrt();
+        let (cphi, ce, a) = (0.25, 0.5, 1.0);
+        let zr = 1.0 / stp;
+        let zv = -(zr + 4.0 * a * d_g);
+        for r in [0.0, 0.1, 1.0, 2.0, 5.0, 10.0] {
+            let dr = (r * r + zr * zr).sqrt();
+            let dv = (r * r + zv * zv).sqrt();
+            let phi = ((-s * dr).exp() / dr - (-s * dv).exp() / dv) / (4.0 * PI * d_g);
+            let en = (zr * (1.0 + s * dr) * (-s * dr).exp() / dr.powi(3)
+                - zv * (1.0 + s * dv) * (-s * dv).exp() / dv.powi(3))
+                / (4.0 * PI);
+            let want = alpha * alpha * (cphi * phi + ce * en);
+            assert!(
+                rel(p.eval(r), want) < 1e-12,
+                "({sa},{ss}) r={r}: {} vs {want}",
+                p.eval(r)
+            );
+        }
     }
 }
 
