@@ -61,8 +61,10 @@ impl Scale {
         beam_photons: 1 << 14,
         beam_subsamples: 1,
         slab_resolution: 12,
-        slab_spp: 2,
-        slab_reference_spp: 4,
+        // Enough for the integration test to compare the path tracer with its reference at a
+        // few % (still well under a second).
+        slab_spp: 32,
+        slab_reference_spp: 128,
         converge_max_spp: 2,
         converge_max_photons: 1 << 16,
         converge_max_subsamples: 1,
