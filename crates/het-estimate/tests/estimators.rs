@@ -308,12 +308,12 @@ fn nonlinear_field_matches_quadrature_in_every_channel() {
     let channel = |c: Coefficients, k: usize| [c.sigma_a[k], c.sigma_s[k]];
     let seeds = 32u64;
     let check = |name: &str, ests: &[Estimate], want: &[[f64; 2]; 3]| {
-        for k in 0..3 {
+        for (k, want_k) in want.iter().enumerate() {
             for (j, coef) in ["σa", "σs"].iter().enumerate() {
                 let vals: Vec<f64> = ests.iter().map(|e| channel(e.coefficients, k)[j]).collect();
                 let (mean, sd) = mean_sd(&vals);
                 let se = sd / (seeds as f64).sqrt();
-                let w = want[k][j];
+                let w = want_k[j];
                 assert!(
                     (mean - w).abs() < 4.0 * se + 1e-4 * w,
                     "{name} channel {k} {coef}: {mean} ± {se}, quadrature {w}"
@@ -374,16 +374,15 @@ fn nonlinear_field_matches_quadrature_in_every_channel() {
             .map(|s| run(Estimator::Sone(p), 0.0, &Plane, &field, &x_i, &x_o, s))
             .collect();
         check(&format!("sone {semi:?}"), &ests, &want);
-        for k in 0..3 {
+        for (k, want_w) in widths.iter().enumerate() {
             let ws: Vec<f64> = ests
                 .iter()
                 .map(|e| e.diagnostics.width.unwrap()[k])
                 .collect();
             let (mw, _) = mean_sd(&ws);
             assert!(
-                (mw - widths[k]).abs() < 0.02 * widths[k],
-                "channel {k}: width {mw} vs {}",
-                widths[k]
+                (mw - want_w).abs() < 0.02 * want_w,
+                "channel {k}: width {mw} vs {want_w}"
             );
         }
         assert!(
