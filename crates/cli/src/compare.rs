@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use tracer::experiment::metrics::{Metrics, compare, compare_films, log_ratio};
+use tracer::experiment::metrics::{Metrics, MetricsError, compare, compare_films, log_ratio};
 use tracer::film::Film;
 use tracer::output::read_exr;
 use tracer::plot::{MapPlot, MapScale, map_png};
@@ -65,13 +65,11 @@ fn compare_counted(
     min_counts: f64,
 ) -> anyhow::Result<Metrics> {
     if (test.width, test.height) != (reference.width, reference.height) {
-        bail!(
-            "the images differ in size: {}×{} against {}×{}",
-            test.width,
-            test.height,
-            reference.width,
-            reference.height
-        );
+        return Err(MetricsError::SizeMismatch {
+            test: (test.width, test.height),
+            reference: (reference.width, reference.height),
+        }
+        .into());
     }
     let extent = sidecar_number(reference_path, "/map/extent", "--min-counts")?;
     let photons = sidecar_number(reference_path, "/map/samples", "--min-counts")?;
@@ -98,15 +96,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(r) => bail!("--min-radius must be a finite number ≥ 0, got {r}"),
     };
     let m = match args.min_counts {
-        None => compare_films(&test, &reference, exclusion),
+        None => compare_films(&test, &reference, exclusion).map_err(anyhow::Error::from),
         Some(n) if n.is_finite() && n >= 0.0 => {
             let r = exclusion.map_or(0.0, |(r, _)| r);
-            return finish(
-                &args,
-                &test,
-                &reference,
-                compare_counted(&test, &reference, &args.reference, r, n)?,
-            );
+            compare_counted(&test, &reference, &args.reference, r, n)
         }
         Some(n) => bail!("--min-counts must be a finite number ≥ 0, got {n}"),
     }
