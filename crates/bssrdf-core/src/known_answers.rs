@@ -228,25 +228,14 @@ fn better_dipole_is_pbd_integrand_at_one_depth() {
     // boundary. Typed here from docs/physics.md#beam-diffusion (η = 1: c_φ = 1/4, c_E = 1/2,
     // A = 1) and compared to 1e-12: a wrong depth, D, boundary or prefactor fails. (The former
     // test only asked the ratio to PBD to lie in 0.7–1.3, which such errors could pass.)
-    use std::f64::consts::PI;
     let bd = family(ProfileModel::BetterDipole, Scattering::Multiple, 1.0);
     for (sa, ss) in [(0.01, 1.0), (0.3, 0.7), (0.0, 2.0)] {
         let p = bd.profile(sa, ss).unwrap();
         let stp = sa + ss;
         let alpha = ss / stp;
         let d_g = (2.0 * sa + ss) / (3.0 * stp * stp);
-        let s = (sa / d_g).sqrt();
-        let (cphi, ce, a) = (0.25, 0.5, 1.0);
-        let zr = 1.0 / stp;
-        let zv = -(zr + 4.0 * a * d_g);
         for r in [0.0, 0.1, 1.0, 2.0, 5.0, 10.0] {
-            let dr = (r * r + zr * zr).sqrt();
-            let dv = (r * r + zv * zv).sqrt();
-            let phi = ((-s * dr).exp() / dr - (-s * dv).exp() / dv) / (4.0 * PI * d_g);
-            let en = (zr * (1.0 + s * dr) * (-s * dr).exp() / dr.powi(3)
-                - zv * (1.0 + s * dv) * (-s * dv).exp() / dv.powi(3))
-                / (4.0 * PI);
-            let want = alpha * alpha * (cphi * phi + ce * en);
+            let want = alpha * alpha * pbd_source_exitance(r, 1.0 / stp, d_g, sa);
             assert!(
                 rel(p.eval(r), want) < 1e-12,
                 "({sa},{ss}) r={r}: {} vs {want}",
@@ -285,25 +274,32 @@ fn pbd_far_field_decays_at_grosjean_sigma_tr() {
 /// Independent brute-force PBD-MS at optical radius `x` (η = 1, g = 0, σt' = 1): composite
 /// Simpson in `ln z` with 40 000 intervals over z ∈ [1e-9, 60], formulas typed from docs/physics.md#beam-diffusion.
 fn pbd_ms_brute(x: f64, alpha: f64) -> f64 {
-    use std::f64::consts::PI;
     let (sa, ssp) = (1.0 - alpha, alpha);
     let st = sa + ssp;
     let d_g = (2.0 * sa + ssp) / (3.0 * st * st);
-    let str_ = (sa / d_g).sqrt();
-    let (cphi, ce, a) = (0.25, 0.5, 1.0);
     let f = |z: f64| {
-        let zv = -z - 4.0 * a * d_g;
         let dr = (x * x + z * z).sqrt();
-        let dv = (x * x + zv * zv).sqrt();
-        let phi = ((-str_ * dr).exp() / dr - (-str_ * dv).exp() / dv) / (4.0 * PI * d_g);
-        let en = (z * (1.0 + str_ * dr) * (-str_ * dr).exp() / dr.powi(3)
-            - zv * (1.0 + str_ * dv) * (-str_ * dv).exp() / dv.powi(3))
-            / (4.0 * PI);
         let kappa = 1.0 - (-2.0 * st * (dr + z)).exp();
         let rho = ssp / st;
-        rho * rho * st * (-st * z).exp() * kappa * (cphi * phi + ce * en)
+        rho * rho * st * (-st * z).exp() * kappa * pbd_source_exitance(x, z, d_g, sa)
     };
     crate::test_util::simpson_log(f, 1e-9, 60.0, 40_000)
+}
+
+/// c_φ φ_D + c_E E_n of docs/physics.md#beam-diffusion for one source at depth `z`, at radius
+/// `r`, with Grosjean's `d_g`, absorption `sa` and η = 1 (c_φ = 1/4, c_E = 1/2, A = 1).
+fn pbd_source_exitance(r: f64, z: f64, d_g: f64, sa: f64) -> f64 {
+    use std::f64::consts::PI;
+    let s = (sa / d_g).sqrt();
+    let (cphi, ce, a) = (0.25, 0.5, 1.0);
+    let zv = -z - 4.0 * a * d_g;
+    let dr = (r * r + z * z).sqrt();
+    let dv = (r * r + zv * zv).sqrt();
+    let phi = ((-s * dr).exp() / dr - (-s * dv).exp() / dv) / (4.0 * PI * d_g);
+    let en = (z * (1.0 + s * dr) * (-s * dr).exp() / dr.powi(3)
+        - zv * (1.0 + s * dv) * (-s * dv).exp() / dv.powi(3))
+        / (4.0 * PI);
+    cphi * phi + ce * en
 }
 
 #[test]

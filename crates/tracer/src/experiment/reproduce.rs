@@ -190,7 +190,9 @@ pub fn reproduce(
         "## Figure 4: a pencil beam in a textured half-space\n\nσs = 1, isotropic, η = 1, multiple \
          scattering only; σa = 0.005 / 0.1 (stripes at 45° or checks, width 4). Maps cover \
          [−15, 15]², {n} × {n} pixels; the reference is light tracing with {p} photons. Errors \
-         ignore pixels within 1 unit of the beam (the singular peak).\n",
+         ignore pixels within 1 unit of the beam (the singular peak). These are one seed's \
+         numbers: differences between estimators smaller than the seed-to-seed spread (the \
+         README's Figure 4 tables give it over 4 seeds) mean nothing.\n",
         n = scale.beam_resolution,
         p = scale.beam_photons
     );
