@@ -6,7 +6,10 @@
 //! translucent object:
 //! * [`Method::PathTraced`]: the path refracts in and performs the volumetric random walk
 //!   ([`super::walk`]), with next-event estimation at every real scattering vertex through
-//!   index-matched boundaries (shadow transmittance by ratio tracking);
+//!   index-matched boundaries (shadow transmittance by ratio tracking). A walk that crosses an
+//!   index-matched medium without scattering keeps the MIS vertex before the medium, and a
+//!   shadow ray through a medium classifies its light as having entered one, so that both
+//!   strategies weight and classify the same light path alike (`docs/physics.md#path-tracer`);
 //! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
 //!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
 //!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
