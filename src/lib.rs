@@ -3,5 +3,11 @@
 #![deny(missing_docs)]
 
 pub use bssrdf_core;
+
+/// The physics the code implements: formulas, sources, units, conventions and the known-answer
+/// values the tests use (the repository's `docs/physics.md`, which doc comments across the
+/// workspace cite as `docs/physics.md#section`).
+#[doc = include_str!("../docs/physics.md")]
+pub mod physics {}
 pub use het_estimate;
 pub use tracer;

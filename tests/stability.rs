@@ -78,13 +78,13 @@ fn sweep_harness_reports_violations_with_inputs() {
 }
 
 /// Values the sweep relies on are the profiles' own limits: at r = 0 the classical dipole is
-/// finite and equal to its closed form (JMLH01, notes §1) at σa = 0, σs' = 1, A = 1, where
+/// finite and equal to its closed form (JMLH01, docs/physics.md#dipole) at σa = 0, σs' = 1, A = 1, where
 /// R(0) = (1/4π)[z_r(1)/z_r³ + z_v/z_v³] with z_r = 1, z_v = 1 + 4/3, so the r = 0 end of
 /// the sweep is a real value and not a clamp artefact.
 #[test]
 fn dipole_at_r_zero_matches_its_closed_form() {
     let fam = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
-    // η = 1 with the default Egan–Hilgeman F_dr: A = 1.003205 (notes §0); use the family's A.
+    // η = 1 with the default Egan–Hilgeman F_dr: A = 1.003205 (docs/physics.md#fresnel); use the family's A.
     let a = fam.a_dipole();
     let p = fam.profile(0.0, 1.0).unwrap();
     let (zr, zv) = (1.0f64, 1.0 + 4.0 * a / 3.0);

@@ -2,6 +2,7 @@
 
 mod common;
 mod fuzz_regressions;
+mod index_matched;
 mod integrators;
 mod precision;
 mod stability;

@@ -171,9 +171,9 @@ fn stripe_beam_map_has_the_texture_symmetries() {
                 }
             }
         }
-        // Wilson–Hilferty upper 0.001 quantile of χ²(dof).
-        let k = dof as f64;
-        let crit = k * (1.0 - 2.0 / (9.0 * k) + 3.09 * (2.0 / (9.0 * k)).sqrt()).powi(3);
+        // Upper quantile of χ²(dof), the two mirrors Šidák-corrected to family level 1e-4.
+        let level = bssrdf_core::chi_square::ChiSquareTest::family(1e-4, 2).level();
+        let crit = bssrdf_core::chi_square::critical(dof, level);
         assert!(dof > 50, "{name}: too few pairs ({dof})");
         assert!(
             chi2 < crit,

@@ -3,7 +3,7 @@
 //! `1/H(μ) = √(1−ϖ) + (ϖ/2) ∫₀¹ μ' H(μ') / (μ + μ') dμ'` on Gauss–Legendre nodes, whose nodes
 //! and weights are themselves computed by Newton's method on the Legendre polynomials.
 //!
-//! Exact results built on it (physics notes §6): the plane albedo of a half-space at normal
+//! Exact results built on it (docs/physics.md#half-space): the plane albedo of a half-space at normal
 //! incidence `A = 1 − H(1)·√(1−ϖ)`, the single-scattering part `(ϖ/2)(1 − ln 2)`, and the
 //! multiple-scattering part `A − R_ss`.
 
@@ -104,7 +104,7 @@ fn h_function_satisfies_its_zeroth_moment_identity() {
 
 #[test]
 fn h_function_matches_the_notes_independent_values() {
-    // H(1) computed outside this repository (physics notes §6, two independent methods).
+    // H(1) computed outside this repository (docs/physics.md#half-space, two independent methods).
     for (omega, h1) in [(0.5, 1.25125956), (0.9, 1.85009852), (0.99, 2.47279283)] {
         assert!(
             (h(omega, 1.0) - h1).abs() < 2e-8,

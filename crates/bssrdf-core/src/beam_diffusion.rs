@@ -1,5 +1,5 @@
 //! Photon beam diffusion, multiple-scattering term (HCJ13, as implemented in pbrt-v3/v4
-//! `BeamDiffusionMS`; physics notes §2).
+//! `BeamDiffusionMS`; docs/physics.md#beam-diffusion).
 //!
 //! # Model
 //! A pencil beam at normal incidence is replaced by a line of isotropic first-scatter sources
@@ -15,7 +15,7 @@
 //!
 //! # Quadrature (deviation from pbrt, on purpose)
 //! pbrt sums 100 stratified midpoints of the exponential depth distribution; that rule is
-//! 5 % off at `r = 0.001` (notes §2). Here, in optical units `x = σt' r`, `ζ = σt' z`, the
+//! 5 % off at `r = 0.001` (docs/physics.md#beam-diffusion). Here, in optical units `x = σt' r`, `ζ = σt' z`, the
 //! integral `∫₀^∞ e^{−ζ} H(ζ) dζ` is split into
 //! * `ζ ∈ [0, 2]`: the integrand has a feature of width `x` and, for `x ≪ 1`, a `1/ζ`
 //!   shoulder for `x ≪ ζ ≪ 1` (the source of the logarithmic divergence at `r → 0`), so it is
@@ -23,17 +23,17 @@
 //!   Gauss–Legendre panels of width ≤ 2 in `w` (`⌈ln(1 + 2/c)/2⌉` panels);
 //! * `ζ ∈ [2, ∞)`: 16-point Gauss–Laguerre, the integrand being smooth on the unit scale.
 //!
-//! This reproduces the notes' adaptive-quadrature ("int") values to < 5e-7 relative at
+//! This reproduces the adaptive-quadrature ("exact") values of docs/physics.md#beam-diffusion to < 5e-7 relative at
 //! `rσt ≥ 0.1` and a brute-force depth integral to < 1e-5 at `rσt = 0.01` (unit tests), with
 //! 24 (`x ≥ 1`) to 40 (`x = 0.01`) integrand evaluations per `eval` (≈ 1.3–3.3 µs). The totals agree with
-//! the notes' totals for pbrt's 100-sample rule (0.05124, 0.33613, 0.68920, 0.85238 for
+//! the totals listed there for pbrt's 100-sample rule (0.05124, 0.33613, 0.68920, 0.85238 for
 //! ϖ = 0.5 … 0.999) to the 5 digits given: that rule's error sits at `rσt < 0.1`, where little
 //! energy is.
 //!
 //! # Units, validity, extremes
 //! `r` in length, `MS` in 1/length²; `MS(r) = σt'² MS₁(σt' r)`. The model overshoots the exact
-//! half-space albedo by 12–33 % (notes §2), so do not expect `total ≤ 1` near `α' = 1`.
-//! At `r → 0` it diverges like `ln(1/r)` (notes §7); `eval` evaluates at
+//! half-space albedo by 12–33 % (docs/physics.md#beam-diffusion), so do not expect `total ≤ 1` near `α' = 1`.
+//! At `r → 0` it diverges like `ln(1/r)` (docs/physics.md#hazards); `eval` evaluates at
 //! `max(r, 1e-6/σt')`, i.e. returns the finite value at one millionth of a reduced mean free
 //! path for smaller radii (`2πr·MS → 0` there, so no energy is affected). `σa = 0` gives an
 //! algebraic tail. `total` and `radius_for_fraction` are numerical (≈ 0.4 ms); the renderer

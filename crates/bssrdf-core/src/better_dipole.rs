@@ -2,17 +2,17 @@
 //!
 //! # Sources and status
 //! The primary note was **not** available to us. The formulas below were pinned down from two
-//! independent secondary sources that agree with each other and with physics notes §8:
+//! independent secondary sources that agree with each other and with docs/physics.md#better-dipole:
 //! (i) appleseed's `betterdipolebssrdf.cpp` (profile) and `sss.cpp` `ComputeRdBetterDipole`,
 //! which cite the note and Hery's *Texturing the Better Dipole* (Pixar) for the total; (ii) a
 //! second open implementation of the profile (Frisvad group's GPU code). Both give the
-//! profile as photon beam diffusion's depth integrand (HCJ13 / notes §2) evaluated at the
+//! profile as photon beam diffusion's depth integrand (HCJ13 / docs/physics.md#beam-diffusion) evaluated at the
 //! single depth `z_r = 1/σt'`, without the near-source correction κ. We derived the total
 //! below from the profile ourselves and it matches Hery's closed form, which cross-checks
 //! the profile's normalisation (the `α'²` prefactor). One discrepancy between the sources:
 //! appleseed evaluates the exponential decay with the classical `σtr = √(3σaσt')` while its
 //! own total uses Grosjean's; we use Grosjean's `σtr = √(σa/D_G)` consistently (as the second
-//! implementation and the total do). Treat as unverified (notes tag \[U\]) until checked against the note.
+//! implementation and the total do). Treat as unverified (\[unchecked\] in docs/physics.md#better-dipole) until checked against the note.
 //!
 //! # Model (optical units `x = σt' r`, lengths in 1/σt')
 //! Grosjean's diffusion coefficient `D = (2σa + σs')/(3σt'²)`, `σtr = √(σa/D)`; modified

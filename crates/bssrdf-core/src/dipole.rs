@@ -1,5 +1,5 @@
 //! Classical dipole diffusion profile (JMLH01, the dipole-diffusion section: the `R_d(r)` and
-//! `S_d` equations; physics notes §1).
+//! `S_d` equations; docs/physics.md#dipole).
 //!
 //! # Model
 //! With reduced coefficients `σs' = (1 − g)σs`, `σt' = σa + σs'`, `α' = σs'/σt'`:
@@ -11,12 +11,12 @@
 //! `R_d(r) = (α'/4π)·[z_r(1+σtr d_r)e^{−σtr d_r}/d_r³ + z_v(1+σtr d_v)e^{−σtr d_v}/d_v³]`,
 //! `d_{r,v} = √(r² + z_{r,v}²)`.
 //!
-//! Total diffuse reflectance (closed form, notes §1 \[D\], also Jensen & Buhler 2002):
+//! Total diffuse reflectance (closed form, docs/physics.md#dipole \[derived\], also Jensen & Buhler 2002):
 //! `R_d,tot = (α'/2)·e^{−√(3(1−α'))}·(1 + e^{−(4/3)A√(3(1−α'))})`.
 //!
 //! # Units and scaling
 //! `r` in scene length, `R_d` in 1/length². Internally the profile is evaluated in optical
-//! units `x = σt' r` and scaled: `R_d(r) = σt'² R₁(σt' r)` (notes §0).
+//! units `x = σt' r` and scaled: `R_d(r) = σt'² R₁(σt' r)` (docs/physics.md#conventions).
 //!
 //! # Validity and extremes
 //! Diffusion theory: accurate for `α'` near 1 and `r` beyond a few mean free paths; it

@@ -2,26 +2,26 @@
 //! (dE12): a real point source at depth `z_r` and a negative image at height `z_v` above the
 //! surface, observed on the surface at distance `x` (all in optical units, see below).
 //!
-//! Profile (notes §1, §2 with a single depth):
+//! Profile (docs/physics.md#dipole, #beam-diffusion with a single depth):
 //! `R₁(x) = (1/4π)·[ k_φ (e^{−σ d_r}/d_r − e^{−σ d_v}/d_v)
 //!                 + k_E (z_r(1+σd_r)e^{−σd_r}/d_r³ + z_v(1+σd_v)e^{−σd_v}/d_v³) ]`,
 //! with `d_{r,v} = √(x² + z_{r,v}²)`. The first bracket is the fluence term, the second the
 //! normal flux of the pair (both image terms add because the image sits above the surface).
 //!
 //! Closed-form radial survival function, from `∫_x^∞ 2πr e^{−σd}/d dr = 2π e^{−σd(x)}/σ` and
-//! `∫_x^∞ 2πr z(1+σd)e^{−σd}/d³ dr = 2π z e^{−σd(x)}/d(x)` [D, notes §1]:
+//! `∫_x^∞ 2πr z(1+σd)e^{−σd}/d³ dr = 2π z e^{−σd(x)}/d(x)` [derived, docs/physics.md#dipole]:
 //! `S(x) = ½[ k_φ (e^{−σd_r} − e^{−σd_v})/σ + k_E (z_r e^{−σd_r}/d_r + z_v e^{−σd_v}/d_v) ]`,
 //! so the total is `S(0)` and radius sampling by inverting `S` is exact.
 //!
 //! Numerics: the fluence difference is written as `e^{−σd_r}[Δ/(d_r d_v) − expm1(−σΔ)/d_v]`
 //! with `Δ = d_v − d_r = (z_v² − z_r²)/(d_v + d_r)`, both terms non-negative, so there is no
-//! far-field cancellation (notes §7); `(1 − e^{−σΔ})/σ` has the finite limit `Δ` at `σ = 0`.
+//! far-field cancellation (docs/physics.md#hazards); `(1 − e^{−σΔ})/σ` has the finite limit `Δ` at `σ = 0`.
 
 use crate::profile::{TWO_PI, invert_survival, one_minus_exp_over};
 
 /// Implements [`crate::RadialProfile`] for a model that is a [`DipolePair`] in optical units
 /// (field `pair`) scaled to scene units by `scale` (σ of the optical unit): the scaling law
-/// `R(r) = scale² R₁(scale·r)` of notes §0, with exact sampling by inverting the survival
+/// `R(r) = scale² R₁(scale·r)` of docs/physics.md#conventions, with exact sampling by inverting the survival
 /// function.
 macro_rules! radial_profile_from_pair {
     ($model:ty) => {

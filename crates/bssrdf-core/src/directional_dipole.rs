@@ -4,7 +4,7 @@
 //!
 //! # Source and status
 //! Implemented from the authors' sample code as carried by `RoaldFre/mitsuba`
-//! `src/subsurface/dirpole.cpp` (physics notes §3); the paper's own notation was not checked
+//! `src/subsurface/dirpole.cpp` (docs/physics.md#directional-dipole); the paper's own notation was not checked
 //! (\[U\]). Differences from the sample code: the Fresnel moments are exact (quadrature) instead
 //! of the polynomial fits, and the degenerate modified normal falls back to `n_i`.
 //!
@@ -27,7 +27,7 @@
 //!
 //! # Validity and extremes
 //! Not energy-conserving in the near field (∫2πrM = 1.088 at σs = 1, σa = 0.01 against the
-//! exact 0.754; notes §3); within ~10 % of the classical dipole beyond ~5 mean free paths.
+//! exact 0.754; docs/physics.md#directional-dipole); within ~10 % of the classical dipole beyond ~5 mean free paths.
 //! `σs' = 0` (where `d_e → ∞`) and vacuum give 0; `σa = 0` gives `σtr = 0` (algebraic decay);
 //! `x_o = x_i` is finite (`d_r ≥ Dμ₀ > 0` or `1/(3σt)`, `d_v = 2A d_e`); the difference can go
 //! negative and is clamped at 0 like the sample code. Light arriving from below the surface
@@ -41,10 +41,10 @@ use std::f64::consts::PI;
 
 /// FHK14's modified normal `n_i* = x̂ × (n_i × x̂) / |n_i × x̂|`, with `x̂ = (x_o − x_i)/|x_o − x_i|`;
 /// equivalently `normalize(n_i − (n_i·x̂) x̂)`: `n_i` projected onto the plane perpendicular to
-/// the chord, so the plane through `x_i` with this normal also contains `x_o` (physics notes §3).
+/// the chord, so the plane through `x_i` with this normal also contains `x_o` (docs/physics.md#directional-dipole).
 ///
 /// Undefined when `x_o = x_i` or `n_i ∥ x̂`; in those cases (chord shorter than 1e-12 of the
-/// coordinates' scale, or `|n_i × x̂| < 1e-9`) it returns `n_i` normalised, as the notes advise.
+/// coordinates' scale, or `|n_i × x̂| < 1e-9`) it returns `n_i` normalised, as docs/physics.md#directional-dipole advises.
 /// `n_i` must be non-zero; the result is always a finite unit vector when it is.
 pub fn modified_normal(n_i: DVec3, x_i: DVec3, x_o: DVec3) -> DVec3 {
     let n = n_i.normalize_or(DVec3::Z);
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn spot_values_match_notes() {
-        // Notes §3 [C]: flat geometry, normal incidence, σs = 1, σa = 0.01, η = 1;
+        // docs/physics.md#directional-dipole [computed]: flat geometry, normal incidence, σs = 1, σa = 0.01, η = 1;
         // M = π(1 − 2C₁(1/η)) S_d.
         let m = DirectionalDipole::new(0.01, 1.0, 0.0, 1.0).unwrap();
         let fam = crate::ProfileFamily::new(

@@ -23,7 +23,7 @@ pub const SIGMA_EPSILON: f64 = 1e-12;
 /// Largest accepted coefficient (1/length); larger values are rejected as out of range.
 pub const SIGMA_MAX: f64 = 1e12;
 /// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
-/// |g| = 1 and `σs' = (1 − g)σs` degenerates; notes §7).
+/// |g| = 1 and `σs' = (1 − g)σs` degenerates; docs/physics.md#hazards).
 pub const G_MAX: f64 = 1.0 - 1e-6;
 /// Validated range of the relative index of refraction.
 pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
@@ -94,7 +94,7 @@ impl ProfileFamily {
                 value: eta,
             });
         }
-        // HG and the reduced coefficients degenerate at |g| = 1 (notes §7): clamp.
+        // HG and the reduced coefficients degenerate at |g| = 1 (docs/physics.md#hazards): clamp.
         let g = g.clamp(-G_MAX, G_MAX);
         let moments = FresnelMoments::new(eta)?;
         let f_dr = options.diffuse_fresnel.f_dr(&moments);

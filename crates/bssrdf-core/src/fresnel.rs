@@ -20,11 +20,11 @@ use crate::quadrature::{gl32, integrate};
 
 /// Fresnel moment `C_i(η) = ∫₀¹ F_r(μ; η) μ^i dμ` of the *exact* unpolarised dielectric
 /// reflectance, for light inside a medium of relative index `η = n_medium / n_outside` that hits
-/// the boundary with cosine `μ` (pbrt-v3 book §11.4.1; physics notes §0). For `η > 1` this
+/// the boundary with cosine `μ` (pbrt-v3 book §11.4.1; docs/physics.md#fresnel). For `η > 1` this
 /// includes total internal reflection below `μ_c = √(1 − 1/η²)`; the *external* moment (light
 /// arriving from outside) is `C_i(1/η)`. `2 C_1(η)` is the internal diffuse reflectance `F_dr`.
 ///
-/// Computed by quadrature (not pbrt's degree-5 fits, which break down above η ≈ 2.5, notes §0):
+/// Computed by quadrature (not pbrt's degree-5 fits, which break down above η ≈ 2.5, docs/physics.md#fresnel):
 /// the TIR part `μ_c^{i+1}/(i+1)` is exact; the rest is integrated over the cosine `t` of the
 /// transmitted direction, `μ = √(1 − (1 − t²)/η²)`, which removes the square-root edge at
 /// `μ_c`, with two 32-point Gauss–Legendre panels (error < 1e-12). For `η < 1` there is no TIR
@@ -112,7 +112,7 @@ impl FresnelMoments {
 
 /// Egan & Hilgeman's rational fit of the internal diffuse Fresnel reflectance, as used by JMLH01
 /// (`F_dr = −1.440/η² + 0.710/η + 0.668 + 0.0636 η`). Within 0.0016 of the exact `2C_1` for
-/// η ≤ 2.2, but 0.016 off at η = 3 and 0.0016 (not 0) at η = 1 (physics notes §0).
+/// η ≤ 2.2, but 0.016 off at η = 3 and 0.0016 (not 0) at η = 1 (docs/physics.md#fresnel).
 pub fn f_dr_egan_hilgeman(eta: f64) -> f64 {
     -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
 }
@@ -120,7 +120,7 @@ pub fn f_dr_egan_hilgeman(eta: f64) -> f64 {
 /// How the classical dipole obtains its diffuse Fresnel reflectance `F_dr` (and so its boundary
 /// coefficient `A = (1 + F_dr)/(1 − F_dr)`).
 ///
-/// Trade-off (physics notes §0): the fit reproduces JMLH01 exactly as published and is
+/// Trade-off (docs/physics.md#fresnel): the fit reproduces JMLH01 exactly as published and is
 /// within 0.0016 of the exact value for η ≤ 2.2, but it gives `A = 1.0032` instead of 1 at η = 1
 /// and `A = 29.99` instead of 23.87 at η = 3. `Exact` is correct over the whole η range and
 /// costs one quadrature per material.
@@ -150,7 +150,7 @@ mod tests {
 
     #[test]
     fn moments_match_independent_table() {
-        // Physics notes §0 [C]: η, C1, C2, C1(1/η), A_J, A_PBD.
+        // docs/physics.md#fresnel [computed]: η, C1, C2, C1(1/η), A_J, A_PBD.
         let table = [
             (1.30, 0.222230, 0.100090, 0.030565, 2.600079, 2.34053),
             (1.33, 0.235975, 0.109413, 0.032965, 2.787514, 2.51536),
@@ -201,7 +201,7 @@ mod tests {
 
     #[test]
     fn fit_matches_notes() {
-        // Notes §0: fit gives A = 1.0032 at η = 1 and ≈ 29.99 at η = 3.
+        // docs/physics.md#fresnel: fit gives A = 1.0032 at η = 1 and ≈ 29.99 at η = 3.
         let a = |f: f64| (1.0 + f) / (1.0 - f);
         assert!((a(f_dr_egan_hilgeman(1.0)) - 1.003205).abs() < 1e-5);
         assert!((a(f_dr_egan_hilgeman(3.0)) - 29.99).abs() < 0.01);

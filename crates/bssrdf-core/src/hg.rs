@@ -80,7 +80,7 @@ mod tests {
 
     #[test]
     fn mean_square_angle_matches_independent_values() {
-        // Values from the physics notes §5 [C], computed outside this repository.
+        // Values from docs/physics.md#path-width [computed], computed outside this repository.
         let table = [
             (-0.5, 5.161042),
             (0.0, 2.934802),
@@ -105,8 +105,8 @@ mod tests {
 
     /// Chi-square goodness of fit of `sample_cos_theta` against the closed-form HG CDF
     /// `P(μ ≤ c) = (1 − g²)/(2g) · [1/√(1 + g² − 2gc) − 1/(1 + g)]` (isotropic: (c + 1)/2),
-    /// 200,000 samples from a fixed-seed SplitMix64 into 40 bins of equal probability; the
-    /// critical value of χ²(39) at the 0.001 level is 72.05.
+    /// 200,000 samples from a fixed-seed SplitMix64 into 40 bins of equal probability; six
+    /// values of g at family-wise level 1e-4 (`crate::chi_square`).
     #[test]
     fn sampler_passes_chi_square_against_the_closed_form_cdf() {
         fn cdf(c: f64, g: f64) -> f64 {
@@ -123,7 +123,9 @@ mod tests {
             z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
             ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
         };
-        for g in [-0.9, -0.4, 0.0, 0.3, 0.8, 0.99] {
+        let gs = [-0.9, -0.4, 0.0, 0.3, 0.8, 0.99];
+        let test = crate::chi_square::ChiSquareTest::family(1e-4, gs.len() as u32);
+        for g in gs {
             let bins = 40;
             // Bin edges by bisection on the closed-form CDF.
             let edges: Vec<f64> = (0..=bins)
@@ -148,12 +150,8 @@ mod tests {
                 let k = edges.partition_point(|&e| e <= c).clamp(1, bins) - 1;
                 counts[k] += 1;
             }
-            let expected = n as f64 / bins as f64;
-            let chi2: f64 = counts
-                .iter()
-                .map(|&o| (o as f64 - expected).powi(2) / expected)
-                .sum();
-            assert!(chi2 < 72.05, "g = {g}: chi2 = {chi2}");
+            let r = test.check_uniform(&counts).unwrap();
+            assert!(r.passes(), "g = {g}: {r}");
         }
     }
 

@@ -1,4 +1,4 @@
-//! Known-answer tests: every expected number comes from the physics notes' independently
+//! Known-answer tests: every expected number comes from docs/physics.md's independently
 //! computed [C] values or from a closed form / brute-force computation written in the test.
 
 use crate::dipole::Dipole;
@@ -18,7 +18,7 @@ fn family(model: ProfileModel, sc: Scattering, eta: f64) -> ProfileFamily {
 
 #[test]
 fn dipole_spot_values_match_notes() {
-    // Notes §1 [C]: σs' = 1, σa = 0.01; A = 1 (η = 1, exact) and A = 2.60206 (η = 1.3 fit).
+    // docs/physics.md#dipole [computed]: σs' = 1, σa = 0.01; A = 1 (η = 1, exact) and A = 2.60206 (η = 1.3 fit).
     let spots = [
         (0.0, 9.315356e-2, 8.260529e-2),
         (0.5, 6.911931e-2, 5.945554e-2),
@@ -60,7 +60,7 @@ fn dipole_spot_values_match_notes() {
 
 #[test]
 fn dipole_total_closed_form_and_numeric() {
-    // Notes §1 [C] table of Rd_tot for α' ∈ {0.5, 0.9, 0.99, 0.999}.
+    // docs/physics.md#dipole [computed] table of Rd_tot for α' ∈ {0.5, 0.9, 0.99, 0.999}.
     let table = [
         (1.0, 1.0, [0.087808, 0.385584, 0.746714, 0.912451]),
         (1.0, 1.003205, [0.087733, 0.385291, 0.746469, 0.912348]),
@@ -97,7 +97,7 @@ fn dipole_total_closed_form_and_numeric() {
 
 #[test]
 fn pbd_spot_values_match_notes_int_column() {
-    // Notes §2 [C] "int" columns (adaptive quadrature of the exact integrals), η = 1, g = 0.
+    // docs/physics.md#beam-diffusion [computed] "exact" columns (adaptive quadrature of the exact integrals), η = 1, g = 0.
     let spots = [
         (1.0, 0.01, 0.1, 2.176604e-1, 4.731028e-1),
         (1.0, 0.01, 0.5, 6.978296e-2, 2.989089e-2),
@@ -128,7 +128,7 @@ fn pbd_spot_values_match_notes_int_column() {
 
 #[test]
 fn single_scattering_totals_are_exact() {
-    // (ϖ/2)(1 − ln 2) for η = 1, g = 0 (notes §2, §6), from the closed form and from a
+    // (ϖ/2)(1 − ln 2) for η = 1, g = 0 (docs/physics.md#beam-diffusion, #half-space), from the closed form and from a
     // brute-force radial integral of eval.
     let fam = family(ProfileModel::Pbd, Scattering::Single, 1.0);
     for w in [0.5, 0.9, 0.99, 0.999, 1.0] {
@@ -138,7 +138,7 @@ fn single_scattering_totals_are_exact() {
         let brute = brute_total(&p, 1e-6, 60.0);
         assert!(rel(brute, want) < 2e-5, "ϖ={w}: brute {brute} vs {want}");
     }
-    // HG single scattering at ϖ = 1 (notes §6 [D+C]).
+    // HG single scattering at ϖ = 1 (docs/physics.md#half-space [derived, computed]).
     for (g, want) in [
         (-0.5, 0.323800),
         (0.0, 0.153426),
@@ -164,7 +164,7 @@ fn single_scattering_totals_are_exact() {
 
 #[test]
 fn pbd_ms_totals_relate_to_notes() {
-    // Notes §2 [C]: PBD-MS totals with pbrt's 100-midpoint depth rule. Ours integrates the
+    // docs/physics.md#beam-diffusion [computed]: PBD-MS totals with pbrt's 100-midpoint depth rule. Ours integrates the
     // depth integral accurately; the rule's error is concentrated at r·σt < 0.1, which holds
     // little energy, so the totals still agree to the 5 digits given (±1e-5).
     let fam = family(ProfileModel::Pbd, Scattering::Multiple, 1.0);
@@ -223,18 +223,25 @@ fn better_dipole_total_matches_hery_formula_and_numeric() {
 
 #[test]
 fn better_dipole_is_pbd_integrand_at_one_depth() {
-    // dE12 as pinned down (see module docs): the PBD depth integrand without κ at z = 1/σt'.
-    // Far from the source κ → 1 and PBD's depth average is dominated by depths ~1/σt', so
-    // the two agree to within tens of % at a few mean free paths and both decay at σtr.
+    // dE12 as pinned down (see module docs and docs/physics.md#better-dipole): the PBD depth
+    // integrand without κ, at the single depth z_r = 1/σt', with Grosjean's D_G and the A_PBD
+    // boundary. Typed here from docs/physics.md#beam-diffusion (η = 1: c_φ = 1/4, c_E = 1/2,
+    // A = 1) and compared to 1e-12: a wrong depth, D, boundary or prefactor fails. (The former
+    // test only asked the ratio to PBD to lie in 0.7–1.3, which such errors could pass.)
     let bd = family(ProfileModel::BetterDipole, Scattering::Multiple, 1.0);
-    let pbd = family(ProfileModel::Pbd, Scattering::Multiple, 1.0);
-    let (a, b) = (
-        bd.profile(0.01, 1.0).unwrap(),
-        pbd.profile(0.01, 1.0).unwrap(),
-    );
-    for r in [2.0, 5.0, 10.0] {
-        let q = a.eval(r) / b.eval(r);
-        assert!((0.7..1.3).contains(&q), "r={r}: ratio {q}");
+    for (sa, ss) in [(0.01, 1.0), (0.3, 0.7), (0.0, 2.0)] {
+        let p = bd.profile(sa, ss).unwrap();
+        let stp = sa + ss;
+        let alpha = ss / stp;
+        let d_g = (2.0 * sa + ss) / (3.0 * stp * stp);
+        for r in [0.0, 0.1, 1.0, 2.0, 5.0, 10.0] {
+            let want = alpha * alpha * pbd_source_exitance(r, 1.0 / stp, d_g, sa);
+            assert!(
+                rel(p.eval(r), want) < 1e-12,
+                "({sa},{ss}) r={r}: {} vs {want}",
+                p.eval(r)
+            );
+        }
     }
 }
 
@@ -265,27 +272,34 @@ fn pbd_far_field_decays_at_grosjean_sigma_tr() {
 }
 
 /// Independent brute-force PBD-MS at optical radius `x` (η = 1, g = 0, σt' = 1): composite
-/// Simpson in `ln z` with 40 000 intervals over z ∈ [1e-9, 60], formulas typed from notes §2.
+/// Simpson in `ln z` with 40 000 intervals over z ∈ [1e-9, 60], formulas typed from docs/physics.md#beam-diffusion.
 fn pbd_ms_brute(x: f64, alpha: f64) -> f64 {
-    use std::f64::consts::PI;
     let (sa, ssp) = (1.0 - alpha, alpha);
     let st = sa + ssp;
     let d_g = (2.0 * sa + ssp) / (3.0 * st * st);
-    let str_ = (sa / d_g).sqrt();
-    let (cphi, ce, a) = (0.25, 0.5, 1.0);
     let f = |z: f64| {
-        let zv = -z - 4.0 * a * d_g;
         let dr = (x * x + z * z).sqrt();
-        let dv = (x * x + zv * zv).sqrt();
-        let phi = ((-str_ * dr).exp() / dr - (-str_ * dv).exp() / dv) / (4.0 * PI * d_g);
-        let en = (z * (1.0 + str_ * dr) * (-str_ * dr).exp() / dr.powi(3)
-            - zv * (1.0 + str_ * dv) * (-str_ * dv).exp() / dv.powi(3))
-            / (4.0 * PI);
         let kappa = 1.0 - (-2.0 * st * (dr + z)).exp();
         let rho = ssp / st;
-        rho * rho * st * (-st * z).exp() * kappa * (cphi * phi + ce * en)
+        rho * rho * st * (-st * z).exp() * kappa * pbd_source_exitance(x, z, d_g, sa)
     };
     crate::test_util::simpson_log(f, 1e-9, 60.0, 40_000)
+}
+
+/// c_φ φ_D + c_E E_n of docs/physics.md#beam-diffusion for one source at depth `z`, at radius
+/// `r`, with Grosjean's `d_g`, absorption `sa` and η = 1 (c_φ = 1/4, c_E = 1/2, A = 1).
+fn pbd_source_exitance(r: f64, z: f64, d_g: f64, sa: f64) -> f64 {
+    use std::f64::consts::PI;
+    let s = (sa / d_g).sqrt();
+    let (cphi, ce, a) = (0.25, 0.5, 1.0);
+    let zv = -z - 4.0 * a * d_g;
+    let dr = (r * r + z * z).sqrt();
+    let dv = (r * r + zv * zv).sqrt();
+    let phi = ((-s * dr).exp() / dr - (-s * dv).exp() / dv) / (4.0 * PI * d_g);
+    let en = (z * (1.0 + s * dr) * (-s * dr).exp() / dr.powi(3)
+        - zv * (1.0 + s * dv) * (-s * dv).exp() / dv.powi(3))
+        / (4.0 * PI);
+    cphi * phi + ce * en
 }
 
 #[test]
@@ -307,7 +321,7 @@ fn pbd_ms_small_radius_matches_brute_force() {
 
 #[test]
 fn single_scattering_matches_brute_force_at_small_and_large_radii() {
-    // Independent brute force of notes §2's SS integral (σt = 1), Simpson in ln(τ − τ_c).
+    // Independent brute force of docs/physics.md#beam-diffusion's SS integral (σt = 1), Simpson in ln(τ − τ_c).
     fn brute(x: f64, omega: f64, g: f64, eta: f64) -> f64 {
         let tc = x * (eta * eta - 1.0f64).sqrt();
         let f = |y: f64| {
@@ -336,7 +350,7 @@ fn single_scattering_matches_brute_force_at_small_and_large_radii() {
 
 #[test]
 fn profiles_obey_the_scaling_law() {
-    // Notes §0: R(r; kσa, kσs) = k² R(kr; σa, σs), and totals are scale-invariant.
+    // docs/physics.md#conventions: R(r; kσa, kσs) = k² R(kr; σa, σs), and totals are scale-invariant.
     for m in [
         ProfileModel::Dipole,
         ProfileModel::BetterDipole,

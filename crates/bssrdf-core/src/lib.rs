@@ -52,10 +52,14 @@
 //! ```
 //!
 //! References are keyed as in `docs/references.md` (JMLH01, HCJ13, dEI11, dE12, FHK14, …).
+//! The formulas, units, conventions and known-answer values are collected in the repository's
+//! `docs/physics.md` (rendered by `cargo doc` as `het_bssrdf::physics`); doc comments cite its
+//! sections as `docs/physics.md#section`.
 #![deny(missing_docs)]
 
 pub mod beam_diffusion;
 pub mod better_dipole;
+pub mod chi_square;
 pub mod dipole;
 mod dipole_pair;
 pub mod directional_dipole;

@@ -1,8 +1,10 @@
 //! Statistical tests of every radius sampler: chi-square (fixed seed, 2·10⁵ samples, bins
-//! pooled to expected ≥ 5, significance 1e-3 via Wilson–Hilferty) of `sample_r` against
+//! pooled to expected ≥ 5, family-wise significance 1e-4 per test function with the Šidák
+//! correction, [`crate::chi_square`]) of `sample_r` against
 //! `pdf_r`, whose bin probabilities are integrated independently (Simpson); plus exactness
 //! checks of the densities and a negative control showing the test can fail.
 
+use crate::chi_square::ChiSquareTest;
 use crate::family::ProfileFamily;
 use crate::model::{ProfileModel, Scattering};
 use crate::profile::RadialProfile;
@@ -12,13 +14,18 @@ use std::f64::consts::PI;
 
 const N: usize = 200_000;
 
-fn assert_chi2(name: &str, p: &impl RadialProfile, sigma_t: f64, seed: u64) {
-    let (stat, crit, dof) = chi_square(p, |r| p.pdf_r(r), 1e-3 / sigma_t, 1e3 / sigma_t, N, seed);
-    assert!(
-        stat < crit,
-        "{name}: χ² = {stat:.1} > {crit:.1} (dof {dof})"
+fn assert_chi2(name: &str, test: ChiSquareTest, p: &impl RadialProfile, sigma_t: f64, seed: u64) {
+    let r = chi_square(
+        test,
+        p,
+        |r| p.pdf_r(r),
+        1e-3 / sigma_t,
+        1e3 / sigma_t,
+        N,
+        seed,
     );
-    assert!(dof >= 20, "{name}: too few bins ({dof})");
+    assert!(r.passes(), "{name}: {r}");
+    assert!(r.dof >= 20, "{name}: too few bins ({})", r.dof);
 }
 
 fn fam(model: ProfileModel, sc: Scattering, g: f64, eta: f64) -> ProfileFamily {
@@ -64,10 +71,12 @@ fn model_samplers_pass_chi_square() {
         (ProfileModel::Pbd, Scattering::All, 0.0, 1.0, 0.1, 0.9),
         (ProfileModel::Dipole, Scattering::All, -0.3, 1.2, 0.02, 4.0),
     ];
+    let test = ChiSquareTest::family(1e-4, cases.len() as u32);
     for (k, (m, sc, g, eta, sa, ss)) in cases.into_iter().enumerate() {
         let p = fam(m, sc, g, eta).profile(sa, ss).unwrap();
         assert_chi2(
             &format!("{m} {sc} g={g} η={eta}"),
+            test,
             &p,
             sa + ss,
             1000 + k as u64,
@@ -104,15 +113,25 @@ fn chi_square_detects_a_wrong_density() {
     let f = fam(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0);
     let sampler = f.profile(0.1, 0.9).unwrap();
     let other = f.profile(0.2, 0.8).unwrap();
-    let (stat, crit, _) = chi_square(&sampler, |r| other.pdf_r(r), 1e-3, 1e3, N, 7);
+    let r = chi_square(
+        ChiSquareTest::SINGLE,
+        &sampler,
+        |r| other.pdf_r(r),
+        1e-3,
+        1e3,
+        N,
+        7,
+    );
     assert!(
-        stat > crit,
-        "the chi-square test must reject a wrong density ({stat} ≤ {crit})"
+        !r.passes(),
+        "the chi-square test must reject a wrong density ({r})"
     );
 }
 
 #[test]
 fn table_samplers_pass_chi_square_and_are_consistent() {
+    // 3 families × 3 coefficient pairs.
+    let test = ChiSquareTest::family(1e-4, 9);
     for (k, (m, sc, g, eta)) in [
         (ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3),
         (ProfileModel::Pbd, Scattering::All, 0.5, 1.0),
@@ -132,6 +151,7 @@ fn table_samplers_pass_chi_square_and_are_consistent() {
             let st = sa + ss;
             assert_chi2(
                 &format!("table {m} {sc} ({sa},{ss})"),
+                test,
                 &s,
                 st,
                 77 + 10 * k as u64 + j as u64,

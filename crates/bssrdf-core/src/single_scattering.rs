@@ -1,5 +1,5 @@
 //! Single-scattering radial profile of photon beam diffusion (HCJ13 as in pbrt-v3/v4
-//! `BeamDiffusionSS`; physics notes §2). Usable with every model through
+//! `BeamDiffusionSS`; docs/physics.md#beam-diffusion). Usable with every model through
 //! [`crate::Scattering`].
 //!
 //! # Model
@@ -12,12 +12,12 @@
 //! `p_HG(−μ)` is Henyey–Greenstein at the physical scattering cosine (backscatter towards the
 //! exit point; pbrt writes it as `HenyeyGreenstein(t/d, g)` in its opposite sign convention),
 //! `F_r(μ; η)` the exact dielectric reflectance for light inside hitting the boundary. For
-//! `η = 1` this is the exact single-scattering exitance of a half-space (notes §6); for
+//! `η = 1` this is the exact single-scattering exitance of a half-space (docs/physics.md#half-space); for
 //! `η > 1` it neglects the refraction of the incident beam, like pbrt.
 //!
 //! Total (derived here by integrating over the exit plane in polar coordinates around the
 //! scattering point): `SS_tot = 2πϖ ∫_{μ_c}^1 p_HG(−μ)(1 − F_r(μ))·μ/(1+μ) dμ`, which is
-//! `(ϖ/2)(1 − ln 2)` for `η = 1`, `g = 0` (notes §6). It is evaluated in the HG CDF variable
+//! `(ϖ/2)(1 − ln 2)` for `η = 1`, `g = 0` (docs/physics.md#half-space). It is evaluated in the HG CDF variable
 //! (so that strongly peaked phase functions are integrated exactly) with a square-root
 //! substitution at the TIR edge, 64 Gauss–Legendre nodes.
 //!
@@ -26,7 +26,7 @@
 //! the multiple-scattering term ([`crate::beam_diffusion`]): `y ∈ [0, 1]` in
 //! `w = ln(1 + y/min(x, 1))` (first panel square-root substituted for the TIR edge), then
 //! Gauss–Laguerre. The factor `e^{−x}` is taken out (`d − x = τ²/(d + x)`), so large `r`
-//! underflows cleanly. Reproduces the notes' "int" values to < 1e-5 relative for `rσt ≥ 0.01`.
+//! underflows cleanly. Reproduces the "exact" values of docs/physics.md#beam-diffusion to < 1e-5 relative for `rσt ≥ 0.01`.
 //!
 //! # Units and extremes
 //! `SS` in 1/length²; `SS(r) = σt² SS₁(σt r)` with `ϖ = σs/σt`. Diverges like `σs/(4πr)` as

@@ -131,7 +131,7 @@ fn limits_are_finite_for_every_model() {
 
 #[test]
 fn divergent_terms_have_finite_values_at_zero() {
-    // PBD-MS ~ ln(1/r) and SS ~ 1/r as r → 0 (notes §7): eval(0) is the documented cap
+    // PBD-MS ~ ln(1/r) and SS ~ 1/r as r → 0 (docs/physics.md#hazards): eval(0) is the documented cap
     // (the value at 1e-6 mean free paths), and 2πr·R stays finite (→ σs/2 for SS, η = 1).
     let fam = ProfileFamily::new(ProfileModel::Pbd, Scattering::Single, 0.0, 1.0).unwrap();
     let p = fam.profile(0.0, 1.0).unwrap();

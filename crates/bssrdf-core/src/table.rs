@@ -4,7 +4,7 @@
 //!
 //! # Layout
 //! Everything is in optical units of the reduced extinction (`x = σt' r`), using the scaling
-//! law `R(r; kσ) = k² R(kr; σ)` (notes §0); for a fixed `g` a profile in these units depends
+//! law `R(r; kσ) = k² R(kr; σ)` (docs/physics.md#conventions); for a fixed `g` a profile in these units depends
 //! only on the reduced albedo `α'` (the single-scattering albedo `ϖ = α'/(1 − g + gα')` and
 //! `σt/σt' = 1/(1 − gϖ)` follow from it).
 //! * Rows: 48 reduced albedos uniform in `s = √(1 − α')` (dense near `α' = 1`, where the

@@ -2,6 +2,7 @@
 //! Test helpers: a tiny deterministic RNG, an independent brute-force radial integrator and a
 //! chi-square goodness-of-fit test for radius samplers.
 
+use crate::chi_square::{ChiSquare, ChiSquareTest};
 use crate::profile::RadialProfile;
 
 /// SplitMix64 (Steele, Lea & Flood 2014): deterministic, good enough for tests.
@@ -54,26 +55,19 @@ pub fn brute_total(p: &impl RadialProfile, lo: f64, hi: f64) -> f64 {
     )
 }
 
-/// Upper critical value of χ²(k) at significance `alpha` = 1e-3 (Wilson–Hilferty).
-pub fn chi2_critical_1e3(k: usize) -> f64 {
-    let k = k as f64;
-    let z = 3.090_232; // Φ⁻¹(1 − 1e-3)
-    let a = 2.0 / (9.0 * k);
-    k * (1.0 - a + z * a.sqrt()).powi(3)
-}
-
 /// Chi-square test of `sampler.sample_r` against the density `pdf` over radius bins
 /// geometric between `lo` and `hi` (plus the two open ends), bins pooled until the expected
-/// count is ≥ 5. Expected bin probabilities come from integrating `pdf` (Simpson, not the
-/// sampler's CDF). Returns (statistic, critical value at 1e-3, degrees of freedom).
+/// count is ≥ 5 ([`crate::chi_square`]). Expected bin probabilities come from integrating
+/// `pdf` (Simpson, not the sampler's CDF).
 pub fn chi_square(
+    test: ChiSquareTest,
     sampler: &impl RadialProfile,
     pdf: impl Fn(f64) -> f64,
     lo: f64,
     hi: f64,
     n_samples: usize,
     seed: u64,
-) -> (f64, f64, usize) {
+) -> ChiSquare {
     let nb = 60;
     let mut edges = vec![0.0];
     for k in 0..=nb {
@@ -104,7 +98,7 @@ pub fn chi_square(
     let inner: f64 = expected.iter().sum();
     expected.push((1.0 - inner).max(0.0));
     edges.push(f64::INFINITY);
-    let mut counts = vec![0usize; expected.len()];
+    let mut counts = vec![0u64; expected.len()];
     let mut rng = Rng::new(seed);
     for _ in 0..n_samples {
         let r = sampler.sample_r(rng.uniform()).expect("non-zero profile");
@@ -115,24 +109,7 @@ pub fn chi_square(
             .min(counts.len() - 1);
         counts[k] += 1;
     }
-    // Pool adjacent bins to expected ≥ 5.
     let n = n_samples as f64;
-    let mut pooled: Vec<(f64, f64)> = Vec::new();
-    let (mut e_acc, mut c_acc) = (0.0, 0.0);
-    for (e, c) in expected.iter().zip(&counts) {
-        e_acc += e * n;
-        c_acc += *c as f64;
-        if e_acc >= 5.0 {
-            pooled.push((e_acc, c_acc));
-            e_acc = 0.0;
-            c_acc = 0.0;
-        }
-    }
-    if let Some(last) = pooled.last_mut() {
-        last.0 += e_acc;
-        last.1 += c_acc;
-    }
-    let stat: f64 = pooled.iter().map(|(e, c)| (c - e) * (c - e) / e).sum();
-    let dof = pooled.len() - 1;
-    (stat, chi2_critical_1e3(dof), dof)
+    let expected: Vec<f64> = expected.iter().map(|p| p * n).collect();
+    test.check(&counts, &expected).expect("enough bins")
 }

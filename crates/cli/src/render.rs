@@ -118,6 +118,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         png.display(),
         json.display()
     );
+    let px = outcome.film.pixels.len().max(1) as f64;
+    let mean: [f64; 3] =
+        std::array::from_fn(|c| outcome.film.pixels.iter().map(|p| p[c]).sum::<f64>() / px);
+    eprintln!(
+        "mean pixel value (R, G, B): {:.6}, {:.6}, {:.6}",
+        mean[0], mean[1], mean[2]
+    );
     for w in &outcome.warnings {
         eprintln!("warning: {w}");
     }

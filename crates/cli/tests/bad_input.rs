@@ -531,6 +531,22 @@ fn compare_bad_images() {
         1,
         &["sizes differ"],
     );
+    // --min-counts: a count, and the reference's beam sidecar to convert values to photons.
+    s.assert_rejected(
+        &["compare", "ref.exr", "ref.exr", "--min-counts", "-1"],
+        1,
+        &["--min-counts", "-1"],
+    );
+    s.assert_rejected(
+        &["compare", "ref.exr", "ref.exr", "--min-counts", "100"],
+        1,
+        &["--min-counts", "ref.json", "het-bssrdf beam"],
+    );
+    s.assert_rejected(
+        &["compare", "wide.exr", "ref.exr", "--min-counts", "100"],
+        1,
+        &["sizes differ"],
+    );
 }
 
 #[test]

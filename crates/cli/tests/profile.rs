@@ -35,7 +35,7 @@ fn dipole_total_is_the_closed_form() {
     let s = (3.0 * (1.0 - alpha)).sqrt();
     let want = 0.5 * alpha * (-s).exp() * (1.0 + (-(4.0 / 3.0) * s).exp());
     assert!((got - want).abs() < 1e-12 * want, "{got} vs {want}");
-    // Notes §1: 0.7538…-ish regime; sanity against the tabulated neighbour α' = 0.99.
+    // docs/physics.md#dipole: 0.7538…-ish regime; sanity against the tabulated neighbour α' = 0.99.
     assert!(got > 0.746714 && got < 0.912451);
 }
 
@@ -64,7 +64,7 @@ fn csv_has_header_and_requested_grid() {
         .collect();
     assert_eq!(rs[0], 0.0);
     assert!((rs[10] - 5.0).abs() < 1e-12 && (rs[2] - 1.0).abs() < 1e-12);
-    // Notes §2 [C]: PBD-MS at r = 1 (σs = 1, σa = 0.01, η = 1) is 3.252422e-2.
+    // docs/physics.md#beam-diffusion [computed]: PBD-MS at r = 1 (σs = 1, σa = 0.01, η = 1) is 3.252422e-2.
     let v: f64 = lines[3].split(',').nth(1).unwrap().parse().unwrap();
     assert!((v - 3.252422e-2).abs() < 1e-5 * 3.252422e-2, "{v}");
     // Defaults: 151 rows from 0 to 15.

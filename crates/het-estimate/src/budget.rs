@@ -67,7 +67,7 @@ impl SampleBudget {
 }
 
 /// What an averaging stage does with a sample whose two projection rays both miss the object
-/// (the paper does not say; notes §4).
+/// (the paper does not say; docs/physics.md#heuristics).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[non_exhaustive]
 pub enum MissPolicy {

@@ -1,7 +1,8 @@
 //! Estimate the homogeneous BSSRDF parameters that stand in for a heterogeneous medium
 //! between an incident point `x_i` and an exitant point `x_o` (Sone, Hachisuka & Koike,
 //! "Parameter Estimation of BSSRDF for Heterogeneous Materials"; key `Sone` in
-//! `docs/references.md`).
+//! `docs/references.md`). Formulas and known answers: `docs/physics.md` (rendered by
+//! `cargo doc` as `het_bssrdf::physics`), cited as `docs/physics.md#section`.
 //!
 //! # Use
 //! ```

@@ -5,7 +5,7 @@
 //! `w = √( ⟨θ²⟩ ℓ (d/2)² / (24 {1 + ⟨θ²⟩ (⟨σa⟩/⟨σs⟩) ℓ² / 12}) )`, with `ℓ = ⟨σs⟩ d/2` the
 //! expected number of scattering events over half the chord and ⟨θ²⟩ the mean square
 //! scattering angle. Substituting ℓ and writing `h = d/2` removes the division by σs
-//! (physics notes §5):
+//! (docs/physics.md#path-width):
 //!
 //! `w² = ⟨θ²⟩ σs h³ / (24 (1 + ⟨θ²⟩ σa σs h² / 12))`.
 //!
@@ -13,7 +13,7 @@
 //! Limits: small d, `w ≈ √(⟨θ²⟩ σs d³ / 192)`; large d with σa > 0, `w² → d / (4σa)`;
 //! σa = 0, `w² = ⟨θ²⟩ σs h³ / 24` (which exceeds (d/2)² once d > 48/(⟨θ²⟩σs)).
 //! Under the Gaussian small-angle path model the numerator is exactly the mean square
-//! (2-D radial) distance of paths from the chord at its midpoint (physics notes §5, derived there): w is an RMS
+//! (2-D radial) distance of paths from the chord at its midpoint (docs/physics.md#path-width, derived there): w is an RMS
 //! radius.
 //!
 //! # Reading choices (options, with the defaults the paper's text supports best)
@@ -191,7 +191,7 @@ mod tests {
         }
     }
 
-    /// The notes' independently computed examples (§5): σs = 1, isotropic exact ⟨θ²⟩.
+    /// The independently computed examples of docs/physics.md#path-width: σs = 1, isotropic exact ⟨θ²⟩.
     #[test]
     fn notes_examples() {
         let cases = [
@@ -204,10 +204,10 @@ mod tests {
         ];
         for (d, sa, want) in cases {
             let w = width(ISO, 1.0, sa, d).unwrap();
-            // The notes quote 4 significant figures.
+            // docs/physics.md quotes 4 significant figures.
             assert!(rel(w, want) < 6e-4, "d={d} sa={sa}: {w} vs {want}");
         }
-        // Large d: w² → d/(4σa); notes: d = 1000, σa = 0.1 gives 50.0.
+        // Large d: w² → d/(4σa); docs/physics.md: d = 1000, σa = 0.1 gives 50.0.
         let w = width(ISO, 1.0, 0.1, 1000.0).unwrap();
         assert!(rel(w, 50.0) < 1e-3, "{w}");
     }

@@ -22,7 +22,7 @@ where
 /// d'Eon & Irving, read as the endpoint mean ½(σ(x_i) + σ(x_o)) (`endpoints`).
 ///
 /// The paper (§4) says only that this heuristic "take[s] averages of coefficients between
-/// incident and exitant points"; dEI11's own rule was not checked (physics notes §4, [U]).
+/// incident and exitant points"; dEI11's own rule was not checked (docs/physics.md#heuristics, unchecked).
 /// The two-lookup endpoint mean is the literal reading and the likelier one, so it is the
 /// paper's baseline here; the chord mean is a separate estimator (`segment`), not attributed
 /// to dEI11.

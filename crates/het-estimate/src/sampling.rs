@@ -142,38 +142,10 @@ pub fn concentric_disk(u: [f64; 2]) -> DVec2 {
 }
 
 #[cfg(test)]
-pub(crate) mod chi2 {
-    //! A small chi-square helper for sampler tests.
-
-    /// Upper critical value of χ² with `dof` degrees of freedom at significance `alpha`
-    /// ∈ {1e-3, 1e-4}, by the Wilson–Hilferty approximation (accurate to ~1% for dof ≥ 10).
-    pub fn critical(dof: usize, alpha: f64) -> f64 {
-        let z = if alpha == 1e-3 {
-            3.090_232_306
-        } else if alpha == 1e-4 {
-            3.719_016_485
-        } else {
-            panic!("unsupported alpha {alpha}")
-        };
-        let k = dof as f64;
-        let t = 2.0 / (9.0 * k);
-        k * (1.0 - t + z * t.sqrt()).powi(3)
-    }
-
-    /// Pearson's statistic for observed counts against expected counts.
-    pub fn statistic(observed: &[u64], expected: &[f64]) -> f64 {
-        observed
-            .iter()
-            .zip(expected)
-            .map(|(&o, &e)| (o as f64 - e).powi(2) / e)
-            .sum()
-    }
-}
-
-#[cfg(test)]
 mod tests {
     use super::*;
     use crate::sampler::SplitMix64;
+    use bssrdf_core::chi_square::ChiSquareTest;
     use std::f64::consts::PI;
 
     /// Equal-area cells of the unit disk: `rings` rings of equal area × `sectors` sectors.
@@ -185,7 +157,7 @@ mod tests {
         ring * sectors + sector
     }
 
-    /// Chi-square test of uniformity at significance 1e-3 (fixed seed). Each point comes from
+    /// Chi-square test of uniformity at significance 1e-4 (fixed seed). Each point comes from
     /// its own independently shifted set, so points are i.i.d. uniform if and only if the
     /// shifted sequence and the concentric map are right; we cycle k so that every index
     /// class is exercised.
@@ -202,10 +174,8 @@ mod tests {
             assert!(p.length() <= 1.0 + 1e-12);
             counts[disk_cell(p, rings, sectors)] += 1;
         }
-        let expected = vec![n as f64 / cells as f64; cells];
-        let stat = chi2::statistic(&counts, &expected);
-        let crit = chi2::critical(cells - 1, 1e-3);
-        assert!(stat < crit, "chi2 {stat} >= {crit}");
+        let r = ChiSquareTest::SINGLE.check_uniform(&counts).unwrap();
+        assert!(r.passes(), "{r}");
     }
 
     /// The same test for the points of one set (k = 0..N with a single shift): the
@@ -226,8 +196,8 @@ mod tests {
             for k in 0..n {
                 counts[disk_cell(set.point(k), rings, sectors)] += 1;
             }
-            let expected = vec![n as f64 / cells as f64; cells];
-            mean_stat += chi2::statistic(&counts, &expected) / reps as f64;
+            let r = ChiSquareTest::SINGLE.check_uniform(&counts).unwrap();
+            mean_stat += r.statistic / reps as f64;
         }
         // i.i.d. points would give E[stat] = dof = 31.
         assert!(
@@ -238,7 +208,7 @@ mod tests {
 
     /// Ellipse points (disk scaled by (a, b)): chi-square over the cells of a grid on the
     /// bounding box, with expected counts from an independent fine-grid area quadrature of
-    /// each cell's intersection with the ellipse. Significance 1e-3, fixed seed.
+    /// each cell's intersection with the ellipse. Significance 1e-4, fixed seed.
     #[test]
     fn ellipse_points_are_uniform_chi_square() {
         let (a, b) = (2.0, 0.7);
@@ -269,29 +239,16 @@ mod tests {
             let u = DiskPoints::new(&mut rng).point((i % 333) as u32);
             counts[cell_of(a * u.x, b * u.y)] += 1;
         }
-        // Pool cells whose expected count is below 5 into one bin (corner cells).
-        let (mut obs, mut exp) = (Vec::new(), Vec::new());
-        let (mut po, mut pe) = (0u64, 0.0);
-        for c in 0..g * g {
-            let e = n as f64 * area[c] as f64 / inside as f64;
-            if e < 5.0 {
-                po += counts[c];
-                pe += e;
-            } else {
-                obs.push(counts[c]);
-                exp.push(e);
-            }
-        }
-        if pe > 0.0 {
-            obs.push(po);
-            exp.push(pe);
-        }
-        let stat = chi2::statistic(&obs, &exp);
-        let crit = chi2::critical(obs.len() - 1, 1e-3);
-        assert!(stat < crit, "chi2 {stat} >= {crit}");
+        // Corner cells expecting fewer than 5 points are pooled by the helper.
+        let expected: Vec<f64> = area
+            .iter()
+            .map(|&a| n as f64 * a as f64 / inside as f64)
+            .collect();
+        let r = ChiSquareTest::SINGLE.check(&counts, &expected).unwrap();
+        assert!(r.passes(), "{r}");
     }
 
-    /// Segment points: chi-square over 50 equal bins, i.i.d. across shifts, significance 1e-3.
+    /// Segment points: chi-square over 50 equal bins, i.i.d. across shifts, significance 1e-4.
     #[test]
     fn segment_points_are_uniform_chi_square() {
         let bins = 50;
@@ -303,9 +260,8 @@ mod tests {
             assert!((0.0..=1.0).contains(&t));
             counts[((t * bins as f64) as usize).min(bins - 1)] += 1;
         }
-        let stat = chi2::statistic(&counts, &vec![n as f64 / bins as f64; bins]);
-        let crit = chi2::critical(bins - 1, 1e-3);
-        assert!(stat < crit, "chi2 {stat} >= {crit}");
+        let r = ChiSquareTest::SINGLE.check_uniform(&counts).unwrap();
+        assert!(r.passes(), "{r}");
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The chord average: the mean of the coefficients along the segment x_i–x_o, projected onto
 //! the surface. A second reading of the paper's description of the d'Eon–Irving heuristic
 //! ("averages of coefficients between incident and exitant points", §4); it is *not* claimed
-//! to be dEI11's rule (physics notes §4).
+//! to be dEI11's rule (docs/physics.md#heuristics).
 
 use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;

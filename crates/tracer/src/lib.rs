@@ -1,6 +1,8 @@
 //! The het-bssrdf CPU tracer: one BVH-backed tracer through which both the reference
 //! volumetric path tracer and the BSSRDF renderer run, so that every reported error compares
-//! like with like (same geometry, textures, camera, lights and film).
+//! like with like (same geometry, textures, camera, lights and film). The transport it
+//! computes (MIS, scattering orders, known answers) is described in `docs/physics.md`
+//! (rendered by `cargo doc` as `het_bssrdf::physics`).
 #![deny(missing_docs)]
 
 pub mod camera;

@@ -6,7 +6,10 @@
 //! translucent object:
 //! * [`Method::PathTraced`]: the path refracts in and performs the volumetric random walk
 //!   ([`super::walk`]), with next-event estimation at every real scattering vertex through
-//!   index-matched boundaries (shadow transmittance by ratio tracking);
+//!   index-matched boundaries (shadow transmittance by ratio tracking). A walk that crosses an
+//!   index-matched medium without scattering keeps the MIS vertex before the medium, and a
+//!   shadow ray through a medium classifies its light as having entered one, so that both
+//!   strategies weight and classify the same light path alike (`docs/physics.md#path-tracer`);
 //! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
 //!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
 //!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
@@ -211,6 +214,40 @@ impl ShadowSegment {
             }
         }
     }
+}
+
+/// Light reaching a vertex by next-event estimation.
+#[derive(Debug, Clone, Copy)]
+struct Direct {
+    /// Radiance (before the path weight).
+    l: Rgb,
+    /// The shadow segment crossed an index-matched medium: the light path it completes has
+    /// entered a medium (with no scattering there), which the scattering-order filter must
+    /// see exactly as it sees the direction-sampled path through the same medium.
+    through_medium: bool,
+}
+
+impl Direct {
+    const NONE: Direct = Direct {
+        l: Rgb::ZERO,
+        through_medium: false,
+    };
+}
+
+/// What a shadow segment lets through.
+#[derive(Debug, Clone, Copy)]
+struct Transmission {
+    /// Transmittance per channel (0 when blocked).
+    tr: Rgb,
+    /// The segment crossed an index-matched medium.
+    through_medium: bool,
+}
+
+impl Transmission {
+    const BLOCKED: Transmission = Transmission {
+        tr: Rgb::ZERO,
+        through_medium: false,
+    };
 }
 
 /// The previous vertex of a path, for MIS when the path hits an emitter by chance.
@@ -528,7 +565,8 @@ impl<'s> PathIntegrator<'s> {
     /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
     /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
     /// pdf), times the shadow ray's transmittance (per channel of `channels`; the ray starts
-    /// inside `medium`, if any). Returns radiance (before path weight).
+    /// inside `medium`, if any). Returns radiance (before path weight) and whether the shadow
+    /// ray crossed a medium.
     #[allow(clippy::too_many_arguments)]
     fn direct(
         &self,
@@ -539,30 +577,30 @@ impl<'s> PathIntegrator<'s> {
         medium: Option<u32>,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> Rgb {
+    ) -> Direct {
         let u = rng.uniform();
         let u2 = rng.uniform2();
         if self.strategy == LightStrategy::DirectionOnly {
-            return Rgb::ZERO;
+            return Direct::NONE;
         }
         let Some(i) = self.lights.select(u) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
         let light = &self.scene.lights[i];
         let Some(ls) = light.sample_li(p, u2) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
         let (f, pdf_dir) = f_and_pdf(ls.wi);
         if f.is_nan() || f <= 0.0 {
-            return Rgb::ZERO;
+            return Direct::NONE;
         }
         let origin = origin_for(ls.wi);
         let Some(seg) = ShadowSegment::toward(origin, &ls) else {
-            return Rgb::ZERO;
+            return Direct::NONE;
         };
-        let tr = self.shadow(&seg, medium, channels, rng, counters);
-        if tr.is_zero() {
-            return Rgb::ZERO;
+        let shadow = self.shadow(&seg, medium, channels, rng, counters);
+        if shadow.tr.is_zero() {
+            return Direct::NONE;
         }
         let w = if ls.delta {
             1.0
@@ -570,7 +608,10 @@ impl<'s> PathIntegrator<'s> {
             self.strategy
                 .nee_weight(ls.pdf * self.lights.select_pdf(), pdf_dir)
         };
-        ls.li * tr * (f * w / self.lights.select_pdf())
+        Direct {
+            l: ls.li * shadow.tr * (f * w / self.lights.select_pdf()),
+            through_medium: shadow.through_medium,
+        }
     }
 
     /// Transmittance of the shadow segment `seg`, which starts inside `medium` (if any): 0 if
@@ -584,12 +625,13 @@ impl<'s> PathIntegrator<'s> {
         channels: Channels,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> Rgb {
+    ) -> Transmission {
         let dir = seg.dir;
         let mut origin = seg.origin;
         let mut remaining = seg.t_max;
         let mut inside = medium;
         let mut tr = Rgb::ONE;
+        let mut through_medium = false;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let ray = Ray::with_range(origin, dir, 0.0, remaining);
             let hit = self.scene.geometry.intersect(&ray);
@@ -597,18 +639,19 @@ impl<'s> PathIntegrator<'s> {
                 // The segment up to the hit (or to its end) lies inside medium `m`; a ray that
                 // finds no boundary inside a closed object has leaked and is left as it is.
                 let t = hit.map_or(remaining, |h| h.t);
+                through_medium = true;
                 if t.is_finite() {
                     tr *= self.medium_transmittance(m, origin, dir, t, channels, rng, counters);
                     if tr.is_zero() {
-                        return Rgb::ZERO;
+                        return Transmission::BLOCKED;
                     }
                 }
             }
             let Some(h) = hit else {
-                return tr;
+                return Transmission { tr, through_medium };
             };
             if Some(h.object) == seg.light_object {
-                return tr;
+                return Transmission { tr, through_medium };
             }
             let ObjectKind::Translucent {
                 material,
@@ -616,19 +659,19 @@ impl<'s> PathIntegrator<'s> {
                 ..
             } = &self.objects[h.object as usize]
             else {
-                return Rgb::ZERO;
+                return Transmission::BLOCKED;
             };
             if material.eta != 1.0 {
-                return Rgb::ZERO;
+                return Transmission::BLOCKED;
             }
             inside = (dir.dot(h.ng) < 0.0).then_some(h.object);
             origin = h.spawn_origin(dir);
             remaining -= h.t;
             if remaining <= 0.0 {
-                return tr;
+                return Transmission { tr, through_medium };
             }
         }
-        Rgb::ZERO
+        Transmission::BLOCKED
     }
 
     /// Transmittance of the medium of `object` along `origin + t·dir`, `t ∈ (0, t_max)`: one
@@ -692,10 +735,12 @@ impl<'s> PathIntegrator<'s> {
             rng,
             counters,
         );
+        // Light whose shadow ray crossed a medium has entered one, as the cosine-sampled path
+        // through the same medium will have (`entered` set with no scattering added).
         st.add(
-            st.beta * albedo * ld,
+            st.beta * albedo * ld.l,
             st.order,
-            st.entered,
+            st.entered || ld.through_medium,
             self.options.scattering,
         );
         let u = rng.uniform2();
@@ -842,7 +887,7 @@ impl<'s> PathIntegrator<'s> {
                         rng,
                         &mut nee_counters,
                     );
-                    added += beta * ld;
+                    added += beta * ld.l;
                 }
             },
         );
@@ -947,6 +992,7 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
+            let ld = ld.l;
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather: skip the (costly) estimate
             }
