@@ -3,5 +3,6 @@
 #![deny(missing_docs)]
 
 pub use bssrdf_core;
+pub use experiments;
 pub use het_estimate;
 pub use tracer;

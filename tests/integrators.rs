@@ -201,9 +201,9 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
 #[test]
 fn built_in_checker_slab_equals_the_example_file() {
     assert_eq!(
-        tracer::experiment::scenes::CHECKER_SLAB,
+        experiments::scenes::CHECKER_SLAB,
         include_str!("../examples/scenes/checker-slab.toml"),
-        "crates/tracer/src/experiment/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
+        "crates/experiments/src/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
     );
 }
 

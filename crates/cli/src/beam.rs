@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use bssrdf_core::{ProfileModel, Scattering};
-use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
+use experiments::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
 use crate::common::{
@@ -201,15 +201,10 @@ pub fn run_method(
     } else {
         progress(setup.resolution as u64, method.name(), "rows")
     };
-    let map = tracer::experiment::beam::run_method(
-        setup,
-        method,
-        profile,
-        photons,
-        subsamples,
-        seed,
-        &|k| bar.inc(k),
-    )?;
+    let map =
+        experiments::beam::run_method(setup, method, profile, photons, subsamples, seed, &|k| {
+            bar.inc(k)
+        })?;
     bar.finish_and_clear();
     Ok(map)
 }

@@ -50,7 +50,7 @@ pub fn progress(len: u64, prefix: &str, unit: &str) -> ProgressBar {
 /// Fails early, before a long run, if `path` (the `--out` value or its default) cannot be
 /// written. The library error names the path; the context names the flag.
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    tracer::experiment::run::check_output_path(path).context("invalid --out")
+    experiments::run::check_output_path(path).context("invalid --out")
 }
 
 /// One line per rare event that happened, so that no cap or fallback is silent.

@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
-use tracer::experiment::beam::{PhotonBudget, write_beam_map};
-use tracer::experiment::converge::{MethodSummary, check_dir, summarize, write_outputs};
-use tracer::experiment::run::{RenderJob, write_render};
-use tracer::experiment::study::{
+use experiments::beam::{PhotonBudget, write_beam_map};
+use experiments::converge::{MethodSummary, check_dir, summarize, write_outputs};
+use experiments::run::{RenderJob, write_render};
+use experiments::study::{
     BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, reference_path, scene_reference, scene_study,
 };
 use tracer::integrator::Method;

@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use bssrdf_core::{ProfileModel, Scattering};
-use tracer::experiment::run::{RenderJob, render_scene, sidecar_paths, write_render};
+use experiments::run::{RenderJob, render_scene, sidecar_paths, write_render};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use tracer::experiment::reproduce::{Scale, reproduce};
+use experiments::reproduce::{Scale, reproduce};
 
 /// How much work to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -48,7 +48,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.out.display()
         )
     })?;
-    tracer::experiment::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
+    experiments::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
         .context("invalid --out")?;
     eprintln!(
         "reproduce ({} scale): expected time {}; writing into {}",

@@ -16,10 +16,10 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::OutputError;
 use crate::error::WriteError;
-use crate::experiment::metrics::Metrics;
-use crate::output::{write_atomic, write_json};
+use crate::metrics::Metrics;
+use tracer::error::OutputError;
+use tracer::output::{write_atomic, write_json};
 
 /// A run counts as converged once its error is within this factor of the final error.
 pub const CONVERGED_TOLERANCE: f64 = 1.1;
@@ -182,7 +182,7 @@ pub fn write_outputs(
 
 /// Checks that `dir` exists, is a directory and accepts new files (before a long study).
 pub fn check_dir(dir: &Path) -> Result<(), OutputError> {
-    crate::experiment::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
+    crate::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
 }
 
 #[cfg(test)]

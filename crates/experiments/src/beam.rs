@@ -11,7 +11,7 @@
 //! point and every exitant point are found by tracing, and the estimators' projection rays
 //! use the BVH.
 //! * `pt` ([`trace_photons`]): light tracing with the volumetric random walk of the path
-//!   tracer ([`crate::integrator::walk`]). Every photon carries weight 1 (analog tracking,
+//!   tracer ([`tracer::integrator::walk`]). Every photon carries weight 1 (analog tracking,
 //!   η = 1), so a pixel's value is an integer count of exits / (photons · Δ²): sums of
 //!   integers are exact, so the map is identical whatever the thread count.
 //! * BSSRDF methods ([`bssrdf_map`]): for `k × k` stratified jittered points x_o per pixel,
@@ -26,17 +26,17 @@ use het_estimate::{Coefficients, Estimator};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::field::{Field, MediumField, PlanarProjection};
-use crate::geometry::{Hit, Ray, primitives};
-use crate::integrator::PathCounters;
-use crate::integrator::path::ChannelView;
-use crate::integrator::walk::{Interface, WalkEnd, WalkMedium};
-use crate::light::Light;
-use crate::render::Counters;
-use crate::rng::Rng;
-use crate::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+use tracer::camera::Camera;
+use tracer::error::SceneError;
+use tracer::field::{Field, MediumField, PlanarProjection};
+use tracer::geometry::{Hit, Ray, primitives};
+use tracer::integrator::PathCounters;
+use tracer::integrator::path::ChannelView;
+use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
+use tracer::light::Light;
+use tracer::render::Counters;
+use tracer::rng::Rng;
+use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// Side of the box standing in for the half-space (scene units), and its depth. With
 /// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
@@ -92,7 +92,7 @@ impl BeamTexture {
     }
 
     /// The texture as a tracer field (planar projection along z, origin at 0).
-    pub fn field(&self) -> Result<Field, crate::error::FieldError> {
+    pub fn field(&self) -> Result<Field, tracer::error::FieldError> {
         let proj = PlanarProjection::default();
         match *self {
             BeamTexture::Const { value } => Field::constant(Rgb::splat(value)),
@@ -503,7 +503,7 @@ pub fn write_beam_map(
     extra: serde_json::Value,
 ) -> Result<(), crate::error::WriteError> {
     let n = map.resolution;
-    crate::output::write_grey_exr(n, n, &map.values, exr)?;
+    tracer::output::write_grey_exr(n, n, &map.values, exr)?;
     #[cfg(feature = "plot")]
     {
         use crate::plot::{MapPlot, MapScale, map_png};
@@ -541,7 +541,7 @@ pub fn write_beam_map(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    crate::output::write_json(&value, &exr.with_extension("json"))?;
+    tracer::output::write_json(&value, &exr.with_extension("json"))?;
     Ok(())
 }
 
@@ -550,7 +550,7 @@ pub fn write_beam_map(
 /// the method names its own. `progress` receives units of work (photons or rows).
 pub fn run_method(
     setup: &BeamSetup,
-    method: crate::integrator::Method,
+    method: tracer::integrator::Method,
     profile: ProfileModel,
     photons: PhotonBudget,
     sub: u32,
@@ -558,8 +558,8 @@ pub fn run_method(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<BeamMap, SceneError> {
     match method {
-        crate::integrator::Method::PathTraced => trace_photons(setup, photons, seed, progress),
-        crate::integrator::Method::Bssrdf {
+        tracer::integrator::Method::PathTraced => trace_photons(setup, photons, seed, progress),
+        tracer::integrator::Method::Bssrdf {
             estimator,
             profile: p,
         } => bssrdf_map(setup, estimator, p.unwrap_or(profile), sub, seed, progress),

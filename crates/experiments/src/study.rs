@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 
 use bssrdf_core::ProfileModel;
 
-use crate::error::SceneError;
-use crate::experiment::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
-use crate::experiment::converge::Run;
-use crate::experiment::metrics::{MetricsError, compare, compare_films};
-use crate::experiment::run::{RenderJob, RenderOutcome, render_scene};
-use crate::film::Film;
-use crate::integrator::{Method, RenderError};
-use crate::output::{read_exr, write_exr};
-use crate::render::Budget;
-use crate::scene::Scene;
+use crate::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
+use crate::converge::Run;
+use crate::metrics::{MetricsError, compare, compare_films};
+use crate::run::{RenderJob, RenderOutcome, render_scene};
+use tracer::error::SceneError;
+use tracer::film::Film;
+use tracer::integrator::{Method, RenderError};
+use tracer::output::{read_exr, write_exr};
+use tracer::render::Budget;
+use tracer::scene::Scene;
 
 /// Seed offset of references, so that they never share random streams with the study runs.
 pub const REFERENCE_SEED_OFFSET: u64 = 0x5eed_0000;
@@ -35,7 +35,7 @@ pub enum StudyError {
     Metrics(#[from] MetricsError),
     /// Reading or writing a file.
     #[error(transparent)]
-    Output(#[from] crate::error::OutputError),
+    Output(#[from] tracer::error::OutputError),
 }
 
 /// Where the cached path-traced reference of a scene file lives: beside the scene, with its

@@ -10,8 +10,8 @@ use std::sync::Once;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::error::OutputError;
-use crate::output::write_atomic;
+use tracer::error::OutputError;
+use tracer::output::write_atomic;
 
 /// A plotting failure (drawing or encoding), or the output write.
 #[derive(Debug, thiserror::Error)]
