@@ -52,8 +52,6 @@ fn renders(c: &mut Criterion) {
                         &RenderOptions {
                             budget: Budget::Samples(1),
                             seed,
-                            progress: false,
-                            label: String::new(),
                         },
                     )
                 })

@@ -97,8 +97,6 @@ fn renders_are_identical_whatever_the_thread_count() {
                 &RenderOptions {
                     budget: Budget::Samples(2),
                     seed: 9,
-                    progress: false,
-                    label: String::new(),
                 },
             )
         })

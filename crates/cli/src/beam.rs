@@ -11,9 +11,7 @@ use bssrdf_core::{ProfileModel, Scattering};
 use experiments::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::common::{
-    check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
-};
+use crate::common::{check_writable, parse_method, parse_positive, parse_seconds, warn_counters};
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -191,15 +189,15 @@ pub fn run_method(
     show_progress: bool,
 ) -> anyhow::Result<BeamMap> {
     let bar = if !show_progress {
-        indicatif::ProgressBar::hidden()
+        experiments::progress::ProgressBar::hidden()
     } else if method == Method::PathTraced {
         let len = match photons {
             PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
             PhotonBudget::Time(_) => 0,
         };
-        progress(len, "pt", "photons")
+        experiments::progress::bar(len, "pt", "photons")
     } else {
-        progress(setup.resolution as u64, method.name(), "rows")
+        experiments::progress::bar(setup.resolution as u64, method.name(), "rows")
     };
     let map =
         experiments::beam::run_method(setup, method, profile, photons, subsamples, seed, &|k| {

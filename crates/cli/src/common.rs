@@ -1,10 +1,9 @@
-//! Helpers shared by the subcommands: method names, output paths, progress bars, summaries.
+//! Helpers shared by the subcommands: method names, output paths, summaries.
 
 use std::path::Path;
 use std::time::Duration;
 
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use tracer::integrator::{Method, PathCounters};
 
 /// Parses a `--method` value (`pt` or an estimator name).
@@ -31,20 +30,6 @@ pub fn parse_positive(s: &str) -> Result<u64, String> {
         Ok(v) if v > 0 => Ok(v),
         _ => Err(format!("expected a positive whole number, got `{s}`")),
     }
-}
-
-/// A progress bar on stderr over `len` units (hidden when stderr is not a terminal).
-pub fn progress(len: u64, prefix: &str, unit: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{prefix:>14}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}  {{elapsed}}<{{eta}}"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar.set_prefix(prefix.to_string());
-    bar
 }
 
 /// Fails early, before a long run, if `path` (the `--out` value or its default) cannot be

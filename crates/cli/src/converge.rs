@@ -185,7 +185,7 @@ fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
                 .with_estimator_samples(estimator_samples(args))
         })
         .collect();
-    let bar = crate::common::progress((methods.len() * spp.len()) as u64, "converge", "runs");
+    let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
     let mut finals = Vec::new();
     let runs = scene_study(
         &scene,
@@ -283,7 +283,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
             }
         })
         .sum();
-    let bar = crate::common::progress(runs_total as u64, "converge", "runs");
+    let bar = experiments::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
     let samples = estimator_samples(args);
     let methods: Vec<Method> = args

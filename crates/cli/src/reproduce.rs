@@ -56,7 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         scale.expected,
         args.out.display()
     );
-    let bar = indicatif::ProgressBar::new_spinner();
+    let bar = experiments::progress::ProgressBar::new_spinner();
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     let start = Instant::now();
     let mut step = |msg: &str| {

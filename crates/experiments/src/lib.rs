@@ -8,6 +8,7 @@ pub mod error;
 pub mod metrics;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod progress;
 pub mod reproduce;
 pub mod run;
 pub mod scenes;

@@ -11,7 +11,7 @@ use tracer::error::OutputError;
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
 use tracer::output::{write_exr, write_json, write_png};
-use tracer::render::{Budget, RenderOptions, Rendered, render};
+use tracer::render::{Budget, NoProgress, Progress, RenderOptions, Rendered, render_with_progress};
 use tracer::scene::Scene;
 
 /// Default most surface interactions per camera path.
@@ -85,17 +85,20 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         seconds,
         counters,
         ..
-    } = render(
-        w,
-        h,
-        &integrator,
-        &RenderOptions {
+    } = {
+        let bar;
+        let progress: &dyn Progress = if job.progress {
+            bar = crate::progress::RowBar::new(job.method.name());
+            &bar
+        } else {
+            &NoProgress
+        };
+        let options = RenderOptions {
             budget: job.budget,
             seed: job.seed,
-            progress: job.progress,
-            label: job.method.name().to_string(),
-        },
-    );
+        };
+        render_with_progress(w, h, &integrator, &options, progress)
+    };
     let mut film = Film::new(w, h);
     film.pixels = pixels;
     Ok(RenderOutcome {
