@@ -52,6 +52,12 @@ pub fn warn_counters(c: &PathCounters) {
             c.leaks
         );
     }
+    if c.profile_failures > 0 {
+        eprintln!(
+            "warning: {} profile evaluations rejected their estimated coefficients (those channels contributed 0)",
+            c.profile_failures
+        );
+    }
     if c.estimator_fallbacks > 0 {
         eprintln!(
             "note: {} estimates fell back to the endpoint average (every projection missed)",

@@ -7,6 +7,7 @@ use std::time::Duration;
 use anyhow::Context;
 use bssrdf_core::{ProfileModel, Scattering};
 use experiments::run::{RenderJob, render_scene, sidecar_paths, write_render};
+use het_estimate::{Estimator, SoneParams};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
@@ -59,11 +60,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = Scene::load(&args.scene)?;
     let method = match args.method {
         Some(m) => m,
-        None => match &scene.settings.estimator {
-            Some(name) => name.parse().map_err(|e: String| {
-                anyhow::anyhow!("{}: render.estimator: {e}", args.scene.display())
-            })?,
-            None => "sone".parse().expect("built-in estimator name"),
+        None => Method::Bssrdf {
+            estimator: scene
+                .settings
+                .estimator
+                .unwrap_or(Estimator::Sone(SoneParams::paper())),
+            profile: None,
         },
     }
     .with_profile(args.profile)

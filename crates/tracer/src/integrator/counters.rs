@@ -38,6 +38,10 @@ pub struct PathCounters {
     pub short_circuits: u64,
     /// Estimates where a channel fell back to the endpoint average (no hits at all).
     pub estimator_fallbacks: u64,
+    /// Profile evaluations whose estimated coefficients the profile rejected; those channels
+    /// contribute 0, so a non-zero count means a bias (never expected: scenes are validated
+    /// with the profiles' own bounds at load).
+    pub profile_failures: u64,
 }
 
 impl PathCounters {
@@ -48,6 +52,26 @@ impl PathCounters {
         self.projection_misses += d.misses as u64;
         self.short_circuits += d.short_circuit as u64;
         self.estimator_fallbacks += d.fallback as u64;
+    }
+
+    /// The diffuse reflectance profile `R(r)` (1/length², the paper's Eq. 1 kernel) of the
+    /// coefficients `c`, per channel, at distance `r`. A channel whose coefficients `family`
+    /// rejects contributes 0 and is counted in [`PathCounters::profile_failures`].
+    pub fn eval_profile(
+        &mut self,
+        family: &bssrdf_core::ProfileFamily,
+        c: het_estimate::Coefficients,
+        r: f64,
+    ) -> bssrdf_core::Rgb {
+        use bssrdf_core::RadialProfile;
+        let mut rd = bssrdf_core::Rgb::ZERO;
+        for ch in 0..3 {
+            match family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
+                Ok(profile) => rd[ch] = profile.eval(r),
+                Err(_) => self.profile_failures += 1,
+            }
+        }
+        rd
     }
 
     /// Adds tracking work.
@@ -72,5 +96,6 @@ impl Counters for PathCounters {
         self.projection_misses += o.projection_misses;
         self.short_circuits += o.short_circuits;
         self.estimator_fallbacks += o.estimator_fallbacks;
+        self.profile_failures += o.profile_failures;
     }
 }

@@ -11,7 +11,10 @@ use serde::Deserialize;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 
-use super::builder::{AssemblyInfo, PendingObject, assemble, validate_material, validate_settings};
+use super::builder::{
+    AssemblyInfo, PendingObject, assemble, validate_material, validate_medium, validate_settings,
+    validate_translucent_scalars,
+};
 use super::desc::*;
 use super::locate::Locator;
 use super::{Material, RenderSettings, Scene, Translucent};
@@ -229,6 +232,18 @@ impl Cx {
                     m
                 }
             };
+            if let Material::Translucent(t) = &material
+                && !t.medium.is_volumetric()
+                && s.mesh.uvs.is_none()
+            {
+                return Err(self.invalid(
+                    &s.key,
+                    format!(
+                        "object `{}` has no texture coordinates, but its material `{}` maps an image by `mapping = \"uv\"`; use a planar mapping or a mesh with UVs",
+                        s.name, s.material
+                    ),
+                ));
+            }
             pending.push(PendingObject {
                 name: s.name,
                 line: self.loc.line_of_key(&s.key),
@@ -264,13 +279,22 @@ impl Cx {
                     .map_err(|e| self.invalid("render.scattering", e.to_string()))?,
             ),
         };
+        let estimator = match &r.estimator {
+            None => None,
+            Some(name) => Some(name.parse::<het_estimate::Estimator>().map_err(|e| {
+                self.invalid(
+                    "render.estimator",
+                    format!("{e} (`pt` is not an estimator: the path tracer is chosen with `--method pt`)"),
+                )
+            })?),
+        };
         let s = RenderSettings {
             width: r.width,
             height: r.height,
             spp: r.spp,
             seed: r.seed,
             max_depth: r.max_depth,
-            estimator: r.estimator,
+            estimator,
             scattering,
         };
         validate_settings(&s).map_err(|(k, m)| self.invalid(&format!("render.{k}"), m))?;
@@ -385,7 +409,7 @@ impl Cx {
                         key: key.clone(),
                         line: self.loc.line_of_key(&key),
                     };
-                    validate_material(&Material::Translucent(probe.clone()))
+                    validate_translucent_scalars(&probe)
                         .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
                     (
                         d.name.clone(),
@@ -595,6 +619,7 @@ impl Cx {
                 let s = self.realize_field(sigma_s, textures, decoded)?;
                 let mut t = base.clone();
                 t.medium = MediumField::new(a, s).scaled(base.unit_scale);
+                validate_medium(&t).map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
                 Ok(Material::Translucent(t))
             }
         }

@@ -65,8 +65,8 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Maximum path depth, if given.
     pub max_depth: Option<u32>,
-    /// Estimator name, if given (parsed by the renderer).
-    pub estimator: Option<String>,
+    /// The BSSRDF estimator, if given (`render.estimator`, parsed at load).
+    pub estimator: Option<het_estimate::Estimator>,
     /// Scattering orders, if given.
     pub scattering: Option<Scattering>,
 }
