@@ -15,10 +15,10 @@
 //! from the `+axis` side (for axis z: from above, x right, y up) appears upright. For texture
 //! coordinates, `(u, v)` with `v` up (OBJ convention) reads the image at `(u, 1 − v)`.
 
-mod projection;
+mod texture_mapping;
 mod texture;
 
-pub use projection::{Axis, PlanarProjection};
+pub use texture_mapping::{Axis, PlanarProjection};
 pub use texture::{Filter, Texture, Wrap};
 
 use std::sync::Arc;
