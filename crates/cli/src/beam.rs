@@ -11,7 +11,7 @@ use bssrdf_core::{ProfileModel, Scattering};
 use experiments::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::common::{check_writable, parse_method, parse_positive, parse_seconds, warn_counters};
+use crate::common::{check_writable, parse_positive, parse_seconds, warn_counters};
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -64,7 +64,7 @@ pub struct SetupArgs {
     #[arg(long, value_parser = parse_positive, default_value_t = 120, allow_hyphen_values = true)]
     pub resolution: u64,
     /// Scattering orders: multiple (the paper), single or all.
-    #[arg(long, default_value = "multiple")]
+    #[arg(long, value_parser = crate::choices::scattering(), default_value = "multiple")]
     pub scattering: Scattering,
 }
 
@@ -152,10 +152,10 @@ pub struct Args {
     setup: SetupArgs,
     /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
     /// endpoints, segment, sone.
-    #[arg(long, value_parser = parse_method, default_value = "sone")]
+    #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
     /// Profile model for BSSRDF methods.
-    #[arg(long, default_value = "dipole")]
+    #[arg(long, value_parser = crate::choices::profile(), default_value = "dipole")]
     profile: ProfileModel,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
@@ -174,7 +174,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
-    #[arg(long)]
+    #[arg(short, long)]
     out: Option<PathBuf>,
 }
 

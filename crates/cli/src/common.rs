@@ -4,12 +4,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use anyhow::Context;
-use tracer::integrator::{Method, PathCounters};
-
-/// Parses a `--method` value (`pt` or an estimator name).
-pub fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse()
-}
+use tracer::integrator::PathCounters;
 
 /// Parses a duration in seconds (> 0).
 pub fn parse_seconds(s: &str) -> Result<Duration, String> {

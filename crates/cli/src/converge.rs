@@ -18,7 +18,7 @@ use tracer::output::read_exr;
 use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
-use crate::common::{parse_method, parse_positive};
+use crate::common::parse_positive;
 
 /// Arguments of `het-bssrdf converge`.
 #[derive(Debug, clap::Args)]
@@ -32,10 +32,10 @@ pub struct Args {
     #[command(flatten)]
     setup: SetupArgs,
     /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
-    #[arg(long, value_delimiter = ',', value_parser = parse_method, default_value = "pt,jensen-out,endpoints,sone")]
+    #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
     /// Profile model of the BSSRDF methods (scene: default each material's).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators.
     #[arg(long, value_parser = parse_positive)]
@@ -66,7 +66,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output directory (created if missing).
-    #[arg(long)]
+    #[arg(short, long)]
     out: Option<PathBuf>,
 }
 

@@ -12,7 +12,7 @@ use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
-use crate::common::{check_writable, parse_method, parse_positive, parse_seconds, warn_counters};
+use crate::common::{check_writable, parse_positive, parse_seconds, warn_counters};
 
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
@@ -21,10 +21,10 @@ pub struct Args {
     scene: PathBuf,
     /// `pt` (the path-traced reference) or a BSSRDF estimator: jensen-in, jensen-out,
     /// endpoints, segment, sone. Default: the scene's `render.estimator`, else `sone`.
-    #[arg(long, value_parser = parse_method)]
+    #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
     /// Profile model for BSSRDF methods (default: each material's, else dipole).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
@@ -41,14 +41,14 @@ pub struct Args {
     seed: Option<u64>,
     /// Scattering orders inside media: multiple, single or all (default: the scene's, else
     /// multiple, as in the paper).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::scattering())]
     scattering: Option<Scattering>,
     /// Most surface interactions per path (default: the scene's, else 8).
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     max_depth: Option<u64>,
     /// Output EXR (default: `<scene>-<method>.exr` in the current directory); the PNG preview
     /// and JSON sidecar are written beside it.
-    #[arg(long)]
+    #[arg(short, long)]
     out: Option<PathBuf>,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]

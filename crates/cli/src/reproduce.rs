@@ -27,7 +27,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     scale: Option<ScaleArg>,
     /// Output directory (created if missing).
-    #[arg(long, default_value = "reproduce-out")]
+    #[arg(short, long, default_value = "reproduce-out")]
     out: PathBuf,
     /// Seed of the runs (references use a different one).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]

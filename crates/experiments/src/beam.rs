@@ -545,7 +545,7 @@ pub fn write_beam_map(
     Ok(())
 }
 
-/// Runs one method of the beam experiment: light tracing for [`Method::PathTraced`] (with
+/// Runs one method of the beam experiment: light tracing for [`Method::PathTraced`](tracer::integrator::Method::PathTraced) (with
 /// `photons`), otherwise the BSSRDF map with `sub × sub` points per pixel and `profile` unless
 /// the method names its own. `progress` receives units of work (photons or rows).
 pub fn run_method(

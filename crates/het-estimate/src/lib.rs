@@ -80,6 +80,7 @@ pub use ellipse::PlanarEllipse;
 pub use estimate::{Diagnostics, Estimate, Region};
 pub use estimator::{Estimator, PreparedEstimator};
 pub use field::{CoefficientField, Coefficients, FieldBounds};
+pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use sampler::{SplitMix64, UniformSource};
