@@ -133,3 +133,48 @@ fn uv_mapped_fields_need_texture_coordinates() {
     let r = s.run(&["render", "ok.toml", "--method", "sone", "--out", "ok.exr"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
 }
+
+/// A unit cube as an ASCII PLY (six quads, outward-facing).
+const CUBE_PLY: &str = "ply
+format ascii 1.0
+element vertex 8
+property float x
+property float y
+property float z
+element face 6
+property list uchar uint vertex_indices
+end_header
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+4 0 3 2 1
+4 4 5 6 7
+4 0 1 5 4
+4 3 7 6 2
+4 0 4 7 3
+4 1 2 6 5
+";
+
+#[test]
+fn a_ply_mesh_renders_and_a_bad_one_is_named() {
+    let s = Scratch::new();
+    s.write("cube.ply", CUBE_PLY);
+    let scene = with_obj("cube.ply").replace("type = \"obj\"", "type = \"ply\"");
+    s.write("ply.toml", &scene);
+    for method in ["pt", "sone"] {
+        let r = s.run(&["render", "ply.toml", "--method", method, "-o", "x.exr"]);
+        assert_eq!(r.code, Some(0), "{method}: {}", r.stderr);
+    }
+    s.write("bad.ply", CUBE_PLY.replace("4 1 2 6 5", "4 1 2 6 9"));
+    s.write("bad.toml", scene.replace("cube.ply", "bad.ply"));
+    s.assert_rejected(
+        RENDER_PT,
+        1,
+        &["bad.toml", "`shape[0]`", "bad.ply", "vertex 9"],
+    );
+}

@@ -497,17 +497,9 @@ shape_desc!(
 );
 
 shape_desc!(
-    /// `[[shape]]` with `type = "obj"`.
-    ObjDesc {
-        /// Mesh file, relative to the scene file.
-        path: String,
-    }
-);
-
-shape_desc!(
-    /// `[[shape]]` with `type = "gltf"`.
-    GltfDesc {
-        /// Mesh file (.gltf or .glb), relative to the scene file.
+    /// `[[shape]]` with `type = "obj"`, `"gltf"` or `"ply"`.
+    MeshFileDesc {
+        /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
     }
 );

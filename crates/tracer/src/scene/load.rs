@@ -721,7 +721,7 @@ impl Cx {
         t: &DeTable<'_>,
         materials: &HashMap<String, MaterialPlan>,
     ) -> Result<Vec<ShapePlan>, SceneError> {
-        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\"";
+        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\" | \"ply\"";
         let mut out: Vec<ShapePlan> = Vec::new();
         let mut names = HashSet::new();
         for (i, (key, v)) in self.elements(t, "shape")?.into_iter().enumerate() {
@@ -796,14 +796,9 @@ impl Cx {
                         "<half_space>".to_string(),
                     )
                 }
-                kind @ ("obj" | "gltf") => {
-                    let (common, rel) = if kind == "obj" {
-                        let d: ObjDesc = self.de(v, &key)?;
-                        (d.common(), d.path)
-                    } else {
-                        let d: GltfDesc = self.de(v, &key)?;
-                        (d.common(), d.path)
-                    };
+                kind @ ("obj" | "gltf" | "ply") => {
+                    let d: MeshFileDesc = self.de(v, &key)?;
+                    let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
                     self.check_readable(&k("path"), &path)?;
                     let mesh = self
@@ -861,10 +856,20 @@ impl Cx {
             "obj" => crate::geometry::obj::load_obj(path),
             #[cfg(feature = "gltf")]
             "gltf" => crate::geometry::gltf::load_gltf(path),
+            #[cfg(feature = "ply")]
+            "ply" => crate::geometry::ply::load_ply(path),
             _ => Err(crate::error::MeshError::Unsupported {
                 file,
-                format: if kind == "obj" { "OBJ" } else { "glTF" },
-                feature: if kind == "obj" { "obj" } else { "gltf" },
+                format: match kind {
+                    "obj" => "OBJ",
+                    "gltf" => "glTF",
+                    _ => "PLY",
+                },
+                feature: match kind {
+                    "obj" => "obj",
+                    "gltf" => "gltf",
+                    _ => "ply",
+                },
             }),
         }
     }
