@@ -192,7 +192,9 @@ pub fn run_method(
         experiments::progress::ProgressBar::hidden()
     } else if method == Method::PathTraced {
         let len = match photons {
-            PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
+            PhotonBudget::Count(n) => {
+                n.div_ceil(experiments::beam::BATCH) * experiments::beam::BATCH
+            }
             PhotonBudget::Time(_) => 0,
         };
         experiments::progress::bar(len, "pt", "photons")

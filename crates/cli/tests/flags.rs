@@ -75,6 +75,12 @@ fn short_out_and_threads() {
     let a = tracer::output::read_exr(&s.join("a.exr")).unwrap();
     let b = tracer::output::read_exr(&s.join("b.exr")).unwrap();
     assert_eq!(a.pixels, b.pixels, "1 and 2 threads differ");
+    // The sidecar names its writer and its layout's version.
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.join("a.json")).unwrap()).unwrap();
+    assert_eq!(json["tool"]["name"], "het-bssrdf", "{json}");
+    assert_eq!(json["tool"]["version"], env!("CARGO_PKG_VERSION"), "{json}");
+    assert_eq!(json["schema_version"], 1, "{json}");
     s.assert_rejected(
         &["render", "ok.toml", "--threads", "0", "-o", "c.exr"],
         2,

@@ -45,7 +45,7 @@ pub const HALF_SPACE_SIZE: f64 = 400.0;
 /// Depth of the half-space box.
 pub const HALF_SPACE_DEPTH: f64 = 200.0;
 /// Photons per parallel batch of the light tracer.
-const BATCH: u64 = 1 << 13;
+pub const BATCH: u64 = 1 << 13;
 
 /// The σa texture of the experiment (values in 1/length).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -541,7 +541,10 @@ pub fn write_beam_map(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    tracer::output::write_json(&value, &exr.with_extension("json"))?;
+    tracer::output::write_json(
+        &crate::provenance::stamped(value),
+        &exr.with_extension("json"),
+    )?;
     Ok(())
 }
 

@@ -176,7 +176,10 @@ pub fn write_outputs(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    write_json(&value, &dir.join("summary.json"))?;
+    write_json(
+        &crate::provenance::stamped(value),
+        &dir.join("summary.json"),
+    )?;
     Ok(())
 }
 

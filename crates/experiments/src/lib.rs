@@ -9,6 +9,7 @@ pub mod metrics;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod progress;
+pub mod provenance;
 pub mod reproduce;
 pub mod run;
 pub mod scenes;

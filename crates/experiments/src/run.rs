@@ -203,5 +203,5 @@ pub fn write_render(
         "warnings": outcome.warnings,
         "mean_rgb": outcome.film.mean().0,
     });
-    write_json(&value, &json_path)
+    write_json(&crate::provenance::stamped(value), &json_path)
 }
