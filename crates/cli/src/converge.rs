@@ -11,7 +11,8 @@ use experiments::beam::{PhotonBudget, write_beam_map};
 use experiments::converge::{MethodSummary, check_dir, summarize, write_outputs};
 use experiments::run::{RenderJob, write_render};
 use experiments::study::{
-    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, reference_path, scene_reference, scene_study,
+    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
+    reference_key, scene_reference, scene_study,
 };
 use tracer::integrator::Method;
 use tracer::output::read_exr;
@@ -40,10 +41,15 @@ pub struct Args {
     /// Averaging samples per region of the segment and Sone estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// A reference image (EXR). Default: path traced at `--reference-spp` (scene, cached beside
-    /// it with its spp and seed in the name) or `--reference-photons` (beam, in --out).
+    /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
+    /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
+    /// (beam, in --out).
     #[arg(long)]
     reference: Option<PathBuf>,
+    /// Directory of cached scene references (default: `$XDG_CACHE_HOME/het-bssrdf`, else
+    /// `~/.cache/het-bssrdf`; `--out` when it cannot be written).
+    #[arg(long, env = "HET_BSSRDF_CACHE_DIR")]
+    cache_dir: Option<PathBuf>,
     /// Samples per pixel of the rendered reference.
     #[arg(long, value_parser = parse_positive, default_value_t = 1024, allow_hyphen_values = true)]
     reference_spp: u64,
@@ -146,6 +152,27 @@ fn prepare_out(out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The directory of cached references: `--cache-dir` (or `HET_BSSRDF_CACHE_DIR`), else the
+/// user's cache directory, checked before any rendering; when it cannot be created or written,
+/// `out` (with a warning).
+fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
+    let Some(dir) = given.map(Path::to_path_buf).or_else(default_cache_dir) else {
+        return out.to_path_buf();
+    };
+    let usable = std::fs::create_dir_all(&dir).is_ok()
+        && experiments::run::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
+    if usable {
+        dir
+    } else {
+        eprintln!(
+            "warning: the reference cache `{}` cannot be written; caching in `{}` instead",
+            dir.display(),
+            out.display()
+        );
+        out.to_path_buf()
+    }
+}
+
 fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
     let file = args
         .scene
@@ -159,7 +186,9 @@ fn run_scene(args: &Args, out: &Path) -> anyhow::Result<()> {
         Some(film) => film,
         None => {
             let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
-            let cache = reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
+            let key = reference_key(&scene, &base, spp)
+                .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
+            let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
             if !cache.is_file() {
                 eprintln!(
                     "rendering the path-traced reference at {spp} spp into {}",

@@ -127,6 +127,7 @@ impl SceneBuilder {
                 display_name: self.name.clone(),
                 source_path: None,
                 locator: &Locator::empty(),
+                inputs: Vec::new(),
             },
             self.settings,
             self.camera,
@@ -151,6 +152,7 @@ pub(crate) struct AssemblyInfo<'a> {
     pub display_name: String,
     pub source_path: Option<PathBuf>,
     pub locator: &'a Locator,
+    pub inputs: Vec<PathBuf>,
 }
 
 /// Checks `[render]` values; `Err((key, message))`.
@@ -308,5 +310,6 @@ pub(crate) fn assemble(
         settings,
         source_path: info.source_path,
         display_name: info.display_name,
+        inputs: info.inputs,
     })
 }

@@ -69,6 +69,7 @@ impl Scene {
             file,
             base_dir: base_dir.to_path_buf(),
             loc,
+            inputs: Default::default(),
         };
         cx.load(&root, display_name)
     }
@@ -79,6 +80,8 @@ struct Cx {
     file: PathBuf,
     base_dir: PathBuf,
     loc: Locator,
+    /// Every mesh and texture file found readable, in the order they were checked.
+    inputs: std::cell::RefCell<Vec<PathBuf>>,
 }
 
 type Val<'i> = Spanned<DeValue<'i>>;
@@ -177,7 +180,10 @@ impl Cx {
 
     fn check_readable(&self, key: &str, path: &Path) -> Result<(), SceneError> {
         match std::fs::metadata(path) {
-            Ok(m) if m.is_file() => Ok(()),
+            Ok(m) if m.is_file() => {
+                self.inputs.borrow_mut().push(path.to_path_buf());
+                Ok(())
+            }
             Ok(_) => Err(SceneError::Io {
                 file: self.file.clone(),
                 key: key.to_string(),
@@ -259,6 +265,7 @@ impl Cx {
                 display_name: display_name.to_string(),
                 source_path: None,
                 locator: &self.loc,
+                inputs: self.inputs.take(),
             },
             settings,
             camera,

@@ -191,9 +191,17 @@ pub struct Scene {
     pub source_path: Option<PathBuf>,
     /// The name used in messages (the file path, or the builder's name).
     pub display_name: String,
+    /// The mesh and texture files read while loading.
+    inputs: Vec<PathBuf>,
 }
 
 impl Scene {
+    /// The files read while loading besides the scene file itself: every mesh, and every
+    /// texture of a used material (for cache keys and provenance).
+    pub fn input_files(&self) -> &[PathBuf] {
+        &self.inputs
+    }
+
     /// The surface of `object` for the estimators.
     pub fn object_surface(&self, object: u32) -> ObjectSurface<'_> {
         ObjectSurface::new(&self.geometry, object)
