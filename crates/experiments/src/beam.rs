@@ -247,6 +247,7 @@ impl ExitCounts {
 
 /// A beam exitance map and how it was made.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct BeamMap {
     /// N.
     pub resolution: u32,

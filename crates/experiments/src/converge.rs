@@ -41,6 +41,7 @@ pub struct Run {
 
 /// The summary of one BSSRDF method against path tracing.
 #[derive(Debug, Clone, Serialize, PartialEq)]
+#[non_exhaustive]
 pub struct MethodSummary {
     /// The method.
     pub method: String,

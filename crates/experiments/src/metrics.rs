@@ -5,6 +5,7 @@ use serde::Serialize;
 
 /// Errors of a test image against a reference.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Metrics {
     /// ‖T − R‖₂ / ‖R‖₂ over the compared values (infinite if the reference is all zero and
     /// the test is not).

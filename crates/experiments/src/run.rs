@@ -50,6 +50,7 @@ impl RenderJob {
 
 /// A finished render.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct RenderOutcome {
     /// The image.
     pub film: Film,

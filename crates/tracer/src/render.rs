@@ -46,6 +46,7 @@ pub trait PixelEstimator: Sync {
 
 /// The result of a render.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Rendered<C> {
     /// Width in pixels.
     pub width: u32,

@@ -9,6 +9,7 @@ use crate::volume::TrackingCounters;
 
 /// Counters of one render (or one row of it).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct PathCounters {
     /// Camera paths (or photons) started.
     pub paths: u64,
