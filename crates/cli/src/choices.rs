@@ -4,6 +4,7 @@
 //! `--help` lists them and shell completion offers them.
 
 use std::ffi::OsStr;
+use std::str::FromStr;
 
 use bssrdf_core::{ProfileModel, Scattering};
 use clap::builder::{PossibleValue, TypedValueParser};
@@ -34,34 +35,30 @@ impl<T: Clone + Send + Sync + 'static> TypedValueParser for Choice<T> {
     }
 }
 
+/// A parser of one of `names` by the type's `FromStr`.
+fn by_name<T: FromStr>(names: Vec<&'static str>) -> Choice<T>
+where
+    T::Err: std::fmt::Display,
+{
+    Choice {
+        names,
+        parse: |s| s.parse::<T>().map_err(|e| e.to_string()),
+    }
+}
+
 /// `pt` or an estimator name.
 pub fn method() -> Choice<Method> {
     let mut names = vec!["pt"];
     names.extend(Estimator::ALL.iter().map(|e| e.name()));
-    Choice {
-        names,
-        parse: |s| s.parse(),
-    }
+    by_name(names)
 }
 
 /// A profile model name.
 pub fn profile() -> Choice<ProfileModel> {
-    Choice {
-        names: ProfileModel::ALL.iter().map(|m| m.name()).collect(),
-        parse: |s| {
-            s.parse()
-                .map_err(|e: bssrdf_core::UnknownName| e.to_string())
-        },
-    }
+    by_name(ProfileModel::ALL.iter().map(|m| m.name()).collect())
 }
 
 /// A scattering selection name.
 pub fn scattering() -> Choice<Scattering> {
-    Choice {
-        names: Scattering::ALL.iter().map(|m| m.name()).collect(),
-        parse: |s| {
-            s.parse()
-                .map_err(|e: bssrdf_core::UnknownName| e.to_string())
-        },
-    }
+    by_name(Scattering::ALL.iter().map(|m| m.name()).collect())
 }
