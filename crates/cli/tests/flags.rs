@@ -81,6 +81,21 @@ fn short_out_and_threads() {
     assert_eq!(json["tool"]["name"], "het-bssrdf", "{json}");
     assert_eq!(json["tool"]["version"], env!("CARGO_PKG_VERSION"), "{json}");
     assert_eq!(json["schema_version"], 1, "{json}");
+    // The EXR header records the render, as pbrt-v4 does.
+    let meta = exr::meta::MetaData::read_from_file(s.join("a.exr"), false).unwrap();
+    let attrs = &meta.headers[0].own_attributes.other;
+    let get = |k: &str| {
+        attrs
+            .get(&exr::meta::attribute::Text::from(k))
+            .unwrap_or_else(|| panic!("`{k}` missing from the EXR header: {attrs:?}"))
+            .clone()
+    };
+    use exr::meta::attribute::AttributeValue as V;
+    assert_eq!(get("samplesPerPixel"), V::I32(1));
+    assert_eq!(get("seed"), V::Text("0".into()));
+    assert_eq!(get("method"), V::Text("pt".into()));
+    assert_eq!(get("profile"), V::Text("none".into()));
+    assert!(matches!(get("renderTimeSeconds"), V::F32(t) if t >= 0.0));
     s.assert_rejected(
         &["render", "ok.toml", "--threads", "0", "-o", "c.exr"],
         2,

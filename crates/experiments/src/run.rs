@@ -10,7 +10,7 @@ use serde_json::json;
 use tracer::error::OutputError;
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
-use tracer::output::{write_exr, write_json, write_png};
+use tracer::output::{ExrAttribute, write_exr_with_attributes, write_json, write_png};
 use tracer::render::{Budget, NoProgress, Progress, RenderOptions, Rendered, render_with_progress};
 use tracer::scene::Scene;
 
@@ -171,9 +171,7 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    write_exr(&outcome.film, exr)?;
     let (png, json_path) = sidecar_paths(exr);
-    write_png(&outcome.film, &png, exposure)?;
     let profile = match job.method {
         Method::Bssrdf { profile, .. } => Some(
             profile
@@ -186,6 +184,31 @@ pub fn write_render(
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
     };
+    write_exr_with_attributes(
+        &outcome.film,
+        exr,
+        &[
+            (
+                "generator",
+                ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
+            ),
+            (
+                "samplesPerPixel",
+                ExrAttribute::Int(i32::try_from(outcome.spp).unwrap_or(i32::MAX)),
+            ),
+            ("seed", ExrAttribute::Text(job.seed.to_string())),
+            ("method", ExrAttribute::Text(outcome.method.clone())),
+            (
+                "profile",
+                ExrAttribute::Text(profile.clone().unwrap_or_else(|| "none".into())),
+            ),
+            (
+                "renderTimeSeconds",
+                ExrAttribute::Float(outcome.seconds as f32),
+            ),
+        ],
+    )?;
+    write_png(&outcome.film, &png, exposure)?;
     let value = json!({
         "scene": scene.source_path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name.clone()),
         "method": outcome.method,

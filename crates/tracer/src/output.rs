@@ -142,10 +142,33 @@ pub fn write_png(film: &Film, path: &Path, exposure_stops: f64) -> Result<(), Ou
     }
 }
 
+/// A custom attribute of an EXR header, as pbrt-v4 records render metadata
+/// (`samplesPerPixel`, `renderTimeSeconds`, …).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ExrAttribute {
+    /// A 32-bit integer (`int`).
+    Int(i32),
+    /// A 32-bit float (`float`).
+    Float(f32),
+    /// Latin-1 text (`string`).
+    Text(String),
+}
+
 /// Writes the film as an EXR with three `f32` channels R, G, B.
 pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
+    write_exr_with_attributes(film, path, &[])
+}
+
+/// [`write_exr`] with custom header attributes (names and values must be Latin-1).
+pub fn write_exr_with_attributes(
+    film: &Film,
+    path: &Path,
+    attributes: &[(&str, ExrAttribute)],
+) -> Result<(), OutputError> {
     #[cfg(feature = "exr")]
     {
+        use exr::meta::attribute::{AttributeValue, Text};
         use exr::prelude::*;
         check_size(film.width, film.height, film.pixels.len(), path)?;
         let w = film.width as usize;
@@ -153,12 +176,26 @@ pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
             let p = film.pixels[y * w + x];
             (p[0] as f32, p[1] as f32, p[2] as f32)
         });
-        let image = Image::from_channels((film.width as usize, film.height as usize), channels);
+        let mut image = Image::from_channels((film.width as usize, film.height as usize), channels);
+        let text = |t: &str| {
+            Text::new_or_none(t).ok_or_else(|| OutputError::Encode {
+                path: path.to_path_buf(),
+                message: format!("EXR header text must be Latin-1: `{t}`"),
+            })
+        };
+        for (name, value) in attributes {
+            let value = match value {
+                ExrAttribute::Int(v) => AttributeValue::I32(*v),
+                ExrAttribute::Float(v) => AttributeValue::F32(*v),
+                ExrAttribute::Text(v) => AttributeValue::Text(text(v)?),
+            };
+            image.layer_data.attributes.other.insert(text(name)?, value);
+        }
         encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
     {
-        let _ = film;
+        let _ = (film, attributes);
         Err(OutputError::Unsupported {
             path: path.to_path_buf(),
             feature: "exr",
