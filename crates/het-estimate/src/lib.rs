@@ -4,6 +4,7 @@
 //! `docs/references.md`).
 //!
 //! # Use
+//! (The example borrows the analytic plane of the `fixtures` feature.)
 //! ```
 //! use het_estimate::analytic::{Plane, PlanePoint, StripeField};
 //! use het_estimate::pattern::Stripe;
@@ -32,7 +33,8 @@
 //!   cost nothing) or an exact/prefiltered ellipse average (so summed-area tables or EWA can
 //!   replace sampling). Geometry and texturing are separate because they vary separately
 //!   (one mesh, many textures; one procedural field, many shapes), and because tests and
-//!   benchmarks substitute analytic versions of each ([`analytic`]). The point type is the
+//!   benchmarks substitute analytic versions of each (module `analytic`, behind the
+//!   `fixtures` feature). The point type is the
 //!   renderer's (`SurfaceQuery::Point`), so a lookup can use triangle ids and UVs.
 //! * **A closed set, resolved once.** [`Estimator`] is an enum (names `jensen-in`,
 //!   `jensen-out`, `endpoints`, `segment`, `sone`); [`Estimator::prepare`] validates it and
@@ -56,6 +58,7 @@
 #[macro_use]
 pub mod names;
 
+#[cfg(feature = "fixtures")]
 pub mod analytic;
 pub mod budget;
 mod chord;
