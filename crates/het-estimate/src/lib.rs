@@ -86,7 +86,9 @@ pub use field::{CoefficientField, Coefficients, FieldBounds};
 pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
-pub use sampler::{SplitMix64, UniformSource};
+#[cfg(feature = "fixtures")]
+pub use sampler::SplitMix64;
+pub use sampler::UniformSource;
 pub use segment::SegmentParams;
 pub use sone::SoneParams;
 pub use surface::{SurfacePoint, SurfaceQuery};
