@@ -20,9 +20,9 @@
 
 use std::time::{Duration, Instant};
 
-use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
-use het_estimate::{Coefficients, Estimator};
+use het_estimate::Estimator;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -458,7 +458,9 @@ pub fn bssrdf_map(
                     };
                     let est = prepared.estimate(&surface, &t.medium, &x_i, &x_o, &mut rng);
                     c.record_estimate(&est.diagnostics);
-                    sum += eval_grey(&family, est.coefficients, (x_o.p - x_i.p).length());
+                    let cf = est.coefficients;
+                    let r = (x_o.p - x_i.p).length();
+                    sum += c.eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r);
                 }
                 *value = sum / (sub * sub) as f64;
             }
@@ -484,14 +486,6 @@ pub fn bssrdf_map(
         exits: None,
         counters,
     })
-}
-
-/// The profile of grey coefficients (channel 0) at distance `r`; 0 for invalid input.
-fn eval_grey(family: &ProfileFamily, c: Coefficients, r: f64) -> f64 {
-    family
-        .profile(c.sigma_a[0], c.sigma_s[0])
-        .map(|p| p.eval(r))
-        .unwrap_or(0.0)
 }
 
 /// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar

@@ -64,15 +64,29 @@ impl PathCounters {
         c: het_estimate::Coefficients,
         r: f64,
     ) -> bssrdf_core::Rgb {
-        use bssrdf_core::RadialProfile;
         let mut rd = bssrdf_core::Rgb::ZERO;
         for ch in 0..3 {
-            match family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
-                Ok(profile) => rd[ch] = profile.eval(r),
-                Err(_) => self.profile_failures += 1,
-            }
+            rd[ch] = self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r);
         }
         rd
+    }
+
+    /// [`PathCounters::eval_profile`] for one channel's coefficients (1/length).
+    pub fn eval_profile_channel(
+        &mut self,
+        family: &bssrdf_core::ProfileFamily,
+        sigma_a: f64,
+        sigma_s: f64,
+        r: f64,
+    ) -> f64 {
+        use bssrdf_core::RadialProfile;
+        match family.profile(sigma_a, sigma_s) {
+            Ok(profile) => profile.eval(r),
+            Err(_) => {
+                self.profile_failures += 1;
+                0.0
+            }
+        }
     }
 
     /// Adds tracking work.
@@ -98,5 +112,28 @@ impl Counters for PathCounters {
         self.short_circuits += o.short_circuits;
         self.estimator_fallbacks += o.estimator_fallbacks;
         self.profile_failures += o.profile_failures;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bssrdf_core::{ProfileFamily, ProfileModel, Scattering};
+
+    #[test]
+    fn rejected_profiles_are_counted_not_silent() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let mut c = PathCounters::default();
+        let ok = c.eval_profile_channel(&family, 0.01, 1.0, 0.5);
+        assert!(ok.is_finite() && ok > 0.0, "{ok}");
+        assert_eq!(c.profile_failures, 0);
+        // Above the profiles' bound (1e12) and negative: 0, each counted.
+        assert_eq!(c.eval_profile_channel(&family, 1e13, 1.0, 0.5), 0.0);
+        assert_eq!(c.eval_profile_channel(&family, -1.0, 1.0, 0.5), 0.0);
+        assert_eq!(c.profile_failures, 2);
+        let mut merged = PathCounters::default();
+        merged.merge(&c);
+        assert_eq!(merged.profile_failures, 2, "merge drops the count");
     }
 }
