@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use het_bssrdf::bssrdf_core::Scattering;
-use het_bssrdf::tracer::experiment::scenes::CHECKER_SLAB;
+use het_bssrdf::experiments::scenes::CHECKER_SLAB;
 use het_bssrdf::tracer::integrator::{Method, PathIntegrator, PathOptions};
 use het_bssrdf::tracer::render::{Budget, RenderOptions, render};
 use het_bssrdf::tracer::scene::Scene;
@@ -52,8 +52,6 @@ fn renders(c: &mut Criterion) {
                         &RenderOptions {
                             budget: Budget::Samples(1),
                             seed,
-                            progress: false,
-                            label: String::new(),
                         },
                     )
                 })

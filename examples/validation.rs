@@ -18,9 +18,9 @@ mod chandrasekhar;
 mod half_space;
 
 use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
+use experiments::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
 use glam::DVec3;
 use het_bssrdf::{bssrdf_core, tracer};
-use tracer::experiment::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
 use tracer::integrator::Method;
 use tracer::integrator::probe::PROBE_ENERGY_FRACTION;
 

@@ -3,6 +3,7 @@
 #![deny(missing_docs)]
 
 pub use bssrdf_core;
+pub use experiments;
 
 /// The physics the code implements: formulas, sources, units, conventions and the known-answer
 /// values the tests use (the repository's `docs/physics.md`, which doc comments across the

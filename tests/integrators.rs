@@ -122,8 +122,6 @@ fn renders_are_identical_whatever_the_thread_count() {
                 &RenderOptions {
                     budget: Budget::Samples(2),
                     seed: 9,
-                    progress: false,
-                    label: String::new(),
                 },
             )
         })
@@ -226,9 +224,9 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
 #[test]
 fn built_in_checker_slab_equals_the_example_file() {
     assert_eq!(
-        tracer::experiment::scenes::CHECKER_SLAB,
+        experiments::scenes::CHECKER_SLAB,
         include_str!("../examples/scenes/checker-slab.toml"),
-        "crates/tracer/src/experiment/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
+        "crates/experiments/src/checker-slab.toml must be a copy of examples/scenes/checker-slab.toml"
     );
 }
 

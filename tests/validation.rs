@@ -3,7 +3,7 @@
 //! against Chandrasekhar's exact albedo and the exact single-scattering albedo.
 
 use bssrdf_core::Scattering;
-use tracer::experiment::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
+use experiments::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
 
 use crate::common::chandrasekhar::{half_space_albedo, single_scattering_albedo};
 

@@ -67,8 +67,6 @@ pub fn mean_and_se(
                 &RenderOptions {
                     budget: Budget::Samples(spp),
                     seed: 1000 + seed,
-                    progress: false,
-                    label: String::new(),
                 },
             );
             assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);

@@ -194,8 +194,6 @@ pub fn measure(case: &Case) -> Measurement {
         &RenderOptions {
             budget: Budget::Samples(case.spp),
             seed: case.seed,
-            progress: false,
-            label: "furnace".into(),
         },
     );
     let seconds = start.elapsed().as_secs_f64();

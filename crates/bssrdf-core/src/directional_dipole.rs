@@ -34,7 +34,7 @@
 //! (`ω_i·n_i < 0`) is treated as grazing.
 
 use crate::error::ParamError;
-use crate::family::validate_sigmas;
+use crate::error::{check_eta, validate_sigmas};
 use crate::fresnel::FresnelMoments;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -91,13 +91,7 @@ impl DirectionalDipole {
     /// [`DirectionalDipole::with_moments`] per pair).
     pub fn new(sigma_a: f64, sigma_s: f64, g: f64, eta: f64) -> Result<Self, ParamError> {
         crate::MediumParams::new(0.0, 0.0, g, eta)?;
-        if eta > crate::family::ETA_RANGE.1 {
-            return Err(ParamError::OutOfRange {
-                name: "eta",
-                range: "[1, 3]",
-                value: eta,
-            });
-        }
+        check_eta(eta)?;
         let internal = FresnelMoments::new(eta)?;
         let external = FresnelMoments::new(1.0 / eta)?;
         Self::with_moments(sigma_a, sigma_s, g, &internal, external.c1)

@@ -62,3 +62,53 @@ pub fn check_g(g: f64) -> Result<f64, ParamError> {
     }
     Ok(g)
 }
+
+/// Coefficients (1/length) below this are treated as exactly 0: a mean free path above 1e12
+/// scene units is vacuum for every practical scene, and it keeps `r = x/σ` finite.
+pub const SIGMA_EPSILON: f64 = 1e-12;
+/// Largest accepted coefficient (1/length); larger values are rejected as out of range.
+pub const SIGMA_MAX: f64 = 1e12;
+/// Validated range of the relative index of refraction η = n_medium / n_outside: the Fresnel
+/// moments' quadrature is accurate there (see [`crate::fresnel`]).
+pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
+
+/// Checks a relative index of refraction: finite and in [`ETA_RANGE`].
+pub fn check_eta(eta: f64) -> Result<f64, ParamError> {
+    if !eta.is_finite() {
+        return Err(ParamError::NotFinite {
+            name: "eta",
+            value: eta,
+        });
+    }
+    if !(ETA_RANGE.0..=ETA_RANGE.1).contains(&eta) {
+        return Err(ParamError::OutOfRange {
+            name: "eta",
+            range: "[1, 3]",
+            value: eta,
+        });
+    }
+    Ok(eta)
+}
+
+/// Checks an absorption or scattering coefficient (1/length): finite, `>= 0` and at most
+/// [`SIGMA_MAX`].
+pub fn check_sigma(name: &'static str, value: f64) -> Result<f64, ParamError> {
+    check_non_negative(name, value)?;
+    if value > SIGMA_MAX {
+        return Err(ParamError::OutOfRange {
+            name,
+            range: "[0, 1e12]",
+            value,
+        });
+    }
+    Ok(value)
+}
+
+/// Validates a coefficient pair: finite, ≥ 0, ≤ [`SIGMA_MAX`]; flushes values below
+/// [`SIGMA_EPSILON`] to 0.
+pub fn validate_sigmas(sigma_a: f64, sigma_s: f64) -> Result<(f64, f64), ParamError> {
+    let check = |name: &'static str, v: f64| -> Result<f64, ParamError> {
+        check_sigma(name, v).map(|v| if v < SIGMA_EPSILON { 0.0 } else { v })
+    };
+    Ok((check("sigma_a", sigma_a)?, check("sigma_s", sigma_s)?))
+}

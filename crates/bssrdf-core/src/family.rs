@@ -10,23 +10,17 @@ use crate::beam_diffusion::BeamDiffusionMs;
 use crate::better_dipole::BetterDipole;
 use crate::dipole::Dipole;
 use crate::directional_dipole::DirectionalDipole;
-use crate::error::check_g;
-use crate::error::{ParamError, check_non_negative};
+use crate::error::ParamError;
+use crate::error::{check_eta, check_g};
 use crate::fresnel::{DiffuseFresnel, FresnelMoments};
 use crate::model::{ProfileModel, Scattering};
 use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_u, numeric_radius_for_fraction};
 use crate::single_scattering::SingleScattering;
 
-/// Coefficients (1/length) below this are treated as exactly 0: a mean free path above 1e12
-/// scene units is vacuum for every practical scene, and it keeps `r = x/σ` finite.
-pub const SIGMA_EPSILON: f64 = 1e-12;
-/// Largest accepted coefficient (1/length); larger values are rejected as out of range.
-pub const SIGMA_MAX: f64 = 1e12;
+pub use crate::error::{ETA_RANGE, SIGMA_EPSILON, SIGMA_MAX, validate_sigmas};
 /// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
 /// |g| = 1 and `σs' = (1 − g)σs` degenerates; docs/physics.md#hazards).
 pub const G_MAX: f64 = 1.0 - 1e-6;
-/// Validated range of the relative index of refraction.
-pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
 
 /// Options of a family beyond the model, `g` and `η`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -81,19 +75,7 @@ impl ProfileFamily {
         options: FamilyOptions,
     ) -> Result<Self, ParamError> {
         check_g(g)?;
-        if !eta.is_finite() {
-            return Err(ParamError::NotFinite {
-                name: "eta",
-                value: eta,
-            });
-        }
-        if !(ETA_RANGE.0..=ETA_RANGE.1).contains(&eta) {
-            return Err(ParamError::OutOfRange {
-                name: "eta",
-                range: "[1, 3]",
-                value: eta,
-            });
-        }
+        check_eta(eta)?;
         // HG and the reduced coefficients degenerate at |g| = 1 (docs/physics.md#hazards): clamp.
         let g = g.clamp(-G_MAX, G_MAX);
         let moments = FresnelMoments::new(eta)?;
@@ -182,23 +164,6 @@ impl ProfileFamily {
             .then(|| SingleScattering::new(sigma_s / sigma_t, sigma_t, self.g, self.eta));
         Ok(Profile { multiple, single })
     }
-}
-
-/// Validates a coefficient pair: finite, ≥ 0, ≤ [`SIGMA_MAX`]; flushes values below
-/// [`SIGMA_EPSILON`] to 0.
-pub fn validate_sigmas(sigma_a: f64, sigma_s: f64) -> Result<(f64, f64), ParamError> {
-    let check = |name: &'static str, v: f64| -> Result<f64, ParamError> {
-        check_non_negative(name, v)?;
-        if v > SIGMA_MAX {
-            return Err(ParamError::OutOfRange {
-                name,
-                range: "[0, 1e12]",
-                value: v,
-            });
-        }
-        Ok(if v < SIGMA_EPSILON { 0.0 } else { v })
-    };
-    Ok((check("sigma_a", sigma_a)?, check("sigma_s", sigma_s)?))
 }
 
 /// The multiple-scattering (diffusion) part of a [`Profile`]. A future profile tabulated from

@@ -78,6 +78,7 @@ pub mod table;
 pub use error::ParamError;
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
 pub use fresnel::{DiffuseFresnel, FresnelMoments};
+pub use glam;
 pub use medium::MediumParams;
 pub use model::{ProfileModel, Scattering, UnknownName};
 pub use profile::RadialProfile;

@@ -8,13 +8,10 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use bssrdf_core::{ProfileModel, Scattering};
-use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
+use experiments::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::common::{
-    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, progress,
-    warn_counters,
-};
+use crate::common::{check_writable, parse_exr_out, parse_positive, parse_seconds, warn_counters};
 use crate::flags::{Given, check_method_flags};
 
 /// Texture kinds.
@@ -69,7 +66,7 @@ pub struct SetupArgs {
     pub resolution: u64,
     /// Scattering orders: multiple (the paper), single or all. (`converge` on a scene: as for
     /// `render`, default the scene's.)
-    #[arg(long, default_value = "multiple")]
+    #[arg(long, value_parser = crate::choices::scattering(), default_value = "multiple")]
     pub scattering: Scattering,
 }
 
@@ -157,10 +154,10 @@ pub struct Args {
     setup: SetupArgs,
     /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
     /// endpoints, segment, sone.
-    #[arg(long, value_parser = parse_method, default_value = "sone")]
+    #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
     /// Profile model for BSSRDF methods (default: dipole).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
@@ -179,7 +176,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
-    #[arg(long, value_parser = parse_exr_out)]
+    #[arg(short, long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
 }
 
@@ -194,25 +191,22 @@ pub fn run_method(
     show_progress: bool,
 ) -> anyhow::Result<BeamMap> {
     let bar = if !show_progress {
-        indicatif::ProgressBar::hidden()
+        experiments::progress::ProgressBar::hidden()
     } else if method == Method::PathTraced {
         let len = match photons {
-            PhotonBudget::Count(n) => n.div_ceil(8192) * 8192,
+            PhotonBudget::Count(n) => {
+                n.div_ceil(experiments::beam::BATCH) * experiments::beam::BATCH
+            }
             PhotonBudget::Time(_) => 0,
         };
-        progress(len, "pt", "photons")
+        experiments::progress::bar(len, "pt", "photons")
     } else {
-        progress(setup.resolution as u64, method.name(), "rows")
+        experiments::progress::bar(setup.resolution as u64, method.name(), "rows")
     };
-    let map = tracer::experiment::beam::run_method(
-        setup,
-        method,
-        profile,
-        photons,
-        subsamples,
-        seed,
-        &|k| bar.inc(k),
-    )?;
+    let map =
+        experiments::beam::run_method(setup, method, profile, photons, subsamples, seed, &|k| {
+            bar.inc(k)
+        })?;
     bar.finish_and_clear();
     Ok(map)
 }

@@ -1,16 +1,10 @@
-//! Helpers shared by the subcommands: method names, output paths, progress bars, summaries.
+//! Helpers shared by the subcommands: method names, output paths, summaries.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
-use tracer::integrator::{Method, PathCounters};
-
-/// Parses a `--method` value (`pt` or an estimator name).
-pub fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse()
-}
+use tracer::integrator::PathCounters;
 
 /// Parses a duration in seconds (> 0).
 pub fn parse_seconds(s: &str) -> Result<Duration, String> {
@@ -47,24 +41,10 @@ pub fn parse_exr_out(s: &str) -> Result<PathBuf, String> {
     }
 }
 
-/// A progress bar on stderr over `len` units (hidden when stderr is not a terminal).
-pub fn progress(len: u64, prefix: &str, unit: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{prefix:>14}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}  {{elapsed}}<{{eta}}"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar.set_prefix(prefix.to_string());
-    bar
-}
-
 /// Fails early, before a long run, if `path` (the `--out` value or its default) cannot be
 /// written. The library error names the path; the context names the flag.
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    tracer::experiment::run::check_output_path(path).context("invalid --out")
+    experiments::run::check_output_path(path).context("invalid --out")
 }
 
 /// One line per rare event that happened, so that no cap or fallback is silent.
@@ -79,6 +59,12 @@ pub fn warn_counters(c: &PathCounters) {
         eprintln!(
             "warning: {} rays inside a closed object found no boundary (paths ended)",
             c.leaks
+        );
+    }
+    if c.profile_failures > 0 {
+        eprintln!(
+            "warning: {} profile evaluations rejected their estimated coefficients (those channels contributed 0)",
+            c.profile_failures
         );
     }
     if c.estimator_fallbacks > 0 {

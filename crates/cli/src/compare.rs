@@ -4,10 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use tracer::experiment::metrics::{Metrics, MetricsError, compare, compare_films, log_ratio};
+use experiments::metrics::{Metrics, MetricsError, compare, compare_films, log_ratio};
+use experiments::plot::{MapPlot, MapScale, map_png};
 use tracer::film::Film;
 use tracer::output::read_exr;
-use tracer::plot::{MapPlot, MapScale, map_png};
 
 /// Arguments of `het-bssrdf compare`.
 #[derive(Debug, clap::Args)]

@@ -7,18 +7,19 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
-use tracer::experiment::beam::{PhotonBudget, write_beam_map};
-use tracer::experiment::converge::{MethodSummary, check_dir, summarize, write_outputs};
-use tracer::experiment::run::{RenderJob, write_render};
-use tracer::experiment::study::{
-    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, reference_path, scene_reference, scene_study,
+use experiments::beam::{PhotonBudget, write_beam_map};
+use experiments::converge::{MethodSummary, check_dir, summarize, write_outputs};
+use experiments::run::{RenderJob, write_render};
+use experiments::study::{
+    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
+    reference_key, scene_reference, scene_study,
 };
 use tracer::integrator::Method;
 use tracer::output::read_exr;
 use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
-use crate::common::{parse_method, parse_positive};
+use crate::common::parse_positive;
 use crate::flags::{Given, check_method_flags};
 
 /// Flags that set up the beam experiment: they do not apply to a scene.
@@ -53,18 +54,23 @@ pub struct Args {
     #[command(flatten)]
     setup: SetupArgs,
     /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
-    #[arg(long, value_delimiter = ',', value_parser = parse_method, default_value = "pt,jensen-out,endpoints,sone")]
+    #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
     /// Profile model of the BSSRDF methods (scene: default each material's).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// A reference image (EXR). Default: path traced at `--reference-spp` (scene, cached beside
-    /// it with its spp and seed in the name) or `--reference-photons` (beam, in --out).
+    /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
+    /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
+    /// (beam, in --out).
     #[arg(long)]
     reference: Option<PathBuf>,
+    /// Directory of cached scene references (default: `$XDG_CACHE_HOME/het-bssrdf`, else
+    /// `~/.cache/het-bssrdf`; `--out` when it cannot be written).
+    #[arg(long, env = "HET_BSSRDF_CACHE_DIR")]
+    cache_dir: Option<PathBuf>,
     /// Samples per pixel of the rendered reference.
     #[arg(long, value_parser = parse_positive, default_value_t = 1024, allow_hyphen_values = true)]
     reference_spp: u64,
@@ -91,7 +97,7 @@ pub struct Args {
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
     /// Output directory (created if missing).
-    #[arg(long)]
+    #[arg(short, long)]
     out: Option<PathBuf>,
 }
 
@@ -184,6 +190,27 @@ fn prepare_out(out: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The directory of cached references: `--cache-dir` (or `HET_BSSRDF_CACHE_DIR`), else the
+/// user's cache directory, checked before any rendering; when it cannot be created or written,
+/// `out` (with a warning).
+fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
+    let Some(dir) = given.map(Path::to_path_buf).or_else(default_cache_dir) else {
+        return out.to_path_buf();
+    };
+    let usable = std::fs::create_dir_all(&dir).is_ok()
+        && experiments::run::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
+    if usable {
+        dir
+    } else {
+        eprintln!(
+            "warning: the reference cache `{}` cannot be written; caching in `{}` instead",
+            dir.display(),
+            out.display()
+        );
+        out.to_path_buf()
+    }
+}
+
 fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     let file = args
         .scene
@@ -191,7 +218,6 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .expect("clap requires a scene without --beam");
     let scene = Scene::load(file)?;
     let mut base = RenderJob::from_scene(&scene, Method::PathTraced);
-    let defaults = (base.scattering, base.max_depth);
     if given.has("scattering") {
         base.scattering = args.setup.scattering;
     }
@@ -204,16 +230,9 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         Some(film) => film,
         None => {
             let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
-            let mut cache =
-                reference_path(file, spp, base.seed.wrapping_add(REFERENCE_SEED_OFFSET));
-            if (base.scattering, base.max_depth) != defaults {
-                // A reference of other settings than the scene's own has its own cache.
-                let stem = cache.file_stem().unwrap_or_default().to_string_lossy();
-                cache = cache.with_file_name(format!(
-                    "{stem}-{}-depth{}.exr",
-                    base.scattering, base.max_depth
-                ));
-            }
+            let key = reference_key(&scene, &base, spp)
+                .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
+            let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
             if !cache.is_file() {
                 eprintln!(
                     "rendering the path-traced reference at {spp} spp into {}",
@@ -239,7 +258,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
                 .with_estimator_samples(estimator_samples(args))
         })
         .collect();
-    let bar = crate::common::progress((methods.len() * spp.len()) as u64, "converge", "runs");
+    let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
     let mut finals = Vec::new();
     let runs = scene_study(
         &scene,
@@ -337,7 +356,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
             }
         })
         .sum();
-    let bar = crate::common::progress(runs_total as u64, "converge", "runs");
+    let bar = experiments::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
     let samples = estimator_samples(args);
     let methods: Vec<Method> = args

@@ -8,6 +8,7 @@
 //! invalid value of `--photons` rather than as an unknown argument `-5`.
 
 mod beam;
+mod choices;
 mod common;
 mod compare;
 mod converge;
@@ -18,6 +19,7 @@ mod reproduce;
 
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::{CommandFactory, FromArgMatches, Subcommand};
 
 /// Render heterogeneous translucent materials with homogeneous BSSRDFs, and measure them
@@ -25,6 +27,10 @@ use clap::{CommandFactory, FromArgMatches, Subcommand};
 #[derive(Debug, clap::Parser)]
 #[command(name = "het-bssrdf", version, about)]
 struct Cli {
+    /// Worker threads (default: the environment's RAYON_NUM_THREADS, else one per core).
+    /// Results are identical whatever the count.
+    #[arg(long, global = true, env = "RAYON_NUM_THREADS", value_parser = common::parse_positive)]
+    threads: Option<u64>,
     #[command(subcommand)]
     command: Command,
 }
@@ -43,9 +49,21 @@ enum Command {
     Converge(converge::Args),
     /// Run the paper's experiments end to end and write report.md.
     Reproduce(reproduce::Args),
+    /// Print a shell completion script, e.g. `het-bssrdf completions bash > het-bssrdf.bash`.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
 }
 
 fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
+    if let Some(n) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(usize::try_from(n).context("--threads is too large")?)
+            .build_global()
+            .context("cannot start the worker threads (--threads)")?;
+    }
     match cli.command {
         Command::Profile(args) => profile::run(args),
         Command::Render(args) => render::run(args),
@@ -53,6 +71,11 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args),
         Command::Converge(args) => converge::run(args, &given),
         Command::Reproduce(args) => reproduce::run(args),
+        Command::Completions { shell } => {
+            let mut cmd = Cli::command();
+            clap_complete::generate(shell, &mut cmd, "het-bssrdf", &mut std::io::stdout());
+            Ok(())
+        }
     }
 }
 

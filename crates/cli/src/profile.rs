@@ -23,7 +23,7 @@ pub enum SingleScattering {
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Profile model: dipole, pbd or better-dipole.
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     model: ProfileModel,
     /// Absorption coefficient σa (1/length, ≥ 0).
     #[arg(long = "sigma-a", allow_hyphen_values = true)]

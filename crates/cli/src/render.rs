@@ -6,14 +6,13 @@ use std::time::Duration;
 
 use anyhow::Context;
 use bssrdf_core::{ProfileModel, Scattering};
-use tracer::experiment::run::{RenderJob, render_scene, sidecar_paths, write_render};
+use experiments::run::{RenderJob, render_scene, sidecar_paths, write_render};
+use het_estimate::{Estimator, SoneParams};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
 
-use crate::common::{
-    check_writable, parse_exr_out, parse_method, parse_positive, parse_seconds, warn_counters,
-};
+use crate::common::{check_writable, parse_exr_out, parse_positive, parse_seconds, warn_counters};
 use crate::flags::check_method_flags;
 
 /// Arguments of `het-bssrdf render`.
@@ -23,10 +22,10 @@ pub struct Args {
     scene: PathBuf,
     /// `pt` (the path-traced reference) or a BSSRDF estimator: jensen-in, jensen-out,
     /// endpoints, segment, sone. Default: the scene's `render.estimator`, else `sone`.
-    #[arg(long, value_parser = parse_method)]
+    #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
     /// Profile model for BSSRDF methods (default: each material's, else dipole).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
@@ -43,14 +42,14 @@ pub struct Args {
     seed: Option<u64>,
     /// Scattering orders inside media: multiple, single or all (default: the scene's, else
     /// multiple, as in the paper).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::choices::scattering())]
     scattering: Option<Scattering>,
     /// Most surface interactions per path (default: the scene's, else 8).
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     max_depth: Option<u64>,
     /// Output EXR (default: `<scene>-<method>.exr` in the current directory); the PNG preview
     /// and JSON sidecar are written beside it.
-    #[arg(long, value_parser = parse_exr_out)]
+    #[arg(short, long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -62,11 +61,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = Scene::load(&args.scene)?;
     let method = match args.method {
         Some(m) => m,
-        None => match &scene.settings.estimator {
-            Some(name) => name.parse().map_err(|e: String| {
-                anyhow::anyhow!("{}: render.estimator: {e}", args.scene.display())
-            })?,
-            None => "sone".parse().expect("built-in estimator name"),
+        None => Method::Bssrdf {
+            estimator: scene
+                .settings
+                .estimator
+                .unwrap_or(Estimator::Sone(SoneParams::paper())),
+            profile: None,
         },
     };
     check_method_flags(

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use tracer::experiment::reproduce::{Scale, reproduce};
+use experiments::reproduce::{Scale, reproduce};
 
 /// How much work to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -27,7 +27,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     scale: Option<ScaleArg>,
     /// Output directory (created if missing).
-    #[arg(long, default_value = "reproduce-out")]
+    #[arg(short, long, default_value = "reproduce-out")]
     out: PathBuf,
     /// Seed of the runs (references use a different one).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
@@ -48,7 +48,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.out.display()
         )
     })?;
-    tracer::experiment::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
+    experiments::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
         .context("invalid --out")?;
     eprintln!(
         "reproduce ({} scale): expected time {}; writing into {}",
@@ -56,7 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         scale.expected,
         args.out.display()
     );
-    let bar = indicatif::ProgressBar::new_spinner();
+    let bar = experiments::progress::ProgressBar::new_spinner();
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     let start = Instant::now();
     let mut step = |msg: &str| {

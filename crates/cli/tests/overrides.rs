@@ -13,6 +13,7 @@ fn converge_writes_each_methods_largest_render_with_its_real_parameters() {
     std::fs::write(&scene_path, scene).unwrap();
     let out = dir.path().join("study");
     let status = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .env("HET_BSSRDF_CACHE_DIR", dir.path().join("cache"))
         .args([
             "converge",
             scene_path.to_str().unwrap(),

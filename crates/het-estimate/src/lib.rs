@@ -5,6 +5,7 @@
 //! `cargo doc` as `het_bssrdf::physics`), cited as `docs/physics.md#section`.
 //!
 //! # Use
+//! (The example borrows the analytic plane of the `fixtures` feature.)
 //! ```
 //! use het_estimate::analytic::{Plane, PlanePoint, StripeField};
 //! use het_estimate::pattern::Stripe;
@@ -33,7 +34,8 @@
 //!   cost nothing) or an exact/prefiltered ellipse average (so summed-area tables or EWA can
 //!   replace sampling). Geometry and texturing are separate because they vary separately
 //!   (one mesh, many textures; one procedural field, many shapes), and because tests and
-//!   benchmarks substitute analytic versions of each ([`analytic`]). The point type is the
+//!   benchmarks substitute analytic versions of each (module `analytic`, behind the
+//!   `fixtures` feature). The point type is the
 //!   renderer's (`SurfaceQuery::Point`), so a lookup can use triangle ids and UVs.
 //! * **A closed set, resolved once.** [`Estimator`] is an enum (names `jensen-in`,
 //!   `jensen-out`, `endpoints`, `segment`, `sone`); [`Estimator::prepare`] validates it and
@@ -57,6 +59,7 @@
 #[macro_use]
 pub mod names;
 
+#[cfg(feature = "fixtures")]
 pub mod analytic;
 pub mod budget;
 mod chord;
@@ -81,9 +84,12 @@ pub use ellipse::PlanarEllipse;
 pub use estimate::{Diagnostics, Estimate, Region};
 pub use estimator::{Estimator, PreparedEstimator};
 pub use field::{CoefficientField, Coefficients, FieldBounds};
+pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
-pub use sampler::{SplitMix64, UniformSource};
+#[cfg(feature = "fixtures")]
+pub use sampler::SplitMix64;
+pub use sampler::UniformSource;
 pub use segment::SegmentParams;
 pub use sone::SoneParams;
 pub use surface::{SurfacePoint, SurfaceQuery};

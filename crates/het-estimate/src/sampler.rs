@@ -15,12 +15,14 @@ impl<U: UniformSource + ?Sized> UniformSource for &mut U {
 
 /// SplitMix64 (SLF14: Steele, Lea & Flood 2014): a
 /// tiny seeded [`UniformSource`] for tests, examples and benchmarks. Renderers pass their own
-/// per-pixel stream instead.
+/// per-pixel stream instead. Behind the `fixtures` feature.
+#[cfg(any(test, feature = "fixtures"))]
 #[derive(Debug, Clone)]
 pub struct SplitMix64 {
     state: u64,
 }
 
+#[cfg(any(test, feature = "fixtures"))]
 impl SplitMix64 {
     /// A stream determined by `seed`.
     pub const fn new(seed: u64) -> Self {
@@ -38,6 +40,7 @@ impl SplitMix64 {
     }
 }
 
+#[cfg(any(test, feature = "fixtures"))]
 impl UniformSource for SplitMix64 {
     /// 53 random bits scaled into `[0, 1)`.
     #[inline]

@@ -7,15 +7,12 @@
 
 pub mod camera;
 pub mod error;
-pub mod experiment;
 pub mod field;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod light;
 pub mod output;
-#[cfg(feature = "plot")]
-pub mod plot;
 pub mod render;
 pub mod rng;
 pub mod scene;

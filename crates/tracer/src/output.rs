@@ -142,10 +142,39 @@ pub fn write_png(film: &Film, path: &Path, exposure_stops: f64) -> Result<(), Ou
     }
 }
 
+/// A custom attribute of an EXR header, as pbrt-v4 records render metadata
+/// (`samplesPerPixel`, `seed`, …).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum ExrAttribute {
+    /// A 32-bit integer (`int`).
+    Int(i32),
+    /// A 32-bit float (`float`).
+    Float(f32),
+    /// Latin-1 text (`string`).
+    Text(String),
+}
+
 /// Writes the film as an EXR with three `f32` channels R, G, B.
 pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
+    write_exr_with_attributes(film, path, &[])
+}
+
+/// The EXR header attribute (a string) in which [`write_exr_with_attributes`] records its
+/// metadata: `name=value` pairs joined by `; `.
+pub const METADATA_ATTRIBUTE: &str = "hetBssrdf";
+
+/// [`write_exr`] with render metadata in the header (names and values must be Latin-1), as
+/// pbrt-v4 records its own; they are joined into the one string attribute
+/// [`METADATA_ATTRIBUTE`] so that the file's bytes stay reproducible.
+pub fn write_exr_with_attributes(
+    film: &Film,
+    path: &Path,
+    attributes: &[(&str, ExrAttribute)],
+) -> Result<(), OutputError> {
     #[cfg(feature = "exr")]
     {
+        use exr::meta::attribute::{AttributeValue, Text};
         use exr::prelude::*;
         check_size(film.width, film.height, film.pixels.len(), path)?;
         let w = film.width as usize;
@@ -153,16 +182,39 @@ pub fn write_exr(film: &Film, path: &Path) -> Result<(), OutputError> {
             let p = film.pixels[y * w + x];
             (p[0] as f32, p[1] as f32, p[2] as f32)
         });
-        let image = Image::from_encoded_channels(
+        let mut image = Image::from_encoded_channels(
             (film.width as usize, film.height as usize),
             fixed_order(),
             channels,
         );
+        if !attributes.is_empty() {
+            // One attribute holding every pair, in the caller's order: the EXR crate keeps
+            // custom attributes in a hash map whose order changes from process to process, so
+            // several attributes would make the file's bytes differ between identical renders.
+            let joined = attributes
+                .iter()
+                .map(|(name, value)| match value {
+                    ExrAttribute::Int(v) => format!("{name}={v}"),
+                    ExrAttribute::Float(v) => format!("{name}={v}"),
+                    ExrAttribute::Text(v) => format!("{name}={v}"),
+                })
+                .collect::<Vec<_>>()
+                .join("; ");
+            let text = Text::new_or_none(&joined).ok_or_else(|| OutputError::Encode {
+                path: path.to_path_buf(),
+                message: format!("EXR header text must be Latin-1: `{joined}`"),
+            })?;
+            image
+                .layer_data
+                .attributes
+                .other
+                .insert(Text::from(METADATA_ATTRIBUTE), AttributeValue::Text(text));
+        }
         encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
     {
-        let _ = film;
+        let _ = (film, attributes);
         Err(OutputError::Unsupported {
             path: path.to_path_buf(),
             feature: "exr",

@@ -1,5 +1,5 @@
 //! The render loop shared by every integrator: rows rendered in parallel with rayon, one random
-//! stream per (pixel, sample), a fixed sample count or a time budget, and a progress bar.
+//! stream per (pixel, sample), a fixed sample count or a time budget, and a progress callback.
 //!
 //! Determinism: every pixel sample draws from `Rng::for_pixel_sample(seed, x, y, s)` and each
 //! pixel's samples are added to its running sum in increasing `s` by one thread, so the image is
@@ -10,7 +10,6 @@
 use std::time::{Duration, Instant};
 
 use bssrdf_core::Rgb;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
 use crate::rng::Rng;
@@ -47,6 +46,7 @@ pub trait PixelEstimator: Sync {
 
 /// The result of a render.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Rendered<C> {
     /// Width in pixels.
     pub width: u32,
@@ -69,24 +69,52 @@ pub struct RenderOptions {
     pub budget: Budget,
     /// Seed of every random stream.
     pub seed: u64,
-    /// Show a progress bar on stderr (hidden automatically when stderr is not a terminal).
-    pub progress: bool,
-    /// Label of the progress bar.
-    pub label: String,
 }
 
-/// Renders `width × height` pixels with `estimator` (see the module docs).
+/// Receives the progress of a render (to draw a progress bar, log, or ignore it). Calls come
+/// from the rendering threads.
+pub trait Progress: Sync {
+    /// A pass over `rows` rows starts (a time-budget render makes several passes).
+    fn start_pass(&self, rows: u64);
+    /// One row of the current pass is finished.
+    fn row_done(&self);
+    /// The render is finished.
+    fn finish(&self);
+}
+
+/// A [`Progress`] that ignores every call.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn start_pass(&self, _: u64) {}
+    fn row_done(&self) {}
+    fn finish(&self) {}
+}
+
+/// Renders `width × height` pixels with `estimator` (see the module docs), reporting no
+/// progress.
 pub fn render<E: PixelEstimator>(
     width: u32,
     height: u32,
     estimator: &E,
     options: &RenderOptions,
 ) -> Rendered<E::Counters> {
+    render_with_progress(width, height, estimator, options, &NoProgress)
+}
+
+/// [`render`], reporting each finished row to `progress`.
+pub fn render_with_progress<E: PixelEstimator>(
+    width: u32,
+    height: u32,
+    estimator: &E,
+    options: &RenderOptions,
+    progress: &dyn Progress,
+) -> Rendered<E::Counters> {
     let start = Instant::now();
     let n = width as usize * height as usize;
     let mut sums = vec![Rgb::ZERO; n];
     let mut counters = E::Counters::default();
-    let bar = progress_bar(options, height as u64);
     // Fixed count: one pass. Time budget: passes of 1, 1, 2, 4, … samples.
     let mut done = 0u32;
     let mut pass = match options.budget {
@@ -94,6 +122,7 @@ pub fn render<E: PixelEstimator>(
         Budget::Time(_) => 1,
     };
     loop {
+        progress.start_pass(height as u64);
         let end = done.saturating_add(pass);
         let pass_start = Instant::now();
         let row_counters: Vec<E::Counters> = sums
@@ -111,7 +140,7 @@ pub fn render<E: PixelEstimator>(
                         *sum += v;
                     }
                 }
-                bar.inc(1);
+                progress.row_done();
                 c
             })
             .collect();
@@ -130,9 +159,8 @@ pub fn render<E: PixelEstimator>(
             break;
         }
         pass = next;
-        bar.reset();
     }
-    bar.finish_and_clear();
+    progress.finish();
     let inv = 1.0 / done as f64;
     Rendered {
         width,
@@ -142,21 +170,6 @@ pub fn render<E: PixelEstimator>(
         seconds: start.elapsed().as_secs_f64(),
         counters,
     }
-}
-
-/// A progress bar over `len` units on stderr, or a hidden one.
-pub fn progress_bar(options: &RenderOptions, len: u64) -> ProgressBar {
-    if !options.progress {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template("{prefix:>12} [{bar:40}] {pos}/{len} rows  {elapsed}<{eta}")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar.set_prefix(options.label.clone());
-    bar
 }
 
 #[cfg(test)]
@@ -173,12 +186,7 @@ mod tests {
     }
 
     fn opts(budget: Budget) -> RenderOptions {
-        RenderOptions {
-            budget,
-            seed: 5,
-            progress: false,
-            label: String::new(),
-        }
+        RenderOptions { budget, seed: 5 }
     }
 
     #[test]

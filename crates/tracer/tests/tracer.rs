@@ -16,6 +16,8 @@ mod meshes;
 mod offset;
 #[path = "tracer/output.rs"]
 mod output;
+#[path = "tracer/ply.rs"]
+mod ply;
 #[path = "tracer/scene.rs"]
 mod scene;
 #[path = "tracer/textures.rs"]

@@ -15,11 +15,11 @@
 //! from the `+axis` side (for axis z: from above, x right, y up) appears upright. For texture
 //! coordinates, `(u, v)` with `v` up (OBJ convention) reads the image at `(u, 1 − v)`.
 
-mod projection;
 mod texture;
+mod texture_mapping;
 
-pub use projection::{Axis, PlanarProjection};
 pub use texture::{Filter, Texture, Wrap};
+pub use texture_mapping::{Axis, PlanarProjection};
 
 use std::sync::Arc;
 

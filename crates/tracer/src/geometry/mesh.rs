@@ -28,6 +28,7 @@ pub struct TriangleMesh {
 /// Edges are found on vertices welded by exact position, so seams where a loader duplicated a
 /// vertex for a different normal or texture coordinate do not count as open edges.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[non_exhaustive]
 pub struct MeshReport {
     /// Number of triangles.
     pub triangles: usize,

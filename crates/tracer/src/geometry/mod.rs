@@ -28,6 +28,8 @@ pub mod gltf;
 pub mod mesh;
 #[cfg(feature = "obj")]
 pub mod obj;
+#[cfg(feature = "ply")]
+pub mod ply;
 pub mod primitives;
 pub mod surface;
 mod watertight;

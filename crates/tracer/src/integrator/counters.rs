@@ -9,6 +9,7 @@ use crate::volume::TrackingCounters;
 
 /// Counters of one render (or one row of it).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct PathCounters {
     /// Camera paths (or photons) started.
     pub paths: u64,
@@ -38,6 +39,10 @@ pub struct PathCounters {
     pub short_circuits: u64,
     /// Estimates where a channel fell back to the endpoint average (no hits at all).
     pub estimator_fallbacks: u64,
+    /// Profile evaluations whose estimated coefficients the profile rejected; those channels
+    /// contribute 0, so a non-zero count means a bias (never expected: scenes are validated
+    /// with the profiles' own bounds at load).
+    pub profile_failures: u64,
 }
 
 impl PathCounters {
@@ -48,6 +53,40 @@ impl PathCounters {
         self.projection_misses += d.misses as u64;
         self.short_circuits += d.short_circuit as u64;
         self.estimator_fallbacks += d.fallback as u64;
+    }
+
+    /// The diffuse reflectance profile `R(r)` (1/length², the paper's Eq. 1 kernel) of the
+    /// coefficients `c`, per channel, at distance `r`. A channel whose coefficients `family`
+    /// rejects contributes 0 and is counted in [`PathCounters::profile_failures`].
+    pub fn eval_profile(
+        &mut self,
+        family: &bssrdf_core::ProfileFamily,
+        c: het_estimate::Coefficients,
+        r: f64,
+    ) -> bssrdf_core::Rgb {
+        let mut rd = bssrdf_core::Rgb::ZERO;
+        for ch in 0..3 {
+            rd[ch] = self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r);
+        }
+        rd
+    }
+
+    /// [`PathCounters::eval_profile`] for one channel's coefficients (1/length).
+    pub fn eval_profile_channel(
+        &mut self,
+        family: &bssrdf_core::ProfileFamily,
+        sigma_a: f64,
+        sigma_s: f64,
+        r: f64,
+    ) -> f64 {
+        use bssrdf_core::RadialProfile;
+        match family.profile(sigma_a, sigma_s) {
+            Ok(profile) => profile.eval(r),
+            Err(_) => {
+                self.profile_failures += 1;
+                0.0
+            }
+        }
     }
 
     /// Adds tracking work.
@@ -72,5 +111,29 @@ impl Counters for PathCounters {
         self.projection_misses += o.projection_misses;
         self.short_circuits += o.short_circuits;
         self.estimator_fallbacks += o.estimator_fallbacks;
+        self.profile_failures += o.profile_failures;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bssrdf_core::{ProfileFamily, ProfileModel, Scattering};
+
+    #[test]
+    fn rejected_profiles_are_counted_not_silent() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let mut c = PathCounters::default();
+        let ok = c.eval_profile_channel(&family, 0.01, 1.0, 0.5);
+        assert!(ok.is_finite() && ok > 0.0, "{ok}");
+        assert_eq!(c.profile_failures, 0);
+        // Above the profiles' bound (1e12) and negative: 0, each counted.
+        assert_eq!(c.eval_profile_channel(&family, 1e13, 1.0, 0.5), 0.0);
+        assert_eq!(c.eval_profile_channel(&family, -1.0, 1.0, 0.5), 0.0);
+        assert_eq!(c.profile_failures, 2);
+        let mut merged = PathCounters::default();
+        merged.merge(&c);
+        assert_eq!(merged.profile_failures, 2, "merge drops the count");
     }
 }

@@ -4,6 +4,7 @@
 
 pub mod counters;
 pub mod lighting;
+mod method;
 pub mod path;
 pub mod probe;
 pub mod walk;

@@ -27,7 +27,7 @@
 //! estimation through the medium, cosine continuation) and the path walks on in the same
 //! medium. Shadow rays know the medium they start in.
 
-use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator, PreparedEstimator};
 
@@ -1002,12 +1002,7 @@ impl<'s> PathIntegrator<'s> {
             counters.record_estimate(&est.diagnostics);
             let r = (x_i.p - hit.p).length();
             let c = est.coefficients;
-            let mut rd = Rgb::ZERO;
-            for ch in 0..3 {
-                if let Ok(profile) = b.family.profile(c.sigma_a[ch], c.sigma_s[ch]) {
-                    rd[ch] = profile.eval(r);
-                }
-            }
+            let rd = counters.eval_profile(&b.family, c, r);
             let w = rd * ph.weight;
             st.l += st.beta * w * ld;
             if k == carrier {

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use bssrdf_core::Rgb;
+use bssrdf_core::error::{check_eta, check_g, check_sigma};
 
 use super::locate::Locator;
 use super::{Material, Object, RenderSettings, Scene, Translucent};
@@ -126,6 +127,7 @@ impl SceneBuilder {
                 display_name: self.name.clone(),
                 source_path: None,
                 locator: &Locator::empty(),
+                inputs: Vec::new(),
             },
             self.settings,
             self.camera,
@@ -150,6 +152,7 @@ pub(crate) struct AssemblyInfo<'a> {
     pub display_name: String,
     pub source_path: Option<PathBuf>,
     pub locator: &'a Locator,
+    pub inputs: Vec<PathBuf>,
 }
 
 /// Checks `[render]` values; `Err((key, message))`.
@@ -200,18 +203,20 @@ pub(crate) fn validate_material(m: &Material) -> Result<(), (String, String)> {
 }
 
 fn validate_translucent(t: &Translucent) -> Result<(), (String, String)> {
-    if !(t.g.is_finite() && t.g.abs() < 1.0) {
-        return Err(("g".into(), format!("|g| must be < 1, got {}", t.g)));
-    }
-    if !(t.eta.is_finite() && t.eta >= 1.0) {
-        return Err((
-            "eta".into(),
-            format!(
-                "eta (n_medium / n_outside) must be finite and ≥ 1, got {}",
-                t.eta
-            ),
-        ));
-    }
+    validate_translucent_scalars(t)?;
+    validate_medium(t)
+}
+
+/// Checks a translucent material's `g`, `eta` and `unit_scale` with the bounds every profile
+/// and estimator accepts (`bssrdf_core::error`), so that no method can reject them later.
+pub(crate) fn validate_translucent_scalars(t: &Translucent) -> Result<(), (String, String)> {
+    check_g(t.g).map_err(|e| ("g".to_string(), format!("|g| must be < 1: {e}")))?;
+    check_eta(t.eta).map_err(|e| {
+        (
+            "eta".to_string(),
+            format!("eta (n_medium / n_outside): {e}"),
+        )
+    })?;
     if !(t.unit_scale.is_finite() && t.unit_scale > 0.0) {
         return Err((
             "unit_scale".into(),
@@ -221,19 +226,23 @@ fn validate_translucent(t: &Translucent) -> Result<(), (String, String)> {
             ),
         ));
     }
+    Ok(())
+}
+
+/// Checks σa and σs everywhere (after `unit_scale`) against the bounds every profile accepts:
+/// finite, ≥ 0 and ≤ 1e12 per scene unit (`bssrdf_core::error::check_sigma`).
+pub(crate) fn validate_medium(t: &Translucent) -> Result<(), (String, String)> {
     for (k, f) in [
         ("sigma_a", t.medium.sigma_a()),
         ("sigma_s", t.medium.sigma_s()),
     ] {
-        if !(rgb_ok(f.min()) && rgb_ok(f.max())) {
-            return Err((
-                k.into(),
-                format!(
-                    "{k} must be finite and non-negative everywhere (range {:?} to {:?})",
-                    f.min().0,
-                    f.max().0
-                ),
-            ));
+        for v in f.min().0.into_iter().chain(f.max().0) {
+            check_sigma(k, v).map_err(|e| {
+                (
+                    k.to_string(),
+                    format!("{e} (per scene unit, after unit_scale)"),
+                )
+            })?;
         }
     }
     Ok(())
@@ -301,6 +310,7 @@ pub(crate) fn assemble(
         settings,
         source_path: info.source_path,
         display_name: info.display_name,
+        inputs: info.inputs,
     };
     scene.require_disjoint_media()?;
     Ok(scene)

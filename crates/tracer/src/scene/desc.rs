@@ -50,6 +50,24 @@ fn rgb_from_seq<'de, A: SeqAccess<'de>>(
     Ok(RgbDesc(v))
 }
 
+/// Exactly `N` elements: serde's fixed-size arrays silently ignore extra elements, so that
+/// `min = [-2, -2, -2, 5]` would load as `[-2, -2, -2]`.
+fn exact<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
+    d: D,
+) -> Result<[T; N], D::Error> {
+    let v: Vec<T> = Vec::deserialize(d)?;
+    let n = v.len();
+    v.try_into()
+        .map_err(|_| de::Error::invalid_length(n, &format!("an array of {N} elements").as_str()))
+}
+
+/// [`exact`] for an optional key.
+fn exact_opt<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
+    d: D,
+) -> Result<Option<[T; N]>, D::Error> {
+    exact(d).map(Some)
+}
+
 /// A coefficient field: a number (grey constant), `[r, g, b]` (constant), or a table with a
 /// `type` (constant | stripe | check | image).
 #[derive(Debug, Clone, PartialEq)]
@@ -120,16 +138,19 @@ pub struct FieldTable {
     /// stripe: angle θ in DEGREES; bands vary along (cos θ, sin θ) in the (s, t) plane.
     pub angle: Option<f64>,
     /// stripe / check: the two values.
+    #[serde(default, deserialize_with = "exact_opt")]
     pub values: Option<[RgbDesc; 2]>,
     /// Projection axis `"x" | "y" | "z"` (default z).
     pub axis: Option<AxisDesc>,
     /// Projection origin (default `[0, 0, 0]`).
+    #[serde(default, deserialize_with = "exact_opt")]
     pub origin: Option<[f64; 3]>,
     /// image: the `[[texture]]` name.
     pub texture: Option<String>,
     /// image: `"planar"` (default) or `"uv"`.
     pub mapping: Option<MappingDesc>,
     /// image, planar: world size `[W, H]` of the image (scene units).
+    #[serde(default, deserialize_with = "exact_opt")]
     pub size: Option<[f64; 2]>,
     /// image: `"repeat"` (default) or `"clamp"`.
     pub wrap: Option<WrapDesc>,
@@ -196,7 +217,7 @@ pub struct RenderDesc {
     pub seed: u64,
     /// Maximum path depth (renderer default when absent).
     pub max_depth: Option<u32>,
-    /// Estimator name (parsed by the renderer).
+    /// BSSRDF estimator name.
     pub estimator: Option<String>,
     /// `"multiple" | "single" | "all"`.
     pub scattering: Option<String>,
@@ -209,10 +230,13 @@ pub struct PerspectiveDesc {
     #[serde(rename = "type")]
     _type: String,
     /// Eye position.
+    #[serde(deserialize_with = "exact")]
     pub eye: [f64; 3],
     /// Point looked at.
+    #[serde(deserialize_with = "exact")]
     pub target: [f64; 3],
     /// Up direction on screen.
+    #[serde(deserialize_with = "exact")]
     pub up: [f64; 3],
     /// Full vertical field of view in DEGREES.
     pub fov_y: f64,
@@ -225,10 +249,13 @@ pub struct OrthographicDesc {
     #[serde(rename = "type")]
     _type: String,
     /// Centre of the view rectangle (rays start on its plane).
+    #[serde(deserialize_with = "exact")]
     pub centre: [f64; 3],
     /// View direction (rays travel along it).
+    #[serde(deserialize_with = "exact")]
     pub direction: [f64; 3],
     /// Up direction on screen.
+    #[serde(deserialize_with = "exact")]
     pub up: [f64; 3],
     /// View width (scene units).
     pub width: f64,
@@ -299,6 +326,7 @@ pub struct DirectionalDesc {
     #[serde(rename = "type")]
     _type: String,
     /// Direction the light TRAVELS.
+    #[serde(deserialize_with = "exact")]
     pub direction: [f64; 3],
     /// Irradiance on a surface perpendicular to the light.
     pub irradiance: RgbDesc,
@@ -311,6 +339,7 @@ pub struct PointDesc {
     #[serde(rename = "type")]
     _type: String,
     /// Position.
+    #[serde(deserialize_with = "exact")]
     pub position: [f64; 3],
     /// Intensity (W/sr).
     pub intensity: RgbDesc,
@@ -323,10 +352,13 @@ pub struct QuadDesc {
     #[serde(rename = "type")]
     _type: String,
     /// A corner.
+    #[serde(deserialize_with = "exact")]
     pub corner: [f64; 3],
     /// First edge.
+    #[serde(deserialize_with = "exact")]
     pub edge_u: [f64; 3],
     /// Second edge; light leaves on the side of edge_u × edge_v.
+    #[serde(deserialize_with = "exact")]
     pub edge_v: [f64; 3],
     /// Radiance.
     pub radiance: RgbDesc,
@@ -349,8 +381,10 @@ pub struct BeamDesc {
     #[serde(rename = "type")]
     _type: String,
     /// Start point.
+    #[serde(deserialize_with = "exact")]
     pub origin: [f64; 3],
     /// Direction of travel.
+    #[serde(deserialize_with = "exact")]
     pub direction: [f64; 3],
     /// Power.
     pub power: RgbDesc,
@@ -365,6 +399,7 @@ pub struct TransformDesc {
     /// Rotation about an axis, applied second.
     pub rotate: Option<RotateDesc>,
     /// Translation, applied last.
+    #[serde(default, deserialize_with = "exact_opt")]
     pub translate: Option<[f64; 3]>,
 }
 
@@ -373,6 +408,7 @@ pub struct TransformDesc {
 #[serde(deny_unknown_fields)]
 pub struct RotateDesc {
     /// Rotation axis (need not be unit).
+    #[serde(deserialize_with = "exact")]
     pub axis: [f64; 3],
     /// Angle in DEGREES, right-handed about `axis`.
     pub degrees: f64,
@@ -422,8 +458,10 @@ shape_desc!(
     /// `[[shape]]` with `type = "box"`.
     BoxDesc {
         /// Smallest corner.
+        #[serde(deserialize_with = "exact")]
         min: [f64; 3],
         /// Largest corner.
+        #[serde(deserialize_with = "exact")]
         max: [f64; 3],
     }
 );
@@ -432,6 +470,7 @@ shape_desc!(
     /// `[[shape]]` with `type = "sphere"`.
     SphereDesc {
         /// Centre.
+        #[serde(deserialize_with = "exact")]
         centre: [f64; 3],
         /// Radius.
         radius: f64,
@@ -446,6 +485,7 @@ shape_desc!(
         /// Height of the surface (default 0).
         top: Option<f64>,
         /// Centre of the top face in x, y (default `[0, 0]`).
+        #[serde(default, deserialize_with = "exact_opt")]
         centre: Option<[f64; 2]>,
         /// Side of the top face (default 1000).
         size: Option<f64>,
@@ -457,17 +497,9 @@ shape_desc!(
 );
 
 shape_desc!(
-    /// `[[shape]]` with `type = "obj"`.
-    ObjDesc {
-        /// Mesh file, relative to the scene file.
-        path: String,
-    }
-);
-
-shape_desc!(
-    /// `[[shape]]` with `type = "gltf"`.
-    GltfDesc {
-        /// Mesh file (.gltf or .glb), relative to the scene file.
+    /// `[[shape]]` with `type = "obj"`, `"gltf"` or `"ply"`.
+    MeshFileDesc {
+        /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
     }
 );

@@ -11,7 +11,10 @@ use serde::Deserialize;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 
-use super::builder::{AssemblyInfo, PendingObject, assemble, validate_material, validate_settings};
+use super::builder::{
+    AssemblyInfo, PendingObject, assemble, validate_material, validate_medium, validate_settings,
+    validate_translucent_scalars,
+};
 use super::desc::*;
 use super::locate::Locator;
 use super::{Material, RenderSettings, Scene, Translucent};
@@ -66,6 +69,7 @@ impl Scene {
             file,
             base_dir: base_dir.to_path_buf(),
             loc,
+            inputs: Default::default(),
         };
         cx.load(&root, display_name)
     }
@@ -76,6 +80,8 @@ struct Cx {
     file: PathBuf,
     base_dir: PathBuf,
     loc: Locator,
+    /// Every mesh and texture file found readable, in the order they were checked.
+    inputs: std::cell::RefCell<Vec<PathBuf>>,
 }
 
 type Val<'i> = Spanned<DeValue<'i>>;
@@ -174,7 +180,10 @@ impl Cx {
 
     fn check_readable(&self, key: &str, path: &Path) -> Result<(), SceneError> {
         match std::fs::metadata(path) {
-            Ok(m) if m.is_file() => Ok(()),
+            Ok(m) if m.is_file() => {
+                self.inputs.borrow_mut().push(path.to_path_buf());
+                Ok(())
+            }
             Ok(_) => Err(SceneError::Io {
                 file: self.file.clone(),
                 key: key.to_string(),
@@ -229,6 +238,18 @@ impl Cx {
                     m
                 }
             };
+            if let Material::Translucent(t) = &material
+                && !t.medium.is_volumetric()
+                && s.mesh.uvs.is_none()
+            {
+                return Err(self.invalid(
+                    &s.key,
+                    format!(
+                        "object `{}` has no texture coordinates, but its material `{}` maps an image by `mapping = \"uv\"`; use a planar mapping or a mesh with UVs",
+                        s.name, s.material
+                    ),
+                ));
+            }
             pending.push(PendingObject {
                 name: s.name,
                 line: self.loc.line_of_key(&s.key),
@@ -244,6 +265,7 @@ impl Cx {
                 display_name: display_name.to_string(),
                 source_path: None,
                 locator: &self.loc,
+                inputs: self.inputs.take(),
             },
             settings,
             camera,
@@ -264,13 +286,22 @@ impl Cx {
                     .map_err(|e| self.invalid("render.scattering", e.to_string()))?,
             ),
         };
+        let estimator = match &r.estimator {
+            None => None,
+            Some(name) => Some(name.parse::<het_estimate::Estimator>().map_err(|e| {
+                self.invalid(
+                    "render.estimator",
+                    format!("{e} (`pt` is not an estimator: the path tracer is chosen with `--method pt`)"),
+                )
+            })?),
+        };
         let s = RenderSettings {
             width: r.width,
             height: r.height,
             spp: r.spp,
             seed: r.seed,
             max_depth: r.max_depth,
-            estimator: r.estimator,
+            estimator,
             scattering,
         };
         validate_settings(&s).map_err(|(k, m)| self.invalid(&format!("render.{k}"), m))?;
@@ -385,7 +416,7 @@ impl Cx {
                         key: key.clone(),
                         line: self.loc.line_of_key(&key),
                     };
-                    validate_material(&Material::Translucent(probe.clone()))
+                    validate_translucent_scalars(&probe)
                         .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
                     (
                         d.name.clone(),
@@ -595,6 +626,7 @@ impl Cx {
                 let s = self.realize_field(sigma_s, textures, decoded)?;
                 let mut t = base.clone();
                 t.medium = MediumField::new(a, s).scaled(base.unit_scale);
+                validate_medium(&t).map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
                 Ok(Material::Translucent(t))
             }
         }
@@ -696,7 +728,7 @@ impl Cx {
         t: &DeTable<'_>,
         materials: &HashMap<String, MaterialPlan>,
     ) -> Result<Vec<ShapePlan>, SceneError> {
-        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\"";
+        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\" | \"ply\"";
         let mut out: Vec<ShapePlan> = Vec::new();
         let mut names = HashSet::new();
         for (i, (key, v)) in self.elements(t, "shape")?.into_iter().enumerate() {
@@ -771,14 +803,9 @@ impl Cx {
                         "<half_space>".to_string(),
                     )
                 }
-                kind @ ("obj" | "gltf") => {
-                    let (common, rel) = if kind == "obj" {
-                        let d: ObjDesc = self.de(v, &key)?;
-                        (d.common(), d.path)
-                    } else {
-                        let d: GltfDesc = self.de(v, &key)?;
-                        (d.common(), d.path)
-                    };
+                kind @ ("obj" | "gltf" | "ply") => {
+                    let d: MeshFileDesc = self.de(v, &key)?;
+                    let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
                     self.check_readable(&k("path"), &path)?;
                     let mesh = self
@@ -836,10 +863,20 @@ impl Cx {
             "obj" => crate::geometry::obj::load_obj(path),
             #[cfg(feature = "gltf")]
             "gltf" => crate::geometry::gltf::load_gltf(path),
+            #[cfg(feature = "ply")]
+            "ply" => crate::geometry::ply::load_ply(path),
             _ => Err(crate::error::MeshError::Unsupported {
                 file,
-                format: if kind == "obj" { "OBJ" } else { "glTF" },
-                feature: if kind == "obj" { "obj" } else { "gltf" },
+                format: match kind {
+                    "obj" => "OBJ",
+                    "gltf" => "glTF",
+                    _ => "PLY",
+                },
+                feature: match kind {
+                    "obj" => "obj",
+                    "gltf" => "gltf",
+                    _ => "ply",
+                },
             }),
         }
     }

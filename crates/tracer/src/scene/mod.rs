@@ -70,8 +70,8 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Maximum path depth, if given.
     pub max_depth: Option<u32>,
-    /// Estimator name, if given (parsed by the renderer).
-    pub estimator: Option<String>,
+    /// The BSSRDF estimator, if given (`render.estimator`, parsed at load).
+    pub estimator: Option<het_estimate::Estimator>,
     /// Scattering orders, if given.
     pub scattering: Option<Scattering>,
 }
@@ -196,9 +196,17 @@ pub struct Scene {
     pub source_path: Option<PathBuf>,
     /// The name used in messages (the file path, or the builder's name).
     pub display_name: String,
+    /// The mesh and texture files read while loading.
+    inputs: Vec<PathBuf>,
 }
 
 impl Scene {
+    /// The files read while loading besides the scene file itself: every mesh, and every
+    /// texture of a used material (for cache keys and provenance).
+    pub fn input_files(&self) -> &[PathBuf] {
+        &self.inputs
+    }
+
     /// The surface of `object` for the estimators.
     pub fn object_surface(&self, object: u32) -> ObjectSurface<'_> {
         ObjectSurface::new(&self.geometry, object)

@@ -37,13 +37,20 @@ pub fn brute_triangle(o: DVec3, d: DVec3, v: [DVec3; 3], t_min: f64, t_max: f64)
     (t > t_min && t < t_max).then_some(t)
 }
 
-/// True when `path` exists; otherwise prints a note that the test is skipped.
-pub fn asset(path: &str) -> Option<std::path::PathBuf> {
-    let p = std::path::PathBuf::from(path);
+/// The shared asset `name`, from `../shared/assets/` beside the repository's root. When it is
+/// absent the test is skipped with a note, except in CI (the environment variable `CI` is
+/// set), where a missing asset fails the test.
+pub fn asset(name: &str) -> Option<std::path::PathBuf> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let p = root.join("../shared/assets").join(name);
     if p.is_file() {
         Some(p)
+    } else if std::env::var_os("CI").is_some() {
+        panic!(
+            "shared asset `../shared/assets/{name}` (from the repository's root) is missing in CI"
+        );
     } else {
-        eprintln!("note: {path} is absent on this machine: test skipped");
+        eprintln!("note: shared asset `../shared/assets/{name}` is absent: test skipped");
         None
     }
 }

@@ -123,8 +123,6 @@ fn image_mean(scene: &Scene, method: Method, strategy: LightStrategy, spp: u32) 
                 &RenderOptions {
                     budget: Budget::Samples(spp),
                     seed: 7000 + seed,
-                    progress: false,
-                    label: String::new(),
                 },
             );
             assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);

@@ -213,7 +213,7 @@ fn gltf_applies_node_transforms_and_flips_v() {
 
 #[test]
 fn bunny_loads_closed() {
-    let Some(p) = asset("/work/shared/assets/bunny.obj") else {
+    let Some(p) = asset("bunny.obj") else {
         return;
     };
     let mut m = load_obj(&p).unwrap();

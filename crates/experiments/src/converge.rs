@@ -16,10 +16,10 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::OutputError;
 use crate::error::WriteError;
-use crate::experiment::metrics::Metrics;
-use crate::output::{write_atomic, write_json};
+use crate::metrics::Metrics;
+use tracer::error::OutputError;
+use tracer::output::{write_atomic, write_json};
 
 /// A run counts as converged once its error is within this factor of the final error.
 pub const CONVERGED_TOLERANCE: f64 = 1.1;
@@ -41,6 +41,7 @@ pub struct Run {
 
 /// The summary of one BSSRDF method against path tracing.
 #[derive(Debug, Clone, Serialize, PartialEq)]
+#[non_exhaustive]
 pub struct MethodSummary {
     /// The method.
     pub method: String,
@@ -176,13 +177,16 @@ pub fn write_outputs(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    write_json(&value, &dir.join("summary.json"))?;
+    write_json(
+        &crate::provenance::stamped(value),
+        &dir.join("summary.json"),
+    )?;
     Ok(())
 }
 
 /// Checks that `dir` exists, is a directory and accepts new files (before a long study).
 pub fn check_dir(dir: &Path) -> Result<(), OutputError> {
-    crate::experiment::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
+    crate::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
 }
 
 #[cfg(test)]

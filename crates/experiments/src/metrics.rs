@@ -5,6 +5,7 @@ use serde::Serialize;
 
 /// Errors of a test image against a reference.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct Metrics {
     /// ‖T − R‖₂ / ‖R‖₂ over the compared values (infinite if the reference is all zero and
     /// the test is not).
@@ -85,8 +86,8 @@ pub fn compare(
 /// than `min_radius` (scene units) to the centre of a square map of half-width `extent`.
 /// Grey images (equal channels in both) are compared on one channel.
 pub fn compare_films(
-    test: &crate::film::Film,
-    reference: &crate::film::Film,
+    test: &tracer::film::Film,
+    reference: &tracer::film::Film,
     exclusion: Option<(f64, f64)>,
 ) -> Result<Metrics, MetricsError> {
     if (test.width, test.height) != (reference.width, reference.height) {
@@ -95,9 +96,9 @@ pub fn compare_films(
             reference: (reference.width, reference.height),
         });
     }
-    let grey = |f: &crate::film::Film| f.pixels.iter().all(|p| p[0] == p[1] && p[1] == p[2]);
+    let grey = |f: &tracer::film::Film| f.pixels.iter().all(|p| p[0] == p[1] && p[1] == p[2]);
     let channels = if grey(test) && grey(reference) { 1 } else { 3 };
-    let flat = |f: &crate::film::Film| -> Vec<f64> {
+    let flat = |f: &tracer::film::Film| -> Vec<f64> {
         f.pixels
             .iter()
             .flat_map(|p| p.0[..channels].to_vec())
@@ -118,7 +119,7 @@ pub fn compare_films(
 
 /// Per-pixel log10(T/R) of the luminances (NaN where either is not positive), for the
 /// difference image.
-pub fn log_ratio(test: &crate::film::Film, reference: &crate::film::Film) -> Vec<f64> {
+pub fn log_ratio(test: &tracer::film::Film, reference: &tracer::film::Film) -> Vec<f64> {
     test.pixels
         .iter()
         .zip(&reference.pixels)

@@ -10,21 +10,17 @@ use std::time::Instant;
 use bssrdf_core::{ProfileModel, Scattering};
 use serde::Serialize;
 
+use crate::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map};
+use crate::converge::{MethodSummary, summarize, write_outputs};
 use crate::error::WriteError;
-use crate::experiment::beam::{
-    BeamMap, BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map,
-};
-use crate::experiment::converge::{MethodSummary, summarize, write_outputs};
-use crate::experiment::metrics::{Metrics, compare, compare_films};
-use crate::experiment::run::{RenderJob, render_scene, write_render};
-use crate::experiment::scenes::CHECKER_SLAB;
-use crate::experiment::study::{
-    BeamBudgets, REFERENCE_SEED_OFFSET, StudyError, beam_study, scene_study,
-};
-use crate::integrator::Method;
-use crate::output::{write_atomic, write_exr};
-use crate::render::Budget;
-use crate::scene::Scene;
+use crate::metrics::{Metrics, compare, compare_films};
+use crate::run::{RenderJob, render_scene, write_render};
+use crate::scenes::CHECKER_SLAB;
+use crate::study::{BeamBudgets, REFERENCE_SEED_OFFSET, StudyError, beam_study, scene_study};
+use tracer::integrator::Method;
+use tracer::output::{write_atomic, write_exr};
+use tracer::render::Budget;
+use tracer::scene::Scene;
 
 /// How much work `reproduce` does.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -127,14 +123,14 @@ pub enum ReproduceError {
     },
 }
 
-impl From<crate::error::OutputError> for ReproduceError {
-    fn from(e: crate::error::OutputError) -> Self {
+impl From<tracer::error::OutputError> for ReproduceError {
+    fn from(e: tracer::error::OutputError) -> Self {
         ReproduceError::Write(e.into())
     }
 }
 
-impl From<crate::error::SceneError> for ReproduceError {
-    fn from(e: crate::error::SceneError) -> Self {
+impl From<tracer::error::SceneError> for ReproduceError {
+    fn from(e: tracer::error::SceneError) -> Self {
         ReproduceError::Study(e.into())
     }
 }
@@ -300,7 +296,7 @@ pub fn reproduce(
     )
     .map_err(StudyError::from)?;
     write_exr(&reference.film, &slab_dir.join("reference-pt.exr"))?;
-    crate::output::write_png(&reference.film, &slab_dir.join("reference-pt.png"), 0.0)?;
+    tracer::output::write_png(&reference.film, &slab_dir.join("reference-pt.png"), 0.0)?;
     let mut slab_images = vec!["![reference](slab/reference-pt.png)".to_string()];
     for name in SLAB_METHODS {
         step(&format!("checker slab: {name} at {} spp", scale.slab_spp));

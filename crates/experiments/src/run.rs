@@ -3,72 +3,19 @@
 //! `render`, `converge` and `reproduce` commands.
 
 use std::path::{Path, PathBuf};
-use std::str::FromStr;
 
-use bssrdf_core::{ProfileModel, Scattering};
-use het_estimate::Estimator;
+use bssrdf_core::Scattering;
 use serde_json::json;
 
-use crate::error::OutputError;
-use crate::film::Film;
-use crate::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
-use crate::output::{write_exr, write_json, write_png};
-use crate::render::{Budget, RenderOptions, Rendered, render};
-use crate::scene::Scene;
+use tracer::error::OutputError;
+use tracer::film::Film;
+use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
+use tracer::output::{ExrAttribute, write_exr_with_attributes, write_json, write_png};
+use tracer::render::{Budget, NoProgress, Progress, RenderOptions, Rendered, render_with_progress};
+use tracer::scene::Scene;
 
 /// Default most surface interactions per camera path.
 pub const DEFAULT_MAX_DEPTH: u32 = 8;
-
-impl FromStr for Method {
-    type Err = String;
-    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`)
-    /// with the estimator's default parameters and each material's own profile.
-    fn from_str(s: &str) -> Result<Self, String> {
-        if s == "pt" {
-            return Ok(Method::PathTraced);
-        }
-        Estimator::from_str(s)
-            .map(|estimator| Method::Bssrdf {
-                estimator,
-                profile: None,
-            })
-            .map_err(|e| format!("{e}; or `pt` for the path-traced reference"))
-    }
-}
-
-impl Method {
-    /// The method with `n` averaging samples per region (segment: on the chord; Sone: in the
-    /// disk and in the ellipse); other methods are unchanged.
-    pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
-        let Some(n) = n else { return self };
-        let budget = het_estimate::SampleBudget::fixed(n.max(1));
-        match self {
-            Method::Bssrdf {
-                estimator: Estimator::Segment(p),
-                profile,
-            } => Method::Bssrdf {
-                estimator: Estimator::Segment(p.with_samples(budget)),
-                profile,
-            },
-            Method::Bssrdf {
-                estimator: Estimator::Sone(p),
-                profile,
-            } => Method::Bssrdf {
-                estimator: Estimator::Sone(p.with_samples(budget)),
-                profile,
-            },
-            m => m,
-        }
-    }
-
-    /// The method with its profile model overridden (BSSRDF methods only).
-    pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
-        match self {
-            Method::Bssrdf { estimator, .. } => Method::Bssrdf { estimator, profile },
-            m => m,
-        }
-    }
-}
 
 /// What a render needs besides the scene.
 #[derive(Debug, Clone)]
@@ -103,6 +50,7 @@ impl RenderJob {
 
 /// A finished render.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct RenderOutcome {
     /// The image.
     pub film: Film,
@@ -138,17 +86,20 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         seconds,
         counters,
         ..
-    } = render(
-        w,
-        h,
-        &integrator,
-        &RenderOptions {
+    } = {
+        let bar;
+        let progress: &dyn Progress = if job.progress {
+            bar = crate::progress::RowBar::new(job.method.name());
+            &bar
+        } else {
+            &NoProgress
+        };
+        let options = RenderOptions {
             budget: job.budget,
             seed: job.seed,
-            progress: job.progress,
-            label: job.method.name().to_string(),
-        },
-    );
+        };
+        render_with_progress(w, h, &integrator, &options, progress)
+    };
     let mut film = Film::new(w, h);
     film.pixels = pixels;
     Ok(RenderOutcome {
@@ -220,9 +171,7 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    write_exr(&outcome.film, exr)?;
     let (png, json_path) = sidecar_paths(exr);
-    write_png(&outcome.film, &png, exposure)?;
     let profile = match job.method {
         Method::Bssrdf { profile, .. } => Some(
             profile
@@ -235,6 +184,30 @@ pub fn write_render(
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
     };
+    write_exr_with_attributes(
+        &outcome.film,
+        exr,
+        &[
+            (
+                "generator",
+                ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
+            ),
+            (
+                "samplesPerPixel",
+                ExrAttribute::Int(i32::try_from(outcome.spp).unwrap_or(i32::MAX)),
+            ),
+            ("seed", ExrAttribute::Text(job.seed.to_string())),
+            ("method", ExrAttribute::Text(outcome.method.clone())),
+            (
+                "profile",
+                ExrAttribute::Text(profile.clone().unwrap_or_else(|| "none".into())),
+            ),
+            // No render time here: a duration makes every file unique, and the bytes of an EXR
+            // must be reproducible for a given seed (its hash is a render's fingerprint). The
+            // time is the sidecar's `wall_seconds`.
+        ],
+    )?;
+    write_png(&outcome.film, &png, exposure)?;
     let value = json!({
         "scene": scene.source_path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name.clone()),
         "method": outcome.method,
@@ -253,5 +226,5 @@ pub fn write_render(
         "warnings": outcome.warnings,
         "mean_rgb": outcome.film.mean().0,
     });
-    write_json(&value, &json_path)
+    write_json(&crate::provenance::stamped(value), &json_path)
 }

@@ -10,8 +10,8 @@ use std::sync::Once;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
-use crate::error::OutputError;
-use crate::output::write_atomic;
+use tracer::error::OutputError;
+use tracer::output::write_atomic;
 
 /// A plotting failure (drawing or encoding), or the output write.
 #[derive(Debug, thiserror::Error)]
@@ -214,6 +214,9 @@ pub fn map_png(path: &Path, map: &MapPlot<'_>) -> Result<(), PlotError> {
         chart
             .configure_mesh()
             .disable_mesh()
+            .x_label_formatter(&|v| tick_label(*v))
+            .y_label_formatter(&|v| tick_label(*v))
+            .label_style(("sans-serif", LABEL_SIZE))
             .draw()
             .map_err(|e| draw_err(path, e))?;
         let dx = (extent[1] - extent[0]) / width as f64;
@@ -235,6 +238,62 @@ pub fn map_png(path: &Path, map: &MapPlot<'_>) -> Result<(), PlotError> {
         root.present().map_err(|e| draw_err(path, e))?;
     }
     encode_png(path, buf, w, h)
+}
+
+/// Font size (pixels) of tick labels and axis titles: legible at the PNGs' size.
+const LABEL_SIZE: u32 = 15;
+
+/// A tick label as people write numbers: `0.1`, `1`, `10`, `2.5`, `1500`; outside
+/// `[0.001, 10⁵)` a power of ten (`10⁻⁶`) or a mantissa and one (`2.5×10⁻⁶`).
+pub fn tick_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let a = v.abs();
+    if (1e-3..1e5).contains(&a) {
+        // Three significant digits, trailing zeros dropped.
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        return if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        };
+    }
+    let e = a.log10().floor();
+    let m = v / 10f64.powf(e);
+    if (m.abs() - 1.0).abs() < 1e-9 {
+        format!(
+            "{}10{}",
+            if v < 0.0 { "−" } else { "" },
+            superscript(e as i32)
+        )
+    } else {
+        format!("{}×10{}", tick_label(m), superscript(e as i32))
+    }
+}
+
+/// The label of a colour-bar tick at `log10(value) = exponent`: `10⁻³` at whole decades,
+/// otherwise the value itself ([`tick_label`]).
+pub fn decade_label(exponent: f64) -> String {
+    if (exponent - exponent.round()).abs() < 1e-9 {
+        format!("10{}", superscript(exponent.round() as i32))
+    } else {
+        tick_label(10f64.powf(exponent))
+    }
+}
+
+/// `n` in Unicode superscript digits (`−3` → `⁻³`).
+fn superscript(n: i32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::new();
+    if n < 0 {
+        s.push('⁻');
+    }
+    for c in n.unsigned_abs().to_string().chars() {
+        s.push(DIGITS[c as usize - '0' as usize]);
+    }
+    s
 }
 
 fn colour_bar<DB: DrawingBackend>(
@@ -260,11 +319,13 @@ fn colour_bar<DB: DrawingBackend>(
         .y_desc(label)
         .y_label_formatter(&|v| {
             if log {
-                format!("1e{v:.1}")
+                decade_label(*v)
             } else {
-                format!("{v:.2e}")
+                tick_label(*v)
             }
         })
+        .label_style(("sans-serif", LABEL_SIZE))
+        .axis_desc_style(("sans-serif", LABEL_SIZE))
         .draw()?;
     let n = 200;
     chart.draw_series((0..n).map(|k| {
@@ -377,8 +438,10 @@ fn draw_loglog<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
-        .x_label_formatter(&|v| format!("{v:.2e}"))
-        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
+        .label_style(("sans-serif", LABEL_SIZE))
+        .axis_desc_style(("sans-serif", LABEL_SIZE))
         .draw()?;
     for (k, s) in series.iter().enumerate() {
         let colour = PALETTE[k % PALETTE.len()];
@@ -408,6 +471,29 @@ fn draw_loglog<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_read_as_people_write_numbers() {
+        for (v, want) in [
+            (0.1, "0.1"),
+            (1.0, "1"),
+            (10.0, "10"),
+            (0.25, "0.25"),
+            (2.5, "2.5"),
+            (1500.0, "1500"),
+            (0.001, "0.001"),
+            (1e-6, "10⁻⁶"),
+            (2.5e-6, "2.5×10⁻⁶"),
+            (1e6, "10⁶"),
+            (0.0, "0"),
+        ] {
+            assert_eq!(tick_label(v), want, "{v}");
+        }
+        assert_eq!(decade_label(-3.0), "10⁻³");
+        assert_eq!(decade_label(0.0), "10⁰");
+        assert_eq!(decade_label(12.0), "10¹²");
+        assert_eq!(decade_label(-0.5), tick_label(10f64.powf(-0.5)));
+    }
 
     #[test]
     fn plots_render_with_embedded_font() {

@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 
 use bssrdf_core::ProfileModel;
 
-use crate::error::SceneError;
-use crate::experiment::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
-use crate::experiment::converge::Run;
-use crate::experiment::metrics::{MetricsError, compare, compare_films};
-use crate::experiment::run::{RenderJob, RenderOutcome, render_scene};
-use crate::film::Film;
-use crate::integrator::{Method, RenderError};
-use crate::output::{read_exr, write_exr};
-use crate::render::Budget;
-use crate::scene::Scene;
+use crate::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
+use crate::converge::Run;
+use crate::metrics::{MetricsError, compare, compare_films};
+use crate::run::{RenderJob, RenderOutcome, render_scene};
+use tracer::error::SceneError;
+use tracer::film::Film;
+use tracer::integrator::{Method, RenderError};
+use tracer::output::{read_exr, write_exr};
+use tracer::render::Budget;
+use tracer::scene::Scene;
 
 /// Seed offset of references, so that they never share random streams with the study runs.
 pub const REFERENCE_SEED_OFFSET: u64 = 0x5eed_0000;
@@ -35,17 +35,68 @@ pub enum StudyError {
     Metrics(#[from] MetricsError),
     /// Reading or writing a file.
     #[error(transparent)]
-    Output(#[from] crate::error::OutputError),
+    Output(#[from] tracer::error::OutputError),
 }
 
-/// Where the cached path-traced reference of a scene file lives: beside the scene, with its
-/// spp and seed in the name.
-pub fn reference_path(scene_file: &Path, spp: u32, seed: u64) -> PathBuf {
-    let stem = scene_file
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    scene_file.with_file_name(format!("{stem}.reference-pt-{spp}spp-seed{seed}.exr"))
+/// The cache key of the path-traced reference of `scene` rendered as `job` at `spp`: a 64-bit
+/// FNV-1a hash of everything the render reads, namely the tool's version, the scene file's
+/// bytes, the name and bytes of every mesh and texture file it read, and the job's spp, seed,
+/// maximum depth and scattering selection. Any change to one of them gives another key, so a
+/// stale reference is never reused.
+pub fn reference_key(scene: &Scene, job: &RenderJob, spp: u32) -> std::io::Result<u64> {
+    let mut h = Fnv1a::default();
+    h.write(env!("CARGO_PKG_VERSION").as_bytes());
+    if let Some(p) = &scene.source_path {
+        h.write(&std::fs::read(p)?);
+    } else {
+        h.write(scene.display_name.as_bytes());
+    }
+    for p in scene.input_files() {
+        h.write(p.to_string_lossy().as_bytes());
+        h.write(&std::fs::read(p)?);
+    }
+    h.write(&u64::from(spp).to_le_bytes());
+    h.write(&job.seed.to_le_bytes());
+    h.write(&u64::from(job.max_depth).to_le_bytes());
+    h.write(job.scattering.name().as_bytes());
+    Ok(h.0)
+}
+
+/// The file of the cached reference with `key` in the cache directory `dir`.
+pub fn reference_file(dir: &Path, key: u64) -> PathBuf {
+    dir.join(format!("reference-pt-{key:016x}.exr"))
+}
+
+/// The default cache directory: `$XDG_CACHE_HOME/het-bssrdf`, else `$HOME/.cache/het-bssrdf`;
+/// `None` when neither variable is set.
+pub fn default_cache_dir() -> Option<PathBuf> {
+    let non_empty = |v: &str| {
+        std::env::var_os(v)
+            .filter(|s| !s.is_empty())
+            .map(PathBuf::from)
+    };
+    non_empty("XDG_CACHE_HOME")
+        .or_else(|| non_empty("HOME").map(|h| h.join(".cache")))
+        .map(|d| d.join("het-bssrdf"))
+}
+
+/// 64-bit FNV-1a: a stable hash (unlike `std`'s), so that keys survive toolchain updates.
+/// Each write is length-prefixed so that concatenations cannot collide.
+struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Fnv1a(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv1a {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in (bytes.len() as u64).to_le_bytes().iter().chain(bytes) {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
 }
 
 /// The path-traced reference of `scene` at `spp`: read from `cache` if it exists, otherwise

@@ -11,7 +11,7 @@
 //! point and every exitant point are found by tracing, and the estimators' projection rays
 //! use the BVH.
 //! * `pt` ([`trace_photons`]): light tracing with the volumetric random walk of the path
-//!   tracer ([`crate::integrator::walk`]). Every photon carries weight 1 (analog tracking,
+//!   tracer ([`tracer::integrator::walk`]). Every photon carries weight 1 (analog tracking,
 //!   η = 1), so a pixel's value is an integer count of exits / (photons · Δ²): sums of
 //!   integers are exact, so the map is identical whatever the thread count.
 //! * BSSRDF methods ([`bssrdf_map`]): for `k × k` stratified jittered points x_o per pixel,
@@ -20,23 +20,23 @@
 
 use std::time::{Duration, Instant};
 
-use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
-use het_estimate::{Coefficients, Estimator};
+use het_estimate::Estimator;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::field::{Field, MediumField, PlanarProjection};
-use crate::geometry::{Hit, Ray, primitives};
-use crate::integrator::PathCounters;
-use crate::integrator::path::ChannelView;
-use crate::integrator::walk::{Interface, WalkEnd, WalkMedium};
-use crate::light::Light;
-use crate::render::Counters;
-use crate::rng::Rng;
-use crate::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+use tracer::camera::Camera;
+use tracer::error::SceneError;
+use tracer::field::{Field, MediumField, PlanarProjection};
+use tracer::geometry::{Hit, Ray, primitives};
+use tracer::integrator::PathCounters;
+use tracer::integrator::path::ChannelView;
+use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
+use tracer::light::Light;
+use tracer::render::Counters;
+use tracer::rng::Rng;
+use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// Side of the box standing in for the half-space (scene units), and its depth. With
 /// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
@@ -45,7 +45,7 @@ pub const HALF_SPACE_SIZE: f64 = 400.0;
 /// Depth of the half-space box.
 pub const HALF_SPACE_DEPTH: f64 = 200.0;
 /// Photons per parallel batch of the light tracer.
-const BATCH: u64 = 1 << 13;
+pub const BATCH: u64 = 1 << 13;
 
 /// The σa texture of the experiment (values in 1/length).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -92,7 +92,7 @@ impl BeamTexture {
     }
 
     /// The texture as a tracer field (planar projection along z, origin at 0).
-    pub fn field(&self) -> Result<Field, crate::error::FieldError> {
+    pub fn field(&self) -> Result<Field, tracer::error::FieldError> {
         let proj = PlanarProjection::default();
         match *self {
             BeamTexture::Const { value } => Field::constant(Rgb::splat(value)),
@@ -247,6 +247,7 @@ impl ExitCounts {
 
 /// A beam exitance map and how it was made.
 #[derive(Debug, Clone, Serialize)]
+#[non_exhaustive]
 pub struct BeamMap {
     /// N.
     pub resolution: u32,
@@ -458,7 +459,9 @@ pub fn bssrdf_map(
                     };
                     let est = prepared.estimate(&surface, &t.medium, &x_i, &x_o, &mut rng);
                     c.record_estimate(&est.diagnostics);
-                    sum += eval_grey(&family, est.coefficients, (x_o.p - x_i.p).length());
+                    let cf = est.coefficients;
+                    let r = (x_o.p - x_i.p).length();
+                    sum += c.eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r);
                 }
                 *value = sum / (sub * sub) as f64;
             }
@@ -486,14 +489,6 @@ pub fn bssrdf_map(
     })
 }
 
-/// The profile of grey coefficients (channel 0) at distance `r`; 0 for invalid input.
-fn eval_grey(family: &ProfileFamily, c: Coefficients, r: f64) -> f64 {
-    family
-        .profile(c.sigma_a[0], c.sigma_s[0])
-        .map(|p| p.eval(r))
-        .unwrap_or(0.0)
-}
-
 /// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar
 /// beside it (feature `plot`), and a JSON sidecar with the set-up, the method, timings and
 /// counters (`extra` is merged in).
@@ -504,7 +499,7 @@ pub fn write_beam_map(
     extra: serde_json::Value,
 ) -> Result<(), crate::error::WriteError> {
     let n = map.resolution;
-    crate::output::write_grey_exr(n, n, &map.values, exr)?;
+    tracer::output::write_grey_exr(n, n, &map.values, exr)?;
     #[cfg(feature = "plot")]
     {
         use crate::plot::{MapPlot, MapScale, map_png};
@@ -542,16 +537,19 @@ pub fn write_beam_map(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    crate::output::write_json(&value, &exr.with_extension("json"))?;
+    tracer::output::write_json(
+        &crate::provenance::stamped(value),
+        &exr.with_extension("json"),
+    )?;
     Ok(())
 }
 
-/// Runs one method of the beam experiment: light tracing for [`Method::PathTraced`] (with
+/// Runs one method of the beam experiment: light tracing for [`Method::PathTraced`](tracer::integrator::Method::PathTraced) (with
 /// `photons`), otherwise the BSSRDF map with `sub × sub` points per pixel and `profile` unless
 /// the method names its own. `progress` receives units of work (photons or rows).
 pub fn run_method(
     setup: &BeamSetup,
-    method: crate::integrator::Method,
+    method: tracer::integrator::Method,
     profile: ProfileModel,
     photons: PhotonBudget,
     sub: u32,
@@ -559,8 +557,8 @@ pub fn run_method(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<BeamMap, SceneError> {
     match method {
-        crate::integrator::Method::PathTraced => trace_photons(setup, photons, seed, progress),
-        crate::integrator::Method::Bssrdf {
+        tracer::integrator::Method::PathTraced => trace_photons(setup, photons, seed, progress),
+        tracer::integrator::Method::Bssrdf {
             estimator,
             profile: p,
         } => bssrdf_map(setup, estimator, p.unwrap_or(profile), sub, seed, progress),

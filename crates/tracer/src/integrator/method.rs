@@ -1,0 +1,60 @@
+//! Parsing a method name (`pt` or an estimator name) and adjusting a method's estimator
+//! samples and profile model.
+
+use std::str::FromStr;
+
+use bssrdf_core::ProfileModel;
+use het_estimate::Estimator;
+
+use super::Method;
+
+impl FromStr for Method {
+    type Err = String;
+    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`)
+    /// with the estimator's default parameters and each material's own profile.
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "pt" {
+            return Ok(Method::PathTraced);
+        }
+        Estimator::from_str(s)
+            .map(|estimator| Method::Bssrdf {
+                estimator,
+                profile: None,
+            })
+            .map_err(|e| format!("{e}; or `pt` for the path-traced reference"))
+    }
+}
+
+impl Method {
+    /// The method with `n` averaging samples per region (segment: on the chord; Sone: in the
+    /// disk and in the ellipse); other methods are unchanged.
+    pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
+        let Some(n) = n else { return self };
+        let budget = het_estimate::SampleBudget::fixed(n.max(1));
+        match self {
+            Method::Bssrdf {
+                estimator: Estimator::Segment(p),
+                profile,
+            } => Method::Bssrdf {
+                estimator: Estimator::Segment(p.with_samples(budget)),
+                profile,
+            },
+            Method::Bssrdf {
+                estimator: Estimator::Sone(p),
+                profile,
+            } => Method::Bssrdf {
+                estimator: Estimator::Sone(p.with_samples(budget)),
+                profile,
+            },
+            m => m,
+        }
+    }
+
+    /// The method with its profile model overridden (BSSRDF methods only).
+    pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
+        match self {
+            Method::Bssrdf { estimator, .. } => Method::Bssrdf { estimator, profile },
+            m => m,
+        }
+    }
+}
