@@ -4,6 +4,7 @@ mod common;
 mod fuzz_regressions;
 mod integrators;
 mod precision;
+mod readme;
 mod stability;
 mod stiff;
 mod validation;

@@ -8,6 +8,12 @@ pub trait SurfacePoint {
     fn position(&self) -> DVec3;
     /// Unit shading normal, pointing out of the medium.
     fn normal(&self) -> DVec3;
+    /// Unit geometric normal (of the surface itself, not interpolated), pointing out of the
+    /// medium. Probe sampling's density uses it ([`crate::probe`]); it defaults to
+    /// [`SurfacePoint::normal`], which is exact for surfaces without normal interpolation.
+    fn geometric_normal(&self) -> DVec3 {
+        self.normal()
+    }
 }
 
 /// Geometric queries restricted to the object being shaded.
