@@ -26,6 +26,17 @@
 //! flat surface the normal probe always finds x_i, instead of succeeding one time in four,
 //! and the random choice between the two faces of a thin slab disappears.
 //!
+//! # The probe radius follows the estimate, not x_o
+//! The estimator may return coefficients far from x_o's own (x_o in a strongly absorbing vein
+//! next to a clear region), and then the BSSRDF reaches further than x_o's profile. A sphere
+//! sized from x_o alone would drop that light: about 6 % of it for σa = 0.1 at x_o against
+//! 0.005 around it. So each channel's sphere is the largest over every profile the estimate
+//! can become — the four corners of the field's bounds ([`FieldBounds`]) and x_o's own — and
+//! when the bounds differ from x_o's coefficients the radius is drawn from an equal mixture of
+//! x_o's profile and that widest one (a defensive mixture: the density stays positive out to
+//! the sphere, and near x_o it stays at least half of x_o's). A constant field keeps the
+//! single profile.
+//!
 //! # Units
 //! `p(x)` is an area density (1/length²), so [`ProbeHit::weight`] `= 1/p(x)` is an area; the
 //! BSSRDF term of a hit is `S(x_i, x_o) · E(x_i) · weight`. [`axis_densities`] splits `p(x)`
@@ -37,7 +48,7 @@
 //! use bssrdf_core::{ProfileFamily, ProfileModel, Scattering};
 //! use het_estimate::glam::DVec3;
 //! use het_estimate::probe::{ProbeChords, ProbeSampler, probe};
-//! use het_estimate::{Coefficients, SplitMix64, SurfacePoint};
+//! use het_estimate::{Coefficients, FieldBounds, SplitMix64, SurfacePoint};
 //!
 //! // The renderer's surface point and its "all hits of a segment" query; here the plane z = 0.
 //! #[derive(Clone, Copy)]
@@ -58,7 +69,7 @@
 //! // Once per material:
 //! let family = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3)?;
 //! let c = Coefficients::grey(0.01, 1.0);
-//! let sampler = ProbeSampler::new(family, c);
+//! let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
 //! // Per shading point x_o:
 //! let x_o = Hit(DVec3::ZERO);
 //! let mut rng = SplitMix64::new(7);
@@ -74,7 +85,7 @@ use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, TableSampler};
 use glam::DVec3;
 
 use crate::frame::orthonormal_basis;
-use crate::{Coefficients, SurfacePoint, UniformSource};
+use crate::{Coefficients, FieldBounds, SurfacePoint, UniformSource};
 
 /// Fraction of the profile's energy inside the probe sphere.
 pub const PROBE_ENERGY_FRACTION: f64 = 0.999;
@@ -102,23 +113,46 @@ impl<C: ProbeChords + ?Sized> ProbeChords for &C {
     }
 }
 
-/// The profile table of one material and the coefficients to sample with where x_o's own do
-/// not scatter. Build once per material (the table costs 0.15 ms for the dipole, 40 ms for
-/// photon beam diffusion).
+/// The profile table of one material and the range of coefficients its estimates can take.
+/// Build once per material (the table costs 0.15 ms for the dipole, 40 ms for photon beam
+/// diffusion).
 #[derive(Debug, Clone)]
 pub struct ProbeSampler {
     table: ProfileTable,
-    fallback: Coefficients,
+    bounds: FieldBounds,
+    /// Per channel, the coefficients (σa, σs) within the bounds whose profile reaches furthest,
+    /// and that radius; `None` where no corner scatters.
+    widest: [Option<((f64, f64), f64)>; 3],
 }
 
 impl ProbeSampler {
-    /// The sampler of `family`. `fallback` is used where the coefficients at x_o do not
-    /// scatter at all (no profile to sample): the field's largest coefficients are a good
-    /// choice.
-    pub fn new(family: ProfileFamily, fallback: Coefficients) -> Self {
+    /// The sampler of `family` for a field whose coefficients (and so the estimates, which
+    /// lie within them) are within `bounds`. Where x_o's coefficients do not scatter at all,
+    /// sampling uses `bounds.max`.
+    pub fn new(family: ProfileFamily, bounds: FieldBounds) -> Self {
+        let table = ProfileTable::new(family);
+        let widest = std::array::from_fn(|c| {
+            let (lo, hi) = (bounds.min, bounds.max);
+            [
+                (lo.sigma_a[c], lo.sigma_s[c]),
+                (lo.sigma_a[c], hi.sigma_s[c]),
+                (hi.sigma_a[c], lo.sigma_s[c]),
+                (hi.sigma_a[c], hi.sigma_s[c]),
+            ]
+            .into_iter()
+            .filter_map(|(a, s)| {
+                let r = table
+                    .sampler(a, s)
+                    .ok()?
+                    .radius_for_fraction(PROBE_ENERGY_FRACTION);
+                (r.is_finite() && r > 0.0).then_some(((a, s), r))
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+        });
         Self {
-            table: ProfileTable::new(family),
-            fallback,
+            table,
+            bounds,
+            widest,
         }
     }
 
@@ -132,18 +166,69 @@ impl ProbeSampler {
             .fold(0.0, f64::max)
     }
 
-    /// The radial samplers and probe radii of the three channels at coefficients `c`.
-    fn channels(&self, c: Coefficients) -> [Option<(TableSampler<'_>, f64)>; 3] {
+    /// The radial densities and probe radii of the three channels at coefficients `c` (x_o's).
+    fn channels(&self, c: Coefficients) -> [Option<(Radial<'_>, f64)>; 3] {
         let c = if c.sigma_s.max_component() > 0.0 {
             c
         } else {
-            self.fallback
+            self.bounds.max
         };
         std::array::from_fn(|ch| {
-            let s = self.table.sampler(c.sigma_a[ch], c.sigma_s[ch]).ok()?;
-            let r_max = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
-            (r_max.is_finite() && r_max > 0.0).then_some((s, r_max))
+            let own = self
+                .table
+                .sampler(c.sigma_a[ch], c.sigma_s[ch])
+                .ok()
+                .map(|s| {
+                    let r = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
+                    (s, if r.is_finite() { r } else { 0.0 })
+                })
+                .filter(|(_, r)| *r > 0.0);
+            let wide = self.widest[ch].filter(|((a, s), _)| {
+                (*a, *s) != (c.sigma_a[ch], c.sigma_s[ch]) && !self.bounds.is_constant()
+            });
+            match (own, wide) {
+                (Some((s, r)), None) => Some((Radial::One(s), r)),
+                (own, Some(((a, sg), r_wide))) => {
+                    let wide = self.table.sampler(a, sg).ok()?;
+                    match own {
+                        Some((s, r)) => Some((Radial::Mixture(s, wide), r.max(r_wide))),
+                        None => Some((Radial::One(wide), r_wide)),
+                    }
+                }
+                (None, None) => None,
+            }
         })
+    }
+}
+
+/// A channel's radial sampling density: x_o's profile, or an equal mixture of it and the
+/// widest profile the estimate can become (see the module docs).
+#[derive(Clone, Copy)]
+enum Radial<'a> {
+    One(TableSampler<'a>),
+    Mixture(TableSampler<'a>, TableSampler<'a>),
+}
+
+impl Radial<'_> {
+    #[inline]
+    fn sample_r(&self, u: f64) -> Option<f64> {
+        match self {
+            Radial::One(s) => s.sample_r(u),
+            Radial::Mixture(a, b) => {
+                if u < 0.5 {
+                    a.sample_r(2.0 * u)
+                } else {
+                    b.sample_r((2.0 * u - 1.0).min(1.0))
+                }
+            }
+        }
+    }
+    #[inline]
+    fn pdf_r(&self, r: f64) -> f64 {
+        match self {
+            Radial::One(s) => s.pdf_r(r),
+            Radial::Mixture(a, b) => 0.5 * (a.pdf_r(r) + b.pdf_r(r)),
+        }
     }
 }
 
@@ -258,11 +343,11 @@ pub fn axis_densities(
     )
 }
 
-fn axis_densities_in<P: RadialProfile>(
+fn axis_densities_in(
     x_o: DVec3,
     frame: &Frame,
     x_i: &impl SurfacePoint,
-    channels: &[Option<(P, f64)>; 3],
+    channels: &[Option<(Radial<'_>, f64)>; 3],
 ) -> [f64; 3] {
     let d = x_i.position() - x_o;
     let dist = d.length();
@@ -360,7 +445,7 @@ mod tests {
             sigma_a: crate::Rgb::new(0.02, 0.05, 0.2),
             sigma_s: crate::Rgb::new(1.0, 1.5, 2.0),
         };
-        let sampler = ProbeSampler::new(family, c);
+        let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
         let big_r = sampler.probe_radius(c);
         let h = 0.4 * big_r;
         let ell = 1.0 / (3.0 * 0.02 * 1.02f64).sqrt();
@@ -389,12 +474,53 @@ mod tests {
         assert!(se < 0.015 * want, "test too weak: {mean} ± {se} of {want}");
     }
 
+    /// x_o sits in the strongly absorbing part of a two-valued field, and the estimate is the
+    /// clear part's coefficients: the probe must still reach the clear profile's tail, so that
+    /// `E[Σ R_clear(r)/p] = 0.999 · total_clear` (the sphere holds PROBE_ENERGY_FRACTION of the
+    /// widest profile). Sized from x_o alone it would find only about 94 % of it.
+    #[test]
+    fn probe_spheres_cover_every_profile_the_estimate_can_become() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let (clear, dark) = (Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0));
+        let bounds = FieldBounds {
+            min: clear,
+            max: dark,
+        };
+        let sampler = ProbeSampler::new(family, bounds);
+        let profile = family.profile(0.005, 1.0).unwrap();
+        let want = PROBE_ENERGY_FRACTION * profile.total();
+        let x_o = P(DVec3::ZERO, DVec3::Z);
+        let mut rng = SplitMix64::new(5);
+        let n = 100_000;
+        let (mut s, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let w: f64 = probe(&Slab(1e9), &x_o, dark, &sampler, &mut rng)
+                .iter()
+                .map(|h| profile.eval(h.hit.position().length()) * h.weight)
+                .sum();
+            s += w;
+            s2 += w * w;
+        }
+        let mean = s / n as f64;
+        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+        // 4 SE, plus 0.2 % for the table's piecewise-linear approximation of the profile.
+        assert!(
+            (mean - want).abs() < 4.0 * se + 2e-3 * want,
+            "{mean} ± {se}, want {want}"
+        );
+        assert!(se < 0.005 * want, "test too weak: {se}");
+        // A constant field keeps x_o's own sphere.
+        let own = ProbeSampler::new(family, FieldBounds::constant(dark));
+        assert!(own.probe_radius(dark) < 0.5 * sampler.probe_radius(dark));
+    }
+
     #[test]
     fn density_splits_by_axis_and_matches_each_hit() {
         let family =
             ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3).unwrap();
         let c = Coefficients::grey(0.05, 1.0);
-        let sampler = ProbeSampler::new(family, c);
+        let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
         let x_o = P(DVec3::ZERO, DVec3::Z);
         let mut rng = SplitMix64::new(3);
         let mut seen = 0;

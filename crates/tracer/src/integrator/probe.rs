@@ -17,10 +17,10 @@ use crate::rng::Rng;
 pub struct ProbeSampler(lib::ProbeSampler);
 
 impl ProbeSampler {
-    /// Builds the table of `family` (once per material); where x_o's coefficients do not
-    /// scatter, sampling uses the field's largest coefficients.
+    /// Builds the table of `family` (once per material); the probe spheres cover every
+    /// profile the medium's estimates can become (its bounds).
     pub fn new(family: ProfileFamily, medium: &MediumField) -> Self {
-        Self(lib::ProbeSampler::new(family, medium.field_bounds().max))
+        Self(lib::ProbeSampler::new(family, medium.field_bounds()))
     }
 
     /// The largest probe radius over the channels at coefficients `c` (0 if none scatters).
