@@ -7,4 +7,5 @@ mod precision;
 mod readme;
 mod stability;
 mod stiff;
+mod tabulated;
 mod validation;

@@ -23,6 +23,7 @@
 //! | [`beam_diffusion`] | photon beam diffusion, multiple scattering | HCJ13 / pbrt | closed-form proposal |
 //! | [`single_scattering`] | single scattering (any model, via [`Scattering`]) | HCJ13 / pbrt | exponential proposal |
 //! | [`directional_dipole`] | directional dipole `S_d(x_i, ω_i, n_i; x_o, n_o)` | FHK14 sample code | — |
+//! | [`tabulated`] | the exact half-space profile, single and multiple, by photon simulation | this project (`docs/tabulated-profile.md`) | exact, binned density |
 //!
 //! [`fresnel`] provides the exact Fresnel moments `C₁`, `C₂` (quadrature, valid for η ∈ [1, 3]
 //! and beyond) and the optional Egan–Hilgeman fit ([`DiffuseFresnel`]); [`family`] prepares a
@@ -81,6 +82,7 @@ pub mod rgb;
 pub mod rgb_profile;
 pub mod single_scattering;
 pub mod table;
+pub mod tabulated;
 
 pub use error::ParamError;
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};

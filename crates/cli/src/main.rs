@@ -14,6 +14,7 @@ mod converge;
 mod profile;
 mod render;
 mod reproduce;
+mod tabulate;
 
 use std::process::ExitCode;
 
@@ -42,6 +43,8 @@ enum Command {
     Converge(converge::Args),
     /// Run the paper's experiments end to end and write report.md.
     Reproduce(reproduce::Args),
+    /// Regenerate the tabulated half-space profile's data file by photon simulation.
+    Tabulate(tabulate::Args),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -52,6 +55,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compare(args) => compare::run(args),
         Command::Converge(args) => converge::run(args),
         Command::Reproduce(args) => reproduce::run(args),
+        Command::Tabulate(args) => tabulate::run(args),
     }
 }
 
