@@ -219,6 +219,37 @@ fn mesh_scene() -> (Geometry, MediumField, Vec<(Hit, Hit)>) {
     (geometry, field, pairs)
 }
 
+/// The cost of one projection (two rays through the BVH) with f64 arguments, and the same
+/// after a round trip through f32 as a renderer with f32 geometry would make (convert its
+/// points to `DVec3` for the trait, and back to f32 for its BVH).
+fn bench_projection(c: &mut Criterion, surface: &ObjectSurface<'_>, pairs: &[(Hit, Hit)]) {
+    let mut group = c.benchmark_group("averaging/mesh-stripe");
+    group
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(30);
+    let mut i = 0usize;
+    group.bench_function("project f64", |b| {
+        b.iter(|| {
+            let (x_i, x_o) = &pairs[i % pairs.len()];
+            i = i.wrapping_add(1);
+            let mid = 0.5 * (x_i.p + x_o.p);
+            black_box(surface.project(black_box(mid), x_o.ns))
+        })
+    });
+    let mut i = 0usize;
+    group.bench_function("project via f32", |b| {
+        b.iter(|| {
+            let (x_i, x_o) = &pairs[i % pairs.len()];
+            i = i.wrapping_add(1);
+            let mid = (0.5 * (x_i.p + x_o.p)).as_vec3();
+            let n = x_o.ns.as_vec3();
+            black_box(surface.project(black_box(mid).as_dvec3(), black_box(n).as_dvec3()))
+        })
+    });
+    group.finish();
+}
+
 fn averaging(c: &mut Criterion) {
     let pairs = beam_pairs(1024, 1);
     let stripe = stripe_preset();
@@ -230,6 +261,7 @@ fn averaging(c: &mut Criterion) {
     let surface = ObjectSurface::new(&geometry, 0);
     print_std_table("mesh-stripe", &surface, &field, &mesh_pairs[..64], 64);
     bench_scene(c, "mesh-stripe", &surface, &field, &mesh_pairs);
+    bench_projection(c, &surface, &mesh_pairs);
 }
 
 criterion_group!(benches, averaging);

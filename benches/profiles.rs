@@ -2,7 +2,7 @@
 //! each model, per-pair construction, table build and table sampling.
 //!
 //! Run: `cargo bench --bench profiles` (add `-- --quick` for a fast pass).
-use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Rgb, Scattering};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
 use std::hint::black_box;
@@ -32,6 +32,36 @@ fn eval(c: &mut Criterion) {
     g.bench_function("directional-dipole S_d r=1", |b| {
         b.iter(|| black_box(&fhk).s_d(DVec3::ZERO, w, n, black_box(DVec3::new(1.0, 0.2, 0.0)), n))
     });
+    for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
+        let fam = ProfileFamily::new(model, Scattering::Multiple, 0.0, 1.33).unwrap();
+        let (sa, ss) = (Rgb::new(0.01, 0.02, 0.05), Rgb::new(1.0, 1.1, 1.2));
+        g.bench_function(format!("profile_rgb+eval_rgb {model} r=1"), |b| {
+            b.iter(|| {
+                fam.profile_rgb(black_box(sa), black_box(ss))
+                    .unwrap()
+                    .eval_rgb(black_box(1.0))
+            })
+        });
+    }
+    g.finish();
+}
+
+/// Per-material calls: numerical totals and energy radii of models without closed forms.
+fn per_material(c: &mut Criterion) {
+    let mut g = c.benchmark_group("per-material");
+    g.sample_size(10);
+    for model in [ProfileModel::Dipole, ProfileModel::Pbd] {
+        let p = ProfileFamily::new(model, Scattering::All, 0.0, 1.33)
+            .unwrap()
+            .profile(0.01, 1.0)
+            .unwrap();
+        g.bench_function(format!("total {model} all"), |b| {
+            b.iter(|| black_box(&p).total())
+        });
+        g.bench_function(format!("radius_for_fraction 0.999 {model} all"), |b| {
+            b.iter(|| black_box(&p).radius_for_fraction(black_box(0.999)))
+        });
+    }
     g.finish();
 }
 
@@ -98,5 +128,5 @@ fn sampling(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, eval, construction, sampling);
+criterion_group!(benches, eval, per_material, construction, sampling);
 criterion_main!(benches);

@@ -5,6 +5,8 @@ mod fuzz_regressions;
 mod index_matched;
 mod integrators;
 mod precision;
+mod readme;
 mod stability;
 mod stiff;
+mod tabulated;
 mod validation;

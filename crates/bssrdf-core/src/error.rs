@@ -31,6 +31,10 @@ pub enum ParamError {
         /// The offending value.
         value: f64,
     },
+    /// A name that matches no choice of a closed set (a profile model, an estimator, …), so
+    /// that parsing composes with `?` alongside the other parameter checks.
+    #[error(transparent)]
+    UnknownName(#[from] crate::model::UnknownName),
 }
 
 /// Checks that `value` is finite and `>= 0`.

@@ -16,6 +16,7 @@ use crate::fresnel::{DiffuseFresnel, FresnelMoments};
 use crate::model::{ProfileModel, Scattering};
 use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_u, numeric_radius_for_fraction};
 use crate::single_scattering::SingleScattering;
+use crate::tabulated::TabulatedTerm;
 
 pub use crate::error::{ETA_RANGE, SIGMA_EPSILON, SIGMA_MAX, validate_sigmas};
 /// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
@@ -76,6 +77,13 @@ impl ProfileFamily {
     ) -> Result<Self, ParamError> {
         check_g(g)?;
         check_eta(eta)?;
+        if model == ProfileModel::Tabulated && eta > crate::tabulated::profile::ETA_MAX {
+            return Err(ParamError::OutOfRange {
+                name: "eta",
+                range: "[1, 1.6] (the tabulated profile's table)",
+                value: eta,
+            });
+        }
         // HG and the reduced coefficients degenerate at |g| = 1 (docs/physics.md#hazards): clamp.
         let g = g.clamp(-G_MAX, G_MAX);
         let moments = FresnelMoments::new(eta)?;
@@ -154,7 +162,17 @@ impl ProfileFamily {
                 ProfileModel::Pbd => {
                     MultipleTerm::Pbd(BeamDiffusionMs::new(alpha_p, sigma_tp, &self.moments))
                 }
+                ProfileModel::Tabulated => {
+                    return Ok(self.tabulated(alpha_p, sigma_tp));
+                }
             })
+        } else if self.model == ProfileModel::Tabulated
+            && self.scattering.includes_single()
+            && sigma_sp >= SIGMA_EPSILON
+            && sigma_tp >= SIGMA_EPSILON
+        {
+            // Single scattering only: the table holds it too.
+            return Ok(self.tabulated(sigma_sp / sigma_tp, sigma_tp));
         } else {
             None
         };
@@ -163,6 +181,25 @@ impl ProfileFamily {
             && sigma_t >= SIGMA_EPSILON)
             .then(|| SingleScattering::new(sigma_s / sigma_t, sigma_t, self.g, self.eta));
         Ok(Profile { multiple, single })
+    }
+}
+
+impl ProfileFamily {
+    /// The tabulated profile at reduced albedo `alpha_p` and extinction `sigma_tp` (similarity
+    /// theory for g ≠ 0, an approximation), counting the orders the family selects, both
+    /// from the table.
+    fn tabulated(&self, alpha_p: f64, sigma_tp: f64) -> Profile {
+        let term = TabulatedTerm::new(
+            sigma_tp,
+            alpha_p,
+            self.eta,
+            self.scattering.includes_single(),
+            self.scattering.includes_multiple(),
+        );
+        Profile {
+            multiple: Some(MultipleTerm::Tabulated(term)),
+            single: None,
+        }
     }
 }
 
@@ -177,6 +214,10 @@ pub enum MultipleTerm {
     BetterDipole(BetterDipole),
     /// Photon beam diffusion, multiple scattering (HCJ13).
     Pbd(BeamDiffusionMs),
+    /// The tabulated half-space profile ([`crate::tabulated`]). It carries *every* order the
+    /// family selects (single scattering included), so a tabulated [`Profile`] has no separate
+    /// single-scattering term.
+    Tabulated(TabulatedTerm),
 }
 
 impl MultipleTerm {
@@ -185,13 +226,14 @@ impl MultipleTerm {
             MultipleTerm::Dipole(m) => m,
             MultipleTerm::BetterDipole(m) => m,
             MultipleTerm::Pbd(m) => m,
+            MultipleTerm::Tabulated(m) => m,
         }
     }
     /// True when `pdf_r` is exactly `2πrR/total` (closed-form CDF).
     fn exact_sampling(&self) -> bool {
         matches!(
             self,
-            MultipleTerm::Dipole(_) | MultipleTerm::BetterDipole(_)
+            MultipleTerm::Dipole(_) | MultipleTerm::BetterDipole(_) | MultipleTerm::Tabulated(_)
         )
     }
     /// A cheap estimate of the total, used only as a mixture weight for sampling.
@@ -201,6 +243,7 @@ impl MultipleTerm {
             MultipleTerm::BetterDipole(m) => m.total(),
             // The better dipole with the same constants is within tens of % of PBD.
             MultipleTerm::Pbd(m) => m.proposal_total(),
+            MultipleTerm::Tabulated(m) => m.total(),
         }
     }
 }

@@ -23,6 +23,7 @@
 //! | [`beam_diffusion`] | photon beam diffusion, multiple scattering | HCJ13 / pbrt | closed-form proposal |
 //! | [`single_scattering`] | single scattering (any model, via [`Scattering`]) | HCJ13 / pbrt | exponential proposal |
 //! | [`directional_dipole`] | directional dipole `S_d(x_i, ω_i, n_i; x_o, n_o)` | FHK14 sample code | — |
+//! | [`tabulated`] | the exact half-space profile, single and multiple, by photon simulation | this project (`docs/tabulated-profile.md`) | exact, binned density |
 //!
 //! [`fresnel`] provides the exact Fresnel moments `C₁`, `C₂` (quadrature, valid for η ∈ [1, 3]
 //! and beyond) and the optional Egan–Hilgeman fit ([`DiffuseFresnel`]); [`family`] prepares a
@@ -33,7 +34,7 @@
 //!
 //! # Using the profiles (renderer side)
 //! ```
-//! use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Scattering};
+//! use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Rgb, Scattering};
 //! // Once per material:
 //! let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.3)?;
 //! let table = ProfileTable::new(family);
@@ -48,8 +49,18 @@
 //! }
 //! let probe_len = sampler.radius_for_fraction(0.999);
 //! assert!(probe_len > 0.0);
+//! // All three colour channels at once (grey channels are evaluated once):
+//! let rgb = family.profile_rgb(Rgb::new(0.01, 0.02, 0.05), Rgb::splat(1.0))?;
+//! let rd: Rgb = rgb.eval_rgb(0.7);
+//! assert!(rd[0] > rd[2]); // less absorption, more light at a distance
+//! // Unknown names are parameter errors too, so set-up composes with `?`:
+//! let model: ProfileModel = "pbd".parse()?;
 //! # Ok::<(), bssrdf_core::ParamError>(())
 //! ```
+//!
+//! The estimators that choose `(σa, σs)` for a heterogeneous object, probe-ray sampling of
+//! incident points, and a complete example of both traits a renderer implements are in the
+//! `het-estimate` crate's documentation (its README).
 //!
 //! References are keyed as in `docs/references.md` (JMLH01, HCJ13, dEI11, dE12, FHK14, …).
 //! The formulas, units, conventions and known-answer values are collected in the repository's
@@ -72,17 +83,22 @@ pub mod model;
 pub mod profile;
 mod quadrature;
 pub mod rgb;
+pub mod rgb_profile;
 pub mod single_scattering;
 pub mod table;
+pub mod tabulated;
 
 pub use error::ParamError;
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
 pub use fresnel::{DiffuseFresnel, FresnelMoments};
+/// The vector types of the public API (`glam::DVec3`), re-exported so that callers use the
+/// same glam version as this crate.
 pub use glam;
 pub use medium::MediumParams;
 pub use model::{ProfileModel, Scattering, UnknownName};
 pub use profile::RadialProfile;
 pub use rgb::Rgb;
+pub use rgb_profile::RgbProfile;
 pub use table::{ProfileTable, TableSampler};
 
 #[cfg(test)]

@@ -14,6 +14,9 @@ pub enum ProfileModel {
     Pbd,
     /// The "better dipole" (dE12).
     BetterDipole,
+    /// The exact half-space profile, tabulated by this project's photon simulation
+    /// ([`crate::tabulated`]); η ∈ [1, 1.6].
+    Tabulated,
 }
 
 impl ProfileModel {
@@ -22,6 +25,7 @@ impl ProfileModel {
         ProfileModel::Dipole,
         ProfileModel::Pbd,
         ProfileModel::BetterDipole,
+        ProfileModel::Tabulated,
     ];
 
     /// The name used on the command line and in scene files.
@@ -30,6 +34,7 @@ impl ProfileModel {
             ProfileModel::Dipole => "dipole",
             ProfileModel::Pbd => "pbd",
             ProfileModel::BetterDipole => "better-dipole",
+            ProfileModel::Tabulated => "tabulated",
         }
     }
 }

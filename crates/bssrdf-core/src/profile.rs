@@ -27,12 +27,20 @@ pub trait RadialProfile {
     /// `R(r)` in 1/length².
     fn eval(&self, r: f64) -> f64;
     /// `∫₀^∞ 2πr R(r) dr`.
+    ///
+    /// Cost: closed form for the dipole and better dipole alone; a numerical integral (about
+    /// 2 ms for photon beam diffusion) otherwise. Call it per material, not per sample (see
+    /// [`crate::rgb_profile`] for measured costs).
     fn total(&self) -> f64;
     /// A radius drawn from [`RadialProfile::pdf_r`] with the uniform number `u ∈ [0, 1)`.
     fn sample_r(&self, u: f64) -> Option<f64>;
     /// Density of [`RadialProfile::sample_r`] with respect to `r` (1/length).
     fn pdf_r(&self, r: f64) -> f64;
     /// Radius holding the fraction `f` of the profile's energy.
+    ///
+    /// Cost: a numerical CDF inversion (milliseconds) for every model without a closed-form
+    /// CDF: per material only. The per-material table's version
+    /// ([`crate::table::TableSampler`]) costs 0.2 µs.
     fn radius_for_fraction(&self, f: f64) -> f64;
 }
 

@@ -16,6 +16,7 @@ mod flags;
 mod profile;
 mod render;
 mod reproduce;
+mod tabulate;
 
 use std::process::ExitCode;
 
@@ -55,6 +56,8 @@ enum Command {
         #[arg(value_enum)]
         shell: clap_complete::Shell,
     },
+    /// Regenerate the tabulated half-space profile's data file by photon simulation.
+    Tabulate(tabulate::Args),
 }
 
 fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
@@ -76,6 +79,7 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
             clap_complete::generate(shell, &mut cmd, "het-bssrdf", &mut std::io::stdout());
             Ok(())
         }
+        Command::Tabulate(args) => tabulate::run(args),
     }
 }
 

@@ -14,7 +14,7 @@ const METHODS: &[&str] = &[
     "segment",
     "sone",
 ];
-const PROFILES: &[&str] = &["dipole", "pbd", "better-dipole"];
+const PROFILES: &[&str] = &["dipole", "pbd", "better-dipole", "tabulated"];
 const SCATTERING: &[&str] = &["multiple", "single", "all"];
 
 #[test]

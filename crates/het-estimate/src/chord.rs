@@ -10,6 +10,18 @@ use crate::ellipse::PlanarEllipse;
 const DEGENERATE_CHORD: f64 = 1e-12;
 /// A plane normal whose cosine with the chord exceeds this is not perpendicular to it.
 const NOT_PERPENDICULAR: f64 = 1e-6;
+/// `|n_i + n_o|²` below this: the two normals (nearly) cancel and their sum has no direction.
+const NORMALS_CANCEL: f64 = 1e-12;
+
+/// `v` or `−v`, whichever is lexicographically positive (a plane normal's sign is arbitrary;
+/// fixing it makes the frame, and so the sample points, independent of the point order).
+fn canonical(v: DVec3) -> DVec3 {
+    if v.x < 0.0 || (v.x == 0.0 && (v.y < 0.0 || (v.y == 0.0 && v.z < 0.0))) {
+        -v
+    } else {
+        v
+    }
+}
 
 /// The chord and its averaging frame.
 ///
@@ -26,11 +38,12 @@ pub(crate) struct Chord {
     pub half_len: f64,
     /// Unit chord direction x̂ (canonical sign).
     pub x_hat: DVec3,
-    /// Unit normal of the averaging plane: FHK14's modified normal n_i*, ⟂ x̂.
+    /// Unit normal of the averaging plane, ⟂ x̂: FHK14's modified normal of n_i + n_o (so the
+    /// plane does not depend on which point is x_i), with a canonical sign.
     pub normal: DVec3,
-    /// Unit in-plane direction n_i* × x̂ of the minor axis.
+    /// Unit in-plane direction `normal × x̂` of the minor axis.
     pub minor_dir: DVec3,
-    /// n_i* was undefined (n_i ∥ x̂) and a fallback was used.
+    /// The modified normal of n_i + n_o was undefined and a fallback was used.
     pub normal_fallback: bool,
 }
 
@@ -39,9 +52,13 @@ impl Chord {
     /// rounding noise, or the positions are not finite), where the region estimators reduce
     /// to point lookups.
     ///
-    /// Plane normal: n_i* = `modified_normal(n_i, x_i, x_o)` (FHK14, as the paper says).
-    /// When n_i ∥ x̂ it is undefined; we then try n_o's modified normal, and failing that any
-    /// unit vector ⟂ x̂ (the averaging plane must contain the chord).
+    /// Plane normal: the paper uses n_i* = `modified_normal(n_i, x_i, x_o)` (FHK14), which
+    /// depends on which point is x_i, so the estimate would not be reciprocal on curved
+    /// surfaces. We use the modified normal of n_i + n_o instead: the same as n_i* wherever
+    /// n_i = n_o (a plane), and symmetric in the two points everywhere. Where that is undefined
+    /// (n_i + n_o ∥ x̂, or the normals cancel), that of n_i − n_o; failing that any
+    /// unit vector ⟂ x̂ (the averaging plane must contain the chord). Every normal gets a
+    /// canonical sign.
     pub fn new(x_i: DVec3, n_i: DVec3, x_o: DVec3, n_o: DVec3) -> Option<Self> {
         let diff = x_o - x_i;
         let d = diff.length();
@@ -55,11 +72,16 @@ impl Chord {
             x_hat = -x_hat;
         }
         let perpendicular = |n: DVec3| n.is_finite() && n.dot(x_hat).abs() <= NOT_PERPENDICULAR;
-        let mut normal = modified_normal(n_i, x_i, x_o);
+        // The same plane whichever point is x_i: the modified normal of n_i + n_o (commutative,
+        // so bit-identical under the swap), with a canonical sign.
+        let mut normal = canonical(modified_normal(n_i + n_o, x_i, x_o));
         let mut normal_fallback = false;
-        if !perpendicular(normal) {
+        if !perpendicular(normal) || (n_i + n_o).length_squared() < NORMALS_CANCEL {
+            // n_i + n_o ∥ x̂, or the normals (nearly) cancel, as on the two faces of a slab:
+            // the modified normal of n_i − n_o (≈ 2n_i there; negated by the swap, which the
+            // canonical sign undoes).
             normal_fallback = true;
-            normal = modified_normal(n_o, x_i, x_o);
+            normal = canonical(modified_normal(n_i - n_o, x_i, x_o));
             if !perpendicular(normal) {
                 normal = x_hat.any_orthonormal_vector();
             }
@@ -151,10 +173,20 @@ mod tests {
         assert!(c.normal_fallback);
         assert!(c.normal.dot(c.x_hat).abs() < 1e-12);
         assert!((c.minor_dir.length() - 1.0).abs() < 1e-12);
-        // n_i ∥ chord but n_o usable.
+        // n_i ∥ chord but n_i + n_o usable: no fallback needed, the same plane both ways.
         let n_o = DVec3::new(1.0, 0.0, 1.0).normalize();
-        let c = Chord::new(DVec3::ZERO, DVec3::Z, DVec3::new(0.0, 0.0, 1.0), n_o).unwrap();
-        assert!(c.normal_fallback);
+        let end = DVec3::new(0.0, 0.0, 1.0);
+        let c = Chord::new(DVec3::ZERO, DVec3::Z, end, n_o).unwrap();
+        assert!(!c.normal_fallback);
         assert!((c.normal - DVec3::X).length() < 1e-12);
+        let swapped = Chord::new(end, n_o, DVec3::ZERO, DVec3::Z).unwrap();
+        assert_eq!(c.normal, swapped.normal);
+        // Opposite normals (the two faces of a slab), chord not along them: n_i − n_o's plane,
+        // the same both ways.
+        let (top, bottom) = (DVec3::ZERO, DVec3::new(0.3, 0.1, -2.0));
+        let c = Chord::new(top, DVec3::Z, bottom, -DVec3::Z).unwrap();
+        let swapped = Chord::new(bottom, -DVec3::Z, top, DVec3::Z).unwrap();
+        assert!(c.normal_fallback && c.normal.dot(c.x_hat).abs() < 1e-12);
+        assert_eq!((c.normal, c.minor_dir), (swapped.normal, swapped.minor_dir));
     }
 }

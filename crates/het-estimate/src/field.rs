@@ -77,6 +77,11 @@ pub trait CoefficientField<P> {
     /// `Some(FieldBounds::constant(c))`, which lets every estimator skip averaging so that a
     /// homogeneous material costs no more than a point lookup. The default, `None`, means
     /// "unknown: average".
+    ///
+    /// Report bounds whenever you know them: they also make constants come back *exactly*.
+    /// Without bounds, `segment` and `sone` average a constant field by summing weighted
+    /// samples, which returns the constant only to rounding (up to about 1e-15 relative), and
+    /// estimates are clamped to the bounds when they are known.
     fn bounds(&self) -> Option<FieldBounds> {
         None
     }

@@ -1,29 +1,10 @@
+#![doc = include_str!("../README.md")]
+//! # The estimators
 //! Estimate the homogeneous BSSRDF parameters that stand in for a heterogeneous medium
 //! between an incident point `x_i` and an exitant point `x_o` (Sone, Hachisuka & Koike,
 //! "Parameter Estimation of BSSRDF for Heterogeneous Materials"; key `Sone` in
 //! `docs/references.md`). Formulas and known answers: `docs/physics.md` (rendered by
 //! `cargo doc` as `het_bssrdf::physics`), cited as `docs/physics.md#section`.
-//!
-//! # Use
-//! (The example borrows the analytic plane of the `fixtures` feature.)
-//! ```
-//! use het_estimate::analytic::{Plane, PlanePoint, StripeField};
-//! use het_estimate::pattern::Stripe;
-//! use het_estimate::{Coefficients, Estimator, SplitMix64};
-//!
-//! // Once per material: pick an estimator (e.g. parsed from the CLI) and resolve ⟨θ²⟩ for g.
-//! let prepared = "sone".parse::<Estimator>().unwrap().prepare(0.0).unwrap();
-//! // Per (x_i, x_o) pair, with the renderer's surface, field, points and random stream.
-//! let field = StripeField {
-//!     pattern: Stripe { width: 4.0, angle: std::f64::consts::FRAC_PI_4 },
-//!     values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
-//! };
-//! let mut rng = SplitMix64::new(1);
-//! let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(5.0, 1.0));
-//! let est = prepared.estimate(&Plane, &field, &x_i, &x_o, &mut rng);
-//! let c = est.coefficients; // feed c.sigma_a, c.sigma_s to the homogeneous profile at r = d
-//! assert!(c.is_valid() && c.sigma_s[0] == 1.0); // σs is constant here: taken from the bounds
-//! ```
 //!
 //! # Design
 //! * **Two traits, implemented by the renderer.** The crate knows nothing about meshes, BVHs
@@ -67,10 +48,12 @@ pub mod ellipse;
 pub mod estimate;
 pub mod estimator;
 pub mod field;
+pub mod frame;
 mod known;
 pub mod path_integral;
 pub mod pattern;
 mod point_lookup;
+pub mod probe;
 mod region_average;
 pub mod sampler;
 pub mod sampling;
@@ -84,6 +67,8 @@ pub use ellipse::PlanarEllipse;
 pub use estimate::{Diagnostics, Estimate, Region};
 pub use estimator::{Estimator, PreparedEstimator};
 pub use field::{CoefficientField, Coefficients, FieldBounds};
+/// The vector types of the public traits (`glam::DVec3`), re-exported so that implementors
+/// use the same glam version as this crate.
 pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};

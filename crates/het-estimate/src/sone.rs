@@ -2,7 +2,9 @@
 //! ellipse around the chord whose minor axis is the path-integral width of Eq. (2).
 //!
 //! Steps, for a pair (x_i, x_o) with chord length d, midpoint m, chord direction x̂ and
-//! FHK14's modified normal n_i* (the averaging plane contains x_i and x_o):
+//! FHK14's modified normal n_i* (the averaging plane contains x_i and x_o; we take the modified
+//! normal of n_i + n_o, which equals n_i* on flat surfaces and keeps the estimate reciprocal on
+//! curved ones, see `chord.rs`):
 //! 1. ⟨σs⟩, ⟨σa⟩: area means over the disk of radius d/2 centred at m in that plane (§3.1),
 //!    each sample x' projected to the surface by the two rays ±n_i* from x' (nearer hit;
 //!    §3.2, Figure 3);

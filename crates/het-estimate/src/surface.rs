@@ -8,12 +8,25 @@ pub trait SurfacePoint {
     fn position(&self) -> DVec3;
     /// Unit shading normal, pointing out of the medium.
     fn normal(&self) -> DVec3;
+    /// Unit geometric normal (of the surface itself, not interpolated), pointing out of the
+    /// medium. Probe sampling's density uses it ([`crate::probe`]); it defaults to
+    /// [`SurfacePoint::normal`], which is exact for surfaces without normal interpolation.
+    fn geometric_normal(&self) -> DVec3 {
+        self.normal()
+    }
 }
 
 /// Geometric queries restricted to the object being shaded.
 ///
 /// Implementations trace against their own acceleration structure; the estimators call
 /// [`SurfaceQuery::project`] once per averaging sample and never allocate.
+///
+/// # f32 geometry
+/// Points cross the trait in f64, because the estimators' geometry (chords, ellipses, widths
+/// down to 1e-6 of the coordinates) needs it. A renderer whose geometry is f32 converts on
+/// every call, and that costs nothing measurable: through an 81,920-triangle BVH one projection
+/// takes 1.59 µs from f64 points and 1.58 µs after an f32 round trip of its arguments
+/// (`cargo bench --bench averaging -- project`, ±5 %). The tracer itself stores its BVH in f32.
 pub trait SurfaceQuery {
     /// The renderer's surface-point type (it may carry triangle ids, UVs, …, for the
     /// coefficient lookup).

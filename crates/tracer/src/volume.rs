@@ -131,17 +131,7 @@ pub fn transmittance<M: ChannelMedium + ?Sized>(
     }
 }
 
-/// An orthonormal basis `(t, b)` completing the unit vector `n` (Duff et al. 2017,
-/// "Building an Orthonormal Basis, Revisited"): branch-free and continuous except at n.z = −0.
-pub fn orthonormal_basis(n: DVec3) -> (DVec3, DVec3) {
-    let sign = 1.0f64.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    (
-        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        DVec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
-}
+pub use het_estimate::frame::orthonormal_basis;
 
 /// The unit vector with polar cosine `cos_theta` and azimuth `phi` about the unit axis `axis`.
 pub fn direction_about(axis: DVec3, cos_theta: f64, phi: f64) -> DVec3 {

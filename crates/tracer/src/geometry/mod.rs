@@ -161,6 +161,10 @@ impl het_estimate::SurfacePoint for Hit {
     fn normal(&self) -> DVec3 {
         self.ns
     }
+    #[inline]
+    fn geometric_normal(&self) -> DVec3 {
+        self.ng
+    }
 }
 
 /// Relative origin offset: `2⁻¹⁸ ≈ 3.8e-6`, i.e. 32 `f32` ulps of the coordinate scale.

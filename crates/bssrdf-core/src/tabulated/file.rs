@@ -1,0 +1,260 @@
+//! The table's data file: a small little-endian binary, versioned, with its provenance.
+//!
+//! Layout (version 1): the magic `HBSSRDFT`, then u32 version, u64 seed, u64 photons per η
+//! plane, u32 planes, u32 albedo rows, u32 radial bins; the planes' η (f64 each); then per
+//! plane: u64 photons dropped at the event cap, and for kind (single, multiple) × row × bin
+//! the exitance density R̂ (f32, per unit area in mean free paths², per unit entering power)
+//! and its standard error (f32), then for kind × row the total (f64) and its standard error
+//! (f64), totals counting every exit including those beyond the last bin.
+
+use super::grid::{ETAS, N_ALBEDO, N_BINS, annulus_area};
+use super::simulate::Tally;
+
+const MAGIC: &[u8; 8] = b"HBSSRDFT";
+/// Format version.
+pub const VERSION: u32 = 1;
+
+/// One η plane of the table, in memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plane {
+    /// Relative refractive index.
+    pub eta: f64,
+    /// Photons dropped at the event cap.
+    pub capped: u64,
+    /// `[kind][row][bin]` exitance density R̂ (1/mfp²).
+    pub density: Vec<f32>,
+    /// Its standard error.
+    pub density_se: Vec<f32>,
+    /// `[kind][row]` total diffuse reflectance.
+    pub total: Vec<f64>,
+    /// Its standard error.
+    pub total_se: Vec<f64>,
+}
+
+/// The whole table with its provenance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableData {
+    /// Seed of the simulation.
+    pub seed: u64,
+    /// Photons traced per plane.
+    pub photons: u64,
+    /// One plane per entry of [`ETAS`].
+    pub planes: Vec<Plane>,
+}
+
+/// A malformed table file.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("tabulated profile data: {0}")]
+pub struct TableFileError(pub &'static str);
+
+impl Plane {
+    /// Mean and standard error per bin and total from a tally of `eta`.
+    pub fn from_tally(eta: f64, t: &Tally) -> Self {
+        let n = t.photons as f64;
+        let mean_se = |s: f64, s2: f64| {
+            let m = s / n;
+            (m, ((s2 / n - m * m).max(0.0) / n).sqrt())
+        };
+        let mut density = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
+        let mut density_se = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
+        for (i, (d, se)) in density.iter_mut().zip(density_se.iter_mut()).enumerate() {
+            let (m, e) = mean_se(t.sum[i], t.sum2[i]);
+            let area = annulus_area(i % N_BINS);
+            *d = (m / area) as f32;
+            *se = (e / area) as f32;
+        }
+        let (total, total_se) = (0..2 * N_ALBEDO)
+            .map(|k| mean_se(t.total[k], t.total2[k]))
+            .unzip();
+        Self {
+            eta,
+            capped: t.capped,
+            density,
+            density_se,
+            total,
+            total_se,
+        }
+    }
+}
+
+impl Plane {
+    /// Pools runs of neighbouring radial bins whose counts are too small to estimate a density
+    /// (the innermost annuli are tiny, the outermost rarely reached): consecutive bins of one
+    /// (kind, row) are merged until the pooled relative standard error is at most
+    /// `max_rel_se`, and every bin of a run gets the run's mean density (area-weighted, so the
+    /// run's energy is unchanged). Bins with a small enough error are left as they are. This
+    /// removes the zeros and spikes of pure counting noise without moving energy between runs.
+    pub fn pool_sparse_bins(&mut self, max_rel_se: f64) {
+        for series in 0..2 * N_ALBEDO {
+            let base = series * N_BINS;
+            let mut j = 0;
+            while j < N_BINS {
+                let (mut e, mut var, mut area) = (0.0, 0.0, 0.0);
+                let mut k = j;
+                while k < N_BINS {
+                    let a = annulus_area(k);
+                    e += f64::from(self.density[base + k]) * a;
+                    var += (f64::from(self.density_se[base + k]) * a).powi(2);
+                    area += a;
+                    k += 1;
+                    if e > 0.0 && var.sqrt() <= max_rel_se * e {
+                        break;
+                    }
+                }
+                if k - j > 1 {
+                    for b in j..k {
+                        self.density[base + b] = (e / area) as f32;
+                        self.density_se[base + b] = (var.sqrt() / area) as f32;
+                    }
+                }
+                j = k;
+            }
+        }
+    }
+}
+
+impl TableData {
+    /// Serialises the table (see the module docs).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut b = Vec::new();
+        b.extend_from_slice(MAGIC);
+        b.extend_from_slice(&VERSION.to_le_bytes());
+        b.extend_from_slice(&self.seed.to_le_bytes());
+        b.extend_from_slice(&self.photons.to_le_bytes());
+        for v in [self.planes.len(), N_ALBEDO, N_BINS] {
+            b.extend_from_slice(&(v as u32).to_le_bytes());
+        }
+        for p in &self.planes {
+            b.extend_from_slice(&p.eta.to_le_bytes());
+        }
+        for p in &self.planes {
+            b.extend_from_slice(&p.capped.to_le_bytes());
+            for v in p.density.iter().chain(&p.density_se) {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            for v in p.total.iter().chain(&p.total_se) {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        b
+    }
+
+    /// Parses a table written by [`TableData::to_bytes`] with this crate's grid.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, TableFileError> {
+        let mut r = Reader(bytes);
+        if r.take(8)? != MAGIC {
+            return Err(TableFileError("not a table file (bad magic)"));
+        }
+        if r.u32()? != VERSION {
+            return Err(TableFileError("unsupported version"));
+        }
+        let (seed, photons) = (r.u64()?, r.u64()?);
+        let (planes, rows, bins) = (r.u32()? as usize, r.u32()? as usize, r.u32()? as usize);
+        if planes != ETAS.len() || rows != N_ALBEDO || bins != N_BINS {
+            return Err(TableFileError("grid differs from this crate's"));
+        }
+        let etas: Vec<f64> = (0..planes).map(|_| r.f64()).collect::<Result<_, _>>()?;
+        if etas.iter().zip(ETAS).any(|(a, b)| *a != b) {
+            return Err(TableFileError(
+                "refractive indices differ from this crate's",
+            ));
+        }
+        let n = 2 * N_ALBEDO * N_BINS;
+        let mut out = Vec::with_capacity(planes);
+        for eta in etas {
+            let capped = r.u64()?;
+            let density = (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>()?;
+            let density_se = (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>()?;
+            let total = (0..2 * N_ALBEDO)
+                .map(|_| r.f64())
+                .collect::<Result<Vec<_>, _>>()?;
+            let total_se = (0..2 * N_ALBEDO)
+                .map(|_| r.f64())
+                .collect::<Result<Vec<_>, _>>()?;
+            let finite = density
+                .iter()
+                .chain(&density_se)
+                .all(|v| v.is_finite() && *v >= 0.0)
+                && total
+                    .iter()
+                    .chain(&total_se)
+                    .all(|v| v.is_finite() && *v >= 0.0);
+            if !finite {
+                return Err(TableFileError("negative or non-finite value"));
+            }
+            out.push(Plane {
+                eta,
+                capped,
+                density,
+                density_se,
+                total,
+                total_se,
+            });
+        }
+        if !r.0.is_empty() {
+            return Err(TableFileError("trailing bytes"));
+        }
+        Ok(Self {
+            seed,
+            photons,
+            planes: out,
+        })
+    }
+}
+
+struct Reader<'a>(&'a [u8]);
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], TableFileError> {
+        if self.0.len() < n {
+            return Err(TableFileError("truncated"));
+        }
+        let (a, b) = self.0.split_at(n);
+        self.0 = b;
+        Ok(a)
+    }
+    fn u32(&mut self) -> Result<u32, TableFileError> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn u64(&mut self) -> Result<u64, TableFileError> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+    fn f32(&mut self) -> Result<f32, TableFileError> {
+        Ok(f32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+    fn f64(&mut self) -> Result<f64, TableFileError> {
+        Ok(f64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+}
+
+/// Simulates every plane with `photons` photons each (see [`super::simulate`]) and returns the
+/// table; bit-identical for a given seed and photon count whatever `threads` is.
+pub fn tabulate(
+    seed: u64,
+    photons: u64,
+    threads: usize,
+    mut progress: impl FnMut(usize),
+) -> TableData {
+    let planes = ETAS
+        .iter()
+        .enumerate()
+        .map(|(i, &eta)| {
+            let t = super::simulate::simulate(eta, i as u64, seed, photons, threads);
+            progress(i);
+            Plane::from_tally(eta, &t)
+        })
+        .collect();
+    TableData {
+        seed,
+        photons,
+        planes,
+    }
+}

@@ -1,0 +1,68 @@
+//! The grid of the tabulated half-space profile: refractive indices, albedos and radii.
+
+/// Relative refractive indices η = n_medium / n_outside of the table's planes.
+pub const ETAS: [f64; 5] = [1.0, 1.15, 1.3, 1.45, 1.6];
+
+/// Number of albedo rows.
+pub const N_ALBEDO: usize = 40;
+/// Smallest tabulated `s = √(1 − α)` (α = 0.999975); larger albedos use this row.
+pub const S_MIN: f64 = 0.005;
+
+/// `s_k = √(1 − α_k)` of row `k`, geometric from [`S_MIN`] to 1 (dense near α = 1, where
+/// the profiles change fastest and translucent materials live: α = 0.999 is s ≈ 0.032).
+pub fn s_of_row(k: usize) -> f64 {
+    if k + 1 >= N_ALBEDO {
+        return 1.0;
+    }
+    S_MIN * (1.0 / S_MIN).powf(k as f64 / (N_ALBEDO - 1) as f64)
+}
+
+/// Single-scattering albedo α_k of row `k`.
+pub fn albedo_of_row(k: usize) -> f64 {
+    let s = s_of_row(k);
+    1.0 - s * s
+}
+
+/// Radial bins in optical units x = σt·r: bin 0 is `[0, X_FIRST)`, then [`BINS_PER_DECADE`]
+/// geometric bins per decade up to [`X_LAST`]; exits beyond count in the totals only.
+pub const X_FIRST: f64 = 1e-3;
+/// Outer edge of the last bin.
+pub const X_LAST: f64 = 1e3;
+/// Geometric bins per decade.
+pub const BINS_PER_DECADE: usize = 20;
+/// Number of radial bins.
+pub const N_BINS: usize = 1 + 6 * BINS_PER_DECADE;
+
+/// Edge `j` of the radial bins (`edge(0) = 0`, `edge(N_BINS) = X_LAST`).
+pub fn edge(j: usize) -> f64 {
+    if j == 0 {
+        0.0
+    } else {
+        X_FIRST * 10f64.powf((j - 1) as f64 / BINS_PER_DECADE as f64)
+    }
+}
+
+/// The bin holding optical radius `x`, or `None` beyond [`X_LAST`].
+#[inline]
+pub fn bin_of(x: f64) -> Option<usize> {
+    if x < X_FIRST {
+        return Some(0);
+    }
+    let j = 1 + ((x / X_FIRST).log10() * BINS_PER_DECADE as f64) as usize;
+    (j < N_BINS).then_some(j)
+}
+
+/// The representative radius of bin `j`: the geometric mean of its edges (0's: X_FIRST / 2).
+pub fn centre(j: usize) -> f64 {
+    if j == 0 {
+        0.5 * X_FIRST
+    } else {
+        (edge(j) * edge(j + 1)).sqrt()
+    }
+}
+
+/// Area of the annulus of bin `j` (optical units²).
+pub fn annulus_area(j: usize) -> f64 {
+    let (a, b) = (edge(j), edge(j + 1));
+    std::f64::consts::PI * (b * b - a * a)
+}

@@ -1,0 +1,13 @@
+//! An exact homogeneous half-space profile, tabulated by Monte Carlo simulation of the
+//! radiative transfer it stands for (this project's own photon tracer, [`simulate`]).
+//!
+//! For a half-space with isotropic scattering the exitance depends only on the albedo α, on the
+//! radius in mean free paths and on η: `R(r; σt, α, η) = σt² · R̂(σt r; α, η)`. The table holds
+//! R̂ for single and multiple scattering separately ([`grid`] lists the η planes, albedo rows
+//! and radial bins), with the photon counts and standard errors it was made with ([`mod@file`]).
+pub mod file;
+pub mod grid;
+pub mod profile;
+pub mod simulate;
+
+pub use profile::TabulatedTerm;

@@ -1,0 +1,544 @@
+//! Importance sampling of incident points x_i around an exitant point x_o with probe rays:
+//! what every renderer that uses a BSSRDF needs besides the profile and the estimator.
+//!
+//! The technique is pbrt-v4's probe-ray sampling (pbrt-v4 §11.4.3, `TabulatedBSSRDF::Sample`
+//! and `PdfSp`; key `pbrt4` in `docs/references.md`) with two variance reductions of this
+//! project's own.
+//!
+//! # The sampler
+//! A probe along axis `a` of x_o's shading frame (the normal, or one of the two tangents)
+//! picks a colour channel `c` uniformly, samples a radius `r` from that channel's radial
+//! profile (the homogeneous profile of the coefficients at x_o, from a
+//! [`ProfileTable`]), an angle φ uniformly, and traces the chord of the sphere of radius
+//! `r_max,c` (holding [`PROBE_ENERGY_FRACTION`] of the profile's energy) along the axis at
+//! (r, φ). The renderer supplies the chord's intersections through [`ProbeChords`].
+//!
+//! pbrt traces one probe along a randomly chosen axis and keeps one of its hits at random.
+//! [`probe`] traces **one probe per axis and keeps every hit**: a multi-sample estimator with
+//! balance-heuristic weights over the three axes (Veach 1997, §9.2), so each hit x contributes
+//! `f(x) / p(x)` with
+//!
+//! `p(x) = Σ_axes (1/3) Σ_c [|x − x_o| < r_max,c] · p_r,c(r_a) / (2π r_a) · |n_g(x) · axis|`,
+//!
+//! `r_a` the distance from x_o to x projected on the plane perpendicular to the axis, `p_r,c`
+//! the channel's radial density (1/length) and `n_g` the geometric normal at x. Then
+//! `E[Σ_hits f/p] = ∫ f dA` over the object's surface inside the largest probe sphere: on a
+//! flat surface the normal probe always finds x_i, instead of succeeding one time in four,
+//! and the random choice between the two faces of a thin slab disappears.
+//!
+//! # The probe radius follows the estimate, not x_o
+//! The estimator may return coefficients far from x_o's own (x_o in a strongly absorbing vein
+//! next to a clear region), and then the BSSRDF reaches further than x_o's profile. A sphere
+//! sized from x_o alone would drop that light: about 6 % of it for σa = 0.1 at x_o against
+//! 0.005 around it. So each channel's sphere is the largest over every profile the estimate
+//! can become — the four corners of the field's bounds ([`FieldBounds`]) and x_o's own — and
+//! when the bounds differ from x_o's coefficients the radius is drawn from an equal mixture of
+//! x_o's profile and that widest one (a defensive mixture: the density stays positive out to
+//! the sphere, and near x_o it stays at least half of x_o's). A constant field keeps the
+//! single profile.
+//!
+//! # Units
+//! `p(x)` is an area density (1/length²), so [`ProbeHit::weight`] `= 1/p(x)` is an area; the
+//! BSSRDF term of a hit is `S(x_i, x_o) · E(x_i) · weight`. [`axis_densities`] splits `p(x)`
+//! by axis, for callers that combine the axes with other weights (the balance heuristic's
+//! weight of axis `a` is `p_a(x) / p(x)`).
+//!
+//! # Use
+//! ```
+//! use bssrdf_core::{ProfileFamily, ProfileModel, Scattering};
+//! use het_estimate::glam::DVec3;
+//! use het_estimate::probe::{ProbeChords, ProbeSampler, probe};
+//! use het_estimate::{Coefficients, FieldBounds, SplitMix64, SurfacePoint};
+//!
+//! // The renderer's surface point and its "all hits of a segment" query; here the plane z = 0.
+//! #[derive(Clone, Copy)]
+//! struct Hit(DVec3);
+//! impl SurfacePoint for Hit {
+//!     fn position(&self) -> DVec3 { self.0 }
+//!     fn normal(&self) -> DVec3 { DVec3::Z }
+//! }
+//! struct Floor;
+//! impl ProbeChords for Floor {
+//!     type Point = Hit;
+//!     fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, mut f: impl FnMut(&Hit)) {
+//!         let t = -o.z / d.z;
+//!         if t >= 0.0 && t <= t_max { f(&Hit(o + t * d)) }
+//!     }
+//! }
+//!
+//! // Once per material:
+//! let family = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3)?;
+//! let c = Coefficients::grey(0.01, 1.0);
+//! let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+//! // Per shading point x_o:
+//! let x_o = Hit(DVec3::ZERO);
+//! let mut rng = SplitMix64::new(7);
+//! let set = probe(&Floor, &x_o, c, &sampler, &mut rng);
+//! for h in set.iter() {
+//!     let r = (h.hit.position() - x_o.position()).length();
+//!     assert!(r < sampler.probe_radius(c) && h.weight > 0.0);
+//! }
+//! # Ok::<(), bssrdf_core::ParamError>(())
+//! ```
+
+use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, TableSampler};
+use glam::DVec3;
+
+use crate::frame::orthonormal_basis;
+use crate::{Coefficients, FieldBounds, SurfacePoint, UniformSource};
+
+/// Fraction of the profile's energy inside the probe sphere.
+pub const PROBE_ENERGY_FRACTION: f64 = 0.999;
+/// Most intersections kept per probe chord.
+pub const MAX_PROBE_HITS: usize = 16;
+
+/// Every intersection of a probe segment with the object being shaded: the one geometric
+/// query probe sampling needs. Implemented by the renderer over its own acceleration
+/// structure (the tracer uses its per-object BVH).
+pub trait ProbeChords {
+    /// The renderer's surface point. Its [`SurfacePoint::geometric_normal`] enters the
+    /// sampling density.
+    type Point: SurfacePoint + Copy;
+
+    /// Calls `f` for every crossing of the segment `origin + t·dir`, `t ∈ [0, t_max]` (`dir` a
+    /// unit vector), with the object being shaded, in increasing `t`. A crossing through a
+    /// shared edge or vertex should be reported once.
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: impl FnMut(&Self::Point));
+}
+
+impl<C: ProbeChords + ?Sized> ProbeChords for &C {
+    type Point = C::Point;
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: impl FnMut(&Self::Point)) {
+        (**self).for_each_hit(origin, dir, t_max, f)
+    }
+}
+
+/// The profile table of one material and the range of coefficients its estimates can take.
+/// Build once per material (the table costs 0.15 ms for the dipole, 40 ms for photon beam
+/// diffusion).
+#[derive(Debug, Clone)]
+pub struct ProbeSampler {
+    table: ProfileTable,
+    bounds: FieldBounds,
+    /// Per channel, the coefficients (σa, σs) within the bounds whose profile reaches furthest,
+    /// and that radius; `None` where no corner scatters.
+    widest: [Option<((f64, f64), f64)>; 3],
+}
+
+impl ProbeSampler {
+    /// The sampler of `family` for a field whose coefficients (and so the estimates, which
+    /// lie within them) are within `bounds`. Where x_o's coefficients do not scatter at all,
+    /// sampling uses `bounds.max`.
+    pub fn new(family: ProfileFamily, bounds: FieldBounds) -> Self {
+        let table = ProfileTable::new(family);
+        let widest = std::array::from_fn(|c| {
+            let (lo, hi) = (bounds.min, bounds.max);
+            [
+                (lo.sigma_a[c], lo.sigma_s[c]),
+                (lo.sigma_a[c], hi.sigma_s[c]),
+                (hi.sigma_a[c], lo.sigma_s[c]),
+                (hi.sigma_a[c], hi.sigma_s[c]),
+            ]
+            .into_iter()
+            .filter_map(|(a, s)| {
+                let r = table
+                    .sampler(a, s)
+                    .ok()?
+                    .radius_for_fraction(PROBE_ENERGY_FRACTION);
+                (r.is_finite() && r > 0.0).then_some(((a, s), r))
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+        });
+        Self {
+            table,
+            bounds,
+            widest,
+        }
+    }
+
+    /// The largest probe radius over the channels at coefficients `c` (length; 0 if none
+    /// scatters).
+    pub fn probe_radius(&self, c: Coefficients) -> f64 {
+        self.channels(c)
+            .iter()
+            .flatten()
+            .map(|(_, r)| *r)
+            .fold(0.0, f64::max)
+    }
+
+    /// The radial densities and probe radii of the three channels at coefficients `c` (x_o's).
+    fn channels(&self, c: Coefficients) -> [Option<(Radial<'_>, f64)>; 3] {
+        let c = if c.sigma_s.max_component() > 0.0 {
+            c
+        } else {
+            self.bounds.max
+        };
+        std::array::from_fn(|ch| {
+            let own = self
+                .table
+                .sampler(c.sigma_a[ch], c.sigma_s[ch])
+                .ok()
+                .map(|s| {
+                    let r = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
+                    (s, if r.is_finite() { r } else { 0.0 })
+                })
+                .filter(|(_, r)| *r > 0.0);
+            let wide = self.widest[ch].filter(|((a, s), _)| {
+                (*a, *s) != (c.sigma_a[ch], c.sigma_s[ch]) && !self.bounds.is_constant()
+            });
+            match (own, wide) {
+                (Some((s, r)), None) => Some((Radial::One(s), r)),
+                (own, Some(((a, sg), r_wide))) => {
+                    let wide = self.table.sampler(a, sg).ok()?;
+                    match own {
+                        Some((s, r)) => Some((Radial::Mixture(s, wide), r.max(r_wide))),
+                        None => Some((Radial::One(wide), r_wide)),
+                    }
+                }
+                (None, None) => None,
+            }
+        })
+    }
+}
+
+/// A channel's radial sampling density: x_o's profile, or an equal mixture of it and the
+/// widest profile the estimate can become (see the module docs).
+#[derive(Clone, Copy)]
+enum Radial<'a> {
+    One(TableSampler<'a>),
+    Mixture(TableSampler<'a>, TableSampler<'a>),
+}
+
+impl Radial<'_> {
+    #[inline]
+    fn sample_r(&self, u: f64) -> Option<f64> {
+        match self {
+            Radial::One(s) => s.sample_r(u),
+            Radial::Mixture(a, b) => {
+                if u < 0.5 {
+                    a.sample_r(2.0 * u)
+                } else {
+                    b.sample_r((2.0 * u - 1.0).min(1.0))
+                }
+            }
+        }
+    }
+    #[inline]
+    fn pdf_r(&self, r: f64) -> f64 {
+        match self {
+            Radial::One(s) => s.pdf_r(r),
+            Radial::Mixture(a, b) => 0.5 * (a.pdf_r(r) + b.pdf_r(r)),
+        }
+    }
+}
+
+/// A found incident point and its estimator weight `1/p(x)` (an area, see the module docs).
+#[derive(Debug, Clone, Copy)]
+pub struct ProbeHit<P> {
+    /// The incident point.
+    pub hit: P,
+    /// `1 / p(x)`.
+    pub weight: f64,
+}
+
+/// The incident points found by the three probes of one shading point (no allocation: at
+/// most [`MAX_PROBE_HITS`] per probe).
+#[derive(Debug, Clone)]
+pub struct ProbeSet<P> {
+    hits: [Option<ProbeHit<P>>; 3 * MAX_PROBE_HITS],
+    len: usize,
+}
+
+impl<P> ProbeSet<P> {
+    /// The hits.
+    pub fn iter(&self) -> impl Iterator<Item = &ProbeHit<P>> {
+        self.hits[..self.len].iter().flatten()
+    }
+    /// Number of hits.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// True when no probe found anything.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// Traces one probe per axis around `x_o` (see the module docs); `coeffs` are the coefficients
+/// at x_o that shape the sampling density. Draws 3 uniform numbers per axis from `rng`.
+pub fn probe<C: ProbeChords, U: UniformSource>(
+    chords: &C,
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    rng: &mut U,
+) -> ProbeSet<C::Point> {
+    let channels = sampler.channels(coeffs);
+    let origin = x_o.position();
+    let frame = Frame::new(x_o.normal());
+    let mut set = ProbeSet {
+        hits: [None; 3 * MAX_PROBE_HITS],
+        len: 0,
+    };
+    for axis in 0..3 {
+        let ch = ((rng.next_f64() * 3.0) as usize).min(2);
+        let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
+        let Some((prof, r_max)) = channels[ch].as_ref() else {
+            continue;
+        };
+        let Some(r) = prof.sample_r(u_r) else {
+            continue;
+        };
+        if r.is_nan() || r >= *r_max {
+            continue;
+        }
+        let phi = std::f64::consts::TAU * u_phi;
+        let (vx, vy, vz) = frame.axes(axis);
+        let half = (r_max * r_max - r * r).sqrt();
+        let base = origin + r * (phi.cos() * vx + phi.sin() * vy) - half * vz;
+        let mut kept = 0;
+        chords.for_each_hit(base, vz, 2.0 * half, |h| {
+            if kept < MAX_PROBE_HITS {
+                let p = axis_densities_in(origin, &frame, h, &channels)
+                    .iter()
+                    .sum::<f64>();
+                if p > 0.0 && p.is_finite() {
+                    set.hits[set.len] = Some(ProbeHit {
+                        hit: *h,
+                        weight: 1.0 / p,
+                    });
+                    set.len += 1;
+                    kept += 1;
+                }
+            }
+        });
+    }
+    set
+}
+
+/// `p(x)` of the module docs (1/length²): the density with which [`probe`] around `x_o`, with
+/// coefficients `coeffs` there, finds the surface point `x_i`.
+pub fn probe_density(
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    x_i: &impl SurfacePoint,
+) -> f64 {
+    axis_densities(x_o, coeffs, sampler, x_i).iter().sum()
+}
+
+/// The three axes' terms of [`probe_density`] (tangent s, tangent t, normal), each already
+/// divided by 3 (the axes' share); their sum is `p(x)`.
+pub fn axis_densities(
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    x_i: &impl SurfacePoint,
+) -> [f64; 3] {
+    axis_densities_in(
+        x_o.position(),
+        &Frame::new(x_o.normal()),
+        x_i,
+        &sampler.channels(coeffs),
+    )
+}
+
+fn axis_densities_in(
+    x_o: DVec3,
+    frame: &Frame,
+    x_i: &impl SurfacePoint,
+    channels: &[Option<(Radial<'_>, f64)>; 3],
+) -> [f64; 3] {
+    let d = x_i.position() - x_o;
+    let dist = d.length();
+    let ng = x_i.geometric_normal();
+    let dl = DVec3::new(d.dot(frame.s), d.dot(frame.t), d.dot(frame.n));
+    let nl = DVec3::new(ng.dot(frame.s), ng.dot(frame.t), ng.dot(frame.n));
+    let r_proj = [
+        (dl.y * dl.y + dl.z * dl.z).sqrt(),
+        (dl.z * dl.z + dl.x * dl.x).sqrt(),
+        (dl.x * dl.x + dl.y * dl.y).sqrt(),
+    ];
+    let mut pdf = [0.0; 3];
+    for (prof, r_max) in channels.iter().flatten() {
+        if dist >= *r_max {
+            continue;
+        }
+        for axis in 0..3 {
+            let r = r_proj[axis];
+            if r > 0.0 {
+                pdf[axis] += prof.pdf_r(r) / (3.0 * std::f64::consts::TAU * r) * nl[axis].abs();
+            }
+        }
+    }
+    pdf
+}
+
+/// The shading frame at x_o.
+struct Frame {
+    s: DVec3,
+    t: DVec3,
+    n: DVec3,
+}
+
+impl Frame {
+    fn new(n: DVec3) -> Self {
+        let (s, t) = orthonormal_basis(n);
+        Self { s, t, n }
+    }
+    /// `(vx, vy, vz)` for projection axis `axis` (0 = s, 1 = t, 2 = n): vz is the probe
+    /// direction and (vx, vy) span the plane the radius is sampled in.
+    fn axes(&self, axis: usize) -> (DVec3, DVec3, DVec3) {
+        match axis {
+            0 => (self.t, self.n, self.s),
+            1 => (self.n, self.s, self.t),
+            _ => (self.s, self.t, self.n),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SplitMix64;
+    use bssrdf_core::{ProfileModel, Scattering};
+
+    #[derive(Clone, Copy)]
+    struct P(DVec3, DVec3);
+    impl SurfacePoint for P {
+        fn position(&self) -> DVec3 {
+            self.0
+        }
+        fn normal(&self) -> DVec3 {
+            self.1
+        }
+    }
+
+    /// Two parallel planes z = 0 (normal +z) and z = −h (normal −z): a slab of thickness h.
+    struct Slab(f64);
+    impl ProbeChords for Slab {
+        type Point = P;
+        fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, mut f: impl FnMut(&P)) {
+            let mut hits = [
+                (-o.z / d.z, DVec3::Z),
+                ((-self.0 - o.z) / d.z, DVec3::NEG_Z),
+            ];
+            hits.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for (t, n) in hits {
+                if t.is_finite() && (0.0..=t_max).contains(&t) {
+                    f(&P(o + t * d, n));
+                }
+            }
+        }
+    }
+
+    /// `E[Σ_hits f/p] = ∫ f dA` over the surface inside the largest probe sphere (radius R),
+    /// here for `f = e^{−|x − x_o|/ℓ}` on a slab of thickness h < R, with closed forms
+    /// `2πℓ²[1 − (1 + R/ℓ)e^{−R/ℓ}]` on the top face and `2πℓ²[(1 + h/ℓ)e^{−h/ℓ} −
+    /// (1 + R/ℓ)e^{−R/ℓ}]` on the bottom one. ℓ = 1/σ_tr of the widest channel keeps f/p
+    /// bounded, as the BSSRDF itself does in a renderer.
+    #[test]
+    fn the_estimator_integrates_over_the_surface_inside_the_probe_sphere() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let c = Coefficients {
+            sigma_a: crate::Rgb::new(0.02, 0.05, 0.2),
+            sigma_s: crate::Rgb::new(1.0, 1.5, 2.0),
+        };
+        let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+        let big_r = sampler.probe_radius(c);
+        let h = 0.4 * big_r;
+        let ell = 1.0 / (3.0 * 0.02 * 1.02f64).sqrt();
+        let e = |x: f64| (1.0 + x / ell) * (-x / ell).exp();
+        let tau = std::f64::consts::TAU;
+        let want = tau * ell * ell * ((1.0 - e(big_r)) + (e(h) - e(big_r)));
+        let x_o = P(DVec3::ZERO, DVec3::Z);
+        let mut rng = SplitMix64::new(11);
+        let n = 200_000;
+        let (mut s, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let set = probe(&Slab(h), &x_o, c, &sampler, &mut rng);
+            let w: f64 = set
+                .iter()
+                .map(|hit| (-hit.hit.position().length() / ell).exp() * hit.weight)
+                .sum();
+            s += w;
+            s2 += w * w;
+        }
+        let mean = s / n as f64;
+        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+        assert!(
+            (mean - want).abs() < 4.0 * se,
+            "{mean} ± {se}, integral {want}"
+        );
+        assert!(se < 0.015 * want, "test too weak: {mean} ± {se} of {want}");
+    }
+
+    /// x_o sits in the strongly absorbing part of a two-valued field, and the estimate is the
+    /// clear part's coefficients: the probe must still reach the clear profile's tail, so that
+    /// `E[Σ R_clear(r)/p] = 0.999 · total_clear` (the sphere holds PROBE_ENERGY_FRACTION of the
+    /// widest profile). Sized from x_o alone it would find only about 94 % of it.
+    #[test]
+    fn probe_spheres_cover_every_profile_the_estimate_can_become() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let (clear, dark) = (Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0));
+        let bounds = FieldBounds {
+            min: clear,
+            max: dark,
+        };
+        let sampler = ProbeSampler::new(family, bounds);
+        let profile = family.profile(0.005, 1.0).unwrap();
+        let want = PROBE_ENERGY_FRACTION * profile.total();
+        let x_o = P(DVec3::ZERO, DVec3::Z);
+        let mut rng = SplitMix64::new(5);
+        let n = 100_000;
+        let (mut s, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let w: f64 = probe(&Slab(1e9), &x_o, dark, &sampler, &mut rng)
+                .iter()
+                .map(|h| profile.eval(h.hit.position().length()) * h.weight)
+                .sum();
+            s += w;
+            s2 += w * w;
+        }
+        let mean = s / n as f64;
+        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+        // 4 SE, plus 0.2 % for the table's piecewise-linear approximation of the profile.
+        assert!(
+            (mean - want).abs() < 4.0 * se + 2e-3 * want,
+            "{mean} ± {se}, want {want}"
+        );
+        assert!(se < 0.005 * want, "test too weak: {se}");
+        // A constant field keeps x_o's own sphere.
+        let own = ProbeSampler::new(family, FieldBounds::constant(dark));
+        assert!(own.probe_radius(dark) < 0.5 * sampler.probe_radius(dark));
+    }
+
+    #[test]
+    fn density_splits_by_axis_and_matches_each_hit() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3).unwrap();
+        let c = Coefficients::grey(0.05, 1.0);
+        let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+        let x_o = P(DVec3::ZERO, DVec3::Z);
+        let mut rng = SplitMix64::new(3);
+        let mut seen = 0;
+        for _ in 0..100 {
+            for hit in probe(&Slab(0.5), &x_o, c, &sampler, &mut rng).iter() {
+                let axes = axis_densities(&x_o, c, &sampler, &hit.hit);
+                let p = probe_density(&x_o, c, &sampler, &hit.hit);
+                assert!((axes.iter().sum::<f64>() - p).abs() <= 1e-12 * p);
+                assert!((hit.weight * p - 1.0).abs() < 1e-12);
+                seen += 1;
+            }
+        }
+        assert!(seen > 100);
+        // Outside every probe sphere the density is zero.
+        let far = P(
+            DVec3::new(10.0 * sampler.probe_radius(c), 0.0, 0.0),
+            DVec3::Z,
+        );
+        assert_eq!(probe_density(&x_o, c, &sampler, &far), 0.0);
+    }
+}

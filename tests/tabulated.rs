@@ -1,0 +1,166 @@
+//! The tabulated half-space profile against exact transport: its data file, its totals at
+//! η = 1 (Chandrasekhar), its single scattering at η = 1.3 (the exact single-scattering
+//! integral of `bssrdf-core`, computed independently of the simulation), and the profile built
+//! on it.
+
+use bssrdf_core::tabulated::file::TableData;
+use bssrdf_core::tabulated::grid::{ETAS, N_ALBEDO, albedo_of_row};
+use bssrdf_core::tabulated::profile::table;
+use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
+
+use crate::common::chandrasekhar::{half_space_albedo, single_scattering_albedo};
+
+const DATA: &[u8] = include_bytes!("../crates/bssrdf-core/data/halfspace-profile-v1.bin");
+
+#[test]
+fn the_data_file_round_trips_and_records_its_provenance() {
+    let t = TableData::from_bytes(DATA).unwrap();
+    assert_eq!(t.to_bytes(), DATA, "the format round-trips bit for bit");
+    assert_eq!(t.planes.len(), ETAS.len());
+    assert!(
+        t.photons >= 1_000_000,
+        "only {} photons per plane",
+        t.photons
+    );
+    for p in &t.planes {
+        assert!(
+            (p.capped as f64) < 0.02 * t.photons as f64,
+            "{} capped",
+            p.capped
+        );
+    }
+    // Corrupt files are errors, not panics.
+    assert!(TableData::from_bytes(&DATA[..DATA.len() - 1]).is_err());
+    assert!(TableData::from_bytes(b"HBSSRDFT").is_err());
+    let mut bad = DATA.to_vec();
+    bad[0] = b'X';
+    assert!(TableData::from_bytes(&bad).is_err());
+}
+
+#[test]
+fn index_matched_totals_match_chandrasekhar() {
+    // A(α) = 1 − H(1)√(1 − α) and R_ss = (α/2)(1 − ln 2), at 4 standard errors of the table.
+    // Paths cut at the event cap lose at most e^{-2.5} of ~1 % of the paths at the largest
+    // albedo row: a bias allowance of 1e-3 there (none is needed below α = 0.9999).
+    let plane = &table().planes[0];
+    assert_eq!(plane.eta, 1.0);
+    let mut checked = 0;
+    for row in 0..N_ALBEDO {
+        let alpha = albedo_of_row(row);
+        if !(0.3..=0.9999).contains(&alpha) {
+            continue;
+        }
+        let (ss, ms) = (plane.total[row], plane.total[N_ALBEDO + row]);
+        let (se_ss, se_ms) = (plane.total_se[row], plane.total_se[N_ALBEDO + row]);
+        let want = half_space_albedo(alpha);
+        let se = (se_ss * se_ss + se_ms * se_ms).sqrt();
+        assert!(
+            (ss + ms - want).abs() < 4.0 * se + 2e-4,
+            "α {alpha}: total {} ± {se}, exact {want}",
+            ss + ms
+        );
+        let want_ss = single_scattering_albedo(alpha);
+        assert!(
+            (ss - want_ss).abs() < 4.0 * se_ss,
+            "α {alpha}: single {ss} ± {se_ss}, exact {want_ss}"
+        );
+        assert!(se < 2e-3, "table too noisy: {se}");
+        checked += 1;
+    }
+    assert!(checked >= 15, "{checked} rows checked");
+}
+
+#[test]
+fn refractive_single_scattering_matches_the_exact_integral() {
+    // At η = 1.3 the single-scattering total, with Fresnel at the exit, is an exact integral
+    // (bssrdf-core's single-scattering term); the table's comes from the photon simulation.
+    let plane_index = ETAS.iter().position(|&e| e == 1.3).unwrap();
+    let plane = &table().planes[plane_index];
+    for row in [5usize, 15, 25, 33] {
+        let alpha = albedo_of_row(row);
+        let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Single, 0.0, 1.3).unwrap();
+        let exact = family.profile(1.0 - alpha, alpha).unwrap().total();
+        let (got, se) = (plane.total[row], plane.total_se[row]);
+        assert!(
+            (got - exact).abs() < 4.0 * se + 2e-3 * exact,
+            "α {alpha}: table {got} ± {se}, exact {exact}"
+        );
+    }
+}
+
+#[test]
+fn the_profile_integrates_to_its_total_and_samples_its_own_density() {
+    for (eta, sc) in [
+        (1.0, Scattering::Multiple),
+        (1.3, Scattering::All),
+        (1.22, Scattering::Single),
+    ] {
+        let family = ProfileFamily::new(ProfileModel::Tabulated, sc, 0.0, eta).unwrap();
+        for (sa, ss) in [(0.01, 1.0), (0.001, 2.0), (0.3, 1.0)] {
+            let p = family.profile(sa, ss).unwrap();
+            let total = p.total();
+            // ∫ 2πr R(r) dr by the trapezoid rule in ln r over the table's range.
+            let st = sa + ss;
+            let (a, b, n) = ((1e-4 / st).ln(), (1e3 / st).ln(), 4000);
+            let h = (b - a) / n as f64;
+            let integral: f64 = (0..=n)
+                .map(|k| {
+                    let r = (a + k as f64 * h).exp();
+                    let w = if k == 0 || k == n { 0.5 } else { 1.0 };
+                    w * std::f64::consts::TAU * r * r * p.eval(r) * h
+                })
+                .sum();
+            assert!(
+                (integral - total).abs() < 0.03 * total,
+                "η {eta} {sc} σa {sa}: ∫ {integral} vs total {total}"
+            );
+            // sample_r and pdf_r agree: E[1/pdf(r)] over samples in the first half of the CDF
+            // is ∫ over that range = its radius, and radius_for_fraction inverts the CDF.
+            let r_half = p.radius_for_fraction(0.5);
+            let mut below = 0;
+            let n = 20_000;
+            for k in 0..n {
+                let u = (k as f64 + 0.5) / n as f64;
+                let r = p.sample_r(u).unwrap();
+                assert!(p.pdf_r(r) > 0.0, "pdf 0 at its own sample {r}");
+                below += usize::from(r <= r_half);
+            }
+            assert!(
+                (below as f64 / n as f64 - 0.5).abs() < 2e-3,
+                "η {eta} {sc}: {below} of {n} below the median"
+            );
+        }
+    }
+    // Outside the table's η range the family is a typed error.
+    assert!(ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, 0.0, 1.7).is_err());
+}
+
+#[test]
+fn eta_interpolation_is_exact_at_the_planes_and_continuous_between() {
+    let total = |eta: f64| {
+        let f = ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, 0.0, eta).unwrap();
+        f.profile(0.002, 1.0).unwrap().total()
+    };
+    // At a plane and an albedo row the profile's total is the stored one.
+    let row = 12;
+    let alpha = albedo_of_row(row);
+    for (k, &eta) in ETAS.iter().enumerate() {
+        let f = ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, 0.0, eta).unwrap();
+        let got = f.profile(1.0 - alpha, alpha).unwrap().total();
+        let plane = &table().planes[k];
+        let want = plane.total[row] + plane.total[N_ALBEDO + row];
+        assert!((got - want).abs() < 1e-9 * want, "η {eta}: {got} vs {want}");
+        // Approaching a plane from both sides gives its value (continuity across stencils).
+        for d in [1e-9, -1e-9] {
+            let e = (eta + d).clamp(1.0, 1.6);
+            assert!((total(e) - total(eta)).abs() < 1e-6, "η {eta}{d:+e}");
+        }
+    }
+    // Between planes the totals stay between smooth bounds (no overshoot beyond 1 %).
+    let (lo, hi) = (total(1.0).min(total(1.6)), total(1.0).max(total(1.6)));
+    for k in 0..=60 {
+        let e = 1.0 + 0.01 * k as f64;
+        let t = total(e);
+        assert!(t > 0.99 * lo && t < 1.01 * hi, "η {e}: {t}");
+    }
+}
