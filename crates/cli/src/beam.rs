@@ -11,6 +11,7 @@ use bssrdf_core::{ProfileModel, Scattering};
 use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
+use crate::interrupt;
 use crate::common::{
     check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
 };
@@ -214,6 +215,25 @@ pub fn run_method(
     Ok(map)
 }
 
+/// Most `--subsamples` K: K × K = 1,048,576 points per pixel.
+const MAX_SUBSAMPLES: u64 = 1024;
+
+/// Checks `--subsamples K` (K × K points per pixel, computed in 64 bits).
+fn check_subsamples(k: u64) -> anyhow::Result<u32> {
+    if k > MAX_SUBSAMPLES {
+        bail!(
+            "--subsamples {k} means {} points per pixel; at most {MAX_SUBSAMPLES} ({} points) are allowed",
+            u128::from(k) * u128::from(k),
+            MAX_SUBSAMPLES * MAX_SUBSAMPLES
+        );
+    }
+    Ok(u32::try_from(k).expect("at most MAX_SUBSAMPLES"))
+}
+
+/// Bytes per pixel of a beam map: the photon counts, the values and their standard errors
+/// (8 bytes each), a batch's counts per thread, and the EXR and PNG buffers.
+const BEAM_BYTES_PER_PIXEL: f64 = 8.0 * 3.0 + 4.0 * 16.0 + 8.0 + 6.0;
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let setup = args.setup.setup()?;
@@ -230,7 +250,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (Some(n), None) => PhotonBudget::Count(n),
         (None, None) => PhotonBudget::Count(1 << 20),
     };
-    let sub = u32::try_from(args.subsamples).context("--subsamples is too large")?;
+    let sub = check_subsamples(args.subsamples)?;
+    let n = f64::from(setup.resolution);
+    tracer::memory::check(
+        || format!("a {0}x{0} beam map", setup.resolution),
+        n * n * BEAM_BYTES_PER_PIXEL,
+    )
+    .context("--resolution")?;
+    interrupt::install()?;
     let map = run_method(
         &setup,
         args.method.with_estimator_samples(
@@ -243,7 +270,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         args.seed,
         true,
     )?;
-    write_beam_map(&map, &setup, &out, serde_json::json!({"seed": args.seed}))?;
+    let interrupted = interrupt::received().map(interrupt::name);
+    if let Some(signal) = interrupted
+        && map.samples == 0
+    {
+        bail!("{signal} before the first batch completed; nothing written");
+    }
+    write_beam_map(
+        &map,
+        &setup,
+        &out,
+        serde_json::json!({"seed": args.seed, "interrupted": interrupted.is_some()}),
+    )?;
+    if let Some(signal) = interrupted {
+        bail!(
+            "{signal}: wrote the {} samples completed to {} (the sidecar says \"interrupted\": true)",
+            map.samples,
+            out.display()
+        );
+    }
     eprintln!(
         "{}: {} samples in {:.2} s; wrote {}",
         map.method,

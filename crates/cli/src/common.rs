@@ -74,3 +74,26 @@ pub fn warn_counters(c: &PathCounters) {
         );
     }
 }
+
+/// Refuses, before anything is allocated, a render of the scene's `width × height` that would
+/// not fit in memory; the error names the scene's keys and the figure.
+pub fn check_image_memory(width: u32, height: u32, scene: &Path) -> anyhow::Result<()> {
+    tracer::memory::check_render(width, height)
+        .with_context(|| format!("{}: render.width, render.height", scene.display()))
+}
+
+/// Triangle count above which a render says how many triangles its shapes became.
+const MANY_TRIANGLES: usize = 1_000_000;
+
+/// Says how many triangles the scene's shapes became when that is many (spheres and other
+/// primitives are tessellated), so that a slow build or a large memory use is explained.
+pub fn note_triangles(scene: &tracer::scene::Scene) {
+    let n = scene.geometry.triangle_count();
+    if n >= MANY_TRIANGLES {
+        eprintln!(
+            "note: the scene's {} objects are {:.1} million triangles",
+            scene.geometry.object_count(),
+            n as f64 / 1e6
+        );
+    }
+}

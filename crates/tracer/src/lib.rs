@@ -10,7 +10,9 @@ pub mod field;
 pub mod film;
 pub mod geometry;
 pub mod integrator;
+pub mod interrupt;
 pub mod light;
+pub mod memory;
 pub mod output;
 #[cfg(feature = "plot")]
 pub mod plot;

@@ -5,7 +5,9 @@
 //! pixel's samples are added to its running sum in increasing `s` by one thread, so the image is
 //! bit-identical whatever the number of threads or the scheduling order. A time-budget render
 //! adds passes of doubling size to the same running sums, so it equals a fixed-count render
-//! with the sample count it reached.
+//! with the sample count it reached. Renders run in passes (see [`render_observed`]), which
+//! neither change a pixel nor depend on the thread count; an interrupt
+//! ([`crate::interrupt`]) keeps the completed passes.
 
 use std::time::{Duration, Instant};
 
@@ -60,6 +62,9 @@ pub struct Rendered<C> {
     pub seconds: f64,
     /// Merged integrator counters.
     pub counters: C,
+    /// True when [`RenderObserver::stop_requested`] ended the render before its budget: the
+    /// image holds the passes completed before the request (`spp` of them).
+    pub interrupted: bool,
 }
 
 /// Options of [`render`].
@@ -75,33 +80,164 @@ pub struct RenderOptions {
     pub label: String,
 }
 
-/// Renders `width × height` pixels with `estimator` (see the module docs).
+/// The image after a completed pass, for checkpoints.
+#[derive(Debug)]
+pub struct Partial<'a, C> {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Sum of the samples of each pixel (row-major); divide by `spp` for the mean.
+    pub sums: &'a [Rgb],
+    /// Samples per pixel completed.
+    pub spp: u32,
+    /// Wall-clock seconds so far.
+    pub seconds: f64,
+    /// Counters of the completed passes.
+    pub counters: &'a C,
+}
+
+impl<C> Partial<'_, C> {
+    /// The mean radiance per pixel so far.
+    pub fn mean(&self) -> Vec<Rgb> {
+        let inv = 1.0 / f64::from(self.spp.max(1));
+        self.sums.iter().map(|&s| s * inv).collect()
+    }
+}
+
+/// What the render loop reports while it runs, and how it is stopped early. Called from the
+/// worker threads, hence `Sync`.
+pub trait RenderObserver<C>: Sync {
+    /// A pass of samples `first..end` starts; `total` is the budget's sample count when it is
+    /// fixed.
+    fn pass_started(&self, first: u32, end: u32, total: Option<u32>) {
+        let _ = (first, end, total);
+    }
+    /// `pixel_samples` more pixel samples were taken (reported pixel by pixel, so a time
+    /// estimate is available from the first samples, not after the first row).
+    fn advance(&self, pixel_samples: u64) {
+        let _ = pixel_samples;
+    }
+    /// True to stop: the pass in progress is abandoned and the render returns the completed
+    /// ones. Polled once per pixel. The default follows [`crate::interrupt`].
+    fn stop_requested(&self) -> bool {
+        crate::interrupt::requested()
+    }
+    /// A pass completed; `partial` is the image so far (for checkpoints).
+    fn pass_finished(&self, partial: &Partial<'_, C>) {
+        let _ = partial;
+    }
+}
+
+/// The observer [`render`] uses: a progress bar (when [`RenderOptions::progress`] is set) over
+/// every pixel sample of the budget (of the current pass for a time budget), stopped by
+/// [`crate::interrupt`].
+#[derive(Debug)]
+pub struct ProgressObserver {
+    bar: ProgressBar,
+    pixels: u64,
+}
+
+impl ProgressObserver {
+    /// A progress bar for a `width × height` render with `options`.
+    pub fn new(options: &RenderOptions, width: u32, height: u32) -> Self {
+        Self {
+            bar: progress_bar(options, 0),
+            pixels: u64::from(width) * u64::from(height),
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+
+    /// Runs `f` (which prints) with the bar hidden.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.bar.suspend(f)
+    }
+}
+
+impl<C> RenderObserver<C> for ProgressObserver {
+    fn pass_started(&self, first: u32, end: u32, total: Option<u32>) {
+        match total {
+            Some(n) => {
+                if first == 0 {
+                    self.bar.set_length(self.pixels * u64::from(n));
+                    self.bar.reset();
+                }
+            }
+            None => {
+                self.bar.set_length(self.pixels * u64::from(end - first));
+                self.bar.reset();
+            }
+        }
+    }
+    fn advance(&self, pixel_samples: u64) {
+        self.bar.inc(pixel_samples);
+    }
+}
+
+/// A pass is not made longer than this (seconds, predicted), so that an interrupt loses at most
+/// about this much work and checkpoints can be written between passes.
+const PASS_SECONDS: f64 = 2.0;
+
+/// Renders `width × height` pixels with `estimator` (see the module docs), with a progress bar
+/// when `options.progress` is set.
 pub fn render<E: PixelEstimator>(
     width: u32,
     height: u32,
     estimator: &E,
     options: &RenderOptions,
 ) -> Rendered<E::Counters> {
+    let observer = ProgressObserver::new(options, width, height);
+    let out = render_observed(width, height, estimator, options, &observer);
+    observer.finish();
+    out
+}
+
+/// [`render`] reporting to `observer` (which replaces the progress bar).
+///
+/// The samples are taken in passes: `1, 1, 2, 4, …` samples per pixel, doubling while a pass
+/// is predicted to take under [`PASS_SECONDS`]. A pass is accumulated into a copy of the running
+/// sums, each pixel's samples in increasing index, and replaces them only when it completes, so
+/// the pass boundaries (and whether checkpoints are written, or an interrupt abandons a pass)
+/// never change a pixel: the image is the same as a single pass's.
+pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Sized>(
+    width: u32,
+    height: u32,
+    estimator: &E,
+    options: &RenderOptions,
+    observer: &O,
+) -> Rendered<E::Counters> {
     let start = Instant::now();
-    let n = width as usize * height as usize;
+    let w = width as usize;
+    let n = w * height as usize;
     let mut sums = vec![Rgb::ZERO; n];
+    let mut next_sums = vec![Rgb::ZERO; n];
     let mut counters = E::Counters::default();
-    let bar = progress_bar(options, height as u64);
-    // Fixed count: one pass. Time budget: passes of 1, 1, 2, 4, … samples.
-    let mut done = 0u32;
-    let mut pass = match options.budget {
-        Budget::Samples(s) => s.max(1),
-        Budget::Time(_) => 1,
+    let total = match options.budget {
+        Budget::Samples(s) => Some(s.max(1)),
+        Budget::Time(_) => None,
     };
-    loop {
+    let mut done = 0u32;
+    let mut pass = 1u32;
+    let mut interrupted = false;
+    while pass > 0 {
         let end = done.saturating_add(pass);
+        observer.pass_started(done, end, total);
         let pass_start = Instant::now();
-        let row_counters: Vec<E::Counters> = sums
-            .par_chunks_mut(width as usize)
+        let rows: Vec<Option<E::Counters>> = next_sums
+            .par_chunks_mut(w.max(1))
+            .zip(sums.par_chunks(w.max(1)))
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(y, (row, old))| {
                 let mut c = E::Counters::default();
+                row.copy_from_slice(old);
                 for (x, sum) in row.iter_mut().enumerate() {
+                    if observer.stop_requested() {
+                        return None;
+                    }
                     for s in done..end {
                         let mut rng = Rng::for_pixel_sample(options.seed, x as u32, y as u32, s);
                         let fx = x as f64 + rng.uniform();
@@ -110,30 +246,32 @@ pub fn render<E: PixelEstimator>(
                         debug_assert!(v.is_finite(), "non-finite sample at ({x}, {y})");
                         *sum += v;
                     }
+                    observer.advance(u64::from(end - done));
                 }
-                bar.inc(1);
-                c
+                Some(c)
             })
             .collect();
-        for c in &row_counters {
+        if observer.stop_requested() || rows.iter().any(Option::is_none) {
+            interrupted = true;
+            break;
+        }
+        for c in rows.iter().flatten() {
             counters.merge(c);
         }
-        let per_sample = pass_start.elapsed().as_secs_f64() / (end - done) as f64;
+        std::mem::swap(&mut sums, &mut next_sums);
+        let per_sample = pass_start.elapsed().as_secs_f64() / f64::from(end - done);
         done = end;
-        let Budget::Time(limit) = options.budget else {
-            break;
-        };
-        // The next pass doubles the count; stop if it is predicted to overshoot the budget.
-        let next = done;
-        let predicted = start.elapsed().as_secs_f64() + per_sample * next as f64;
-        if predicted > limit.as_secs_f64() || done >= u32::MAX / 2 {
-            break;
-        }
-        pass = next;
-        bar.reset();
+        observer.pass_finished(&Partial {
+            width,
+            height,
+            sums: &sums,
+            spp: done,
+            seconds: start.elapsed().as_secs_f64(),
+            counters: &counters,
+        });
+        pass = next_pass(options.budget, done, per_sample, start.elapsed().as_secs_f64());
     }
-    bar.finish_and_clear();
-    let inv = 1.0 / done as f64;
+    let inv = 1.0 / f64::from(done.max(1));
     Rendered {
         width,
         height,
@@ -141,6 +279,30 @@ pub fn render<E: PixelEstimator>(
         spp: done,
         seconds: start.elapsed().as_secs_f64(),
         counters,
+        interrupted,
+    }
+}
+
+/// The size of the pass after `done` samples per pixel (0: stop): double the samples so far,
+/// but no more than [`PASS_SECONDS`] of predicted work, nor past the budget. A time budget stops
+/// when the next pass is predicted to overshoot it.
+fn next_pass(budget: Budget, done: u32, per_sample: f64, elapsed: f64) -> u32 {
+    let by_time = if per_sample > 0.0 {
+        (PASS_SECONDS / per_sample).floor().clamp(1.0, f64::from(u32::MAX)) as u32
+    } else {
+        u32::MAX
+    };
+    let pass = done.min(by_time).max(1);
+    match budget {
+        Budget::Samples(total) => pass.min(total.max(1).saturating_sub(done)),
+        Budget::Time(limit) => {
+            if done >= u32::MAX / 2 || elapsed + per_sample * f64::from(pass) > limit.as_secs_f64()
+            {
+                0
+            } else {
+                pass
+            }
+        }
     }
 }
 
@@ -151,7 +313,7 @@ pub fn progress_bar(options: &RenderOptions, len: u64) -> ProgressBar {
     }
     let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template("{prefix:>12} [{bar:40}] {pos}/{len} rows  {elapsed}<{eta}")
+        ProgressStyle::with_template("{prefix:>12} [{bar:40}] {percent:>3}%  {elapsed}<{eta}")
             .expect("static template")
             .progress_chars("=> "),
     );

@@ -329,9 +329,12 @@ pub fn trace_photons(
     };
     loop {
         let pass_start = Instant::now();
+        // After an interrupt (crate::interrupt) the batches not yet started are skipped; the
+        // completed ones are kept and counted, so the map stays normalised by its photons.
         let results: Vec<(Vec<u32>, ExitCounts, PathCounters)> = (batches_done
             ..batches_done + next)
             .into_par_iter()
+            .filter(|_| !crate::interrupt::requested())
             .map(|b| {
                 let mut local = vec![0u32; n * n];
                 let mut ex = ExitCounts::default();
@@ -383,6 +386,9 @@ pub fn trace_photons(
             counters.merge(c);
         }
         batches_done += next;
+        if crate::interrupt::requested() {
+            break;
+        }
         let PhotonBudget::Time(limit) = budget else {
             break;
         };
@@ -445,9 +451,10 @@ pub fn bssrdf_map(
             let mut c = PathCounters::default();
             for (j, value) in row.iter_mut().enumerate() {
                 let mut sum = 0.0;
-                for s in 0..sub * sub {
-                    let mut rng = Rng::from_keys(seed, &[0xb55, i as u64, j as u64, s as u64]);
-                    let (a, b) = ((s % sub) as f64, (s / sub) as f64);
+                let k = u64::from(sub);
+                for s in 0..k * k {
+                    let mut rng = Rng::from_keys(seed, &[0xb55, i as u64, j as u64, s]);
+                    let (a, b) = ((s % k) as f64, (s / k) as f64);
                     let x = -e + (j as f64 + (a + rng.uniform()) / sub as f64) * delta;
                     let y = e - (i as f64 + (b + rng.uniform()) / sub as f64) * delta;
                     let down = Ray::new(DVec3::new(x, y, 1.0), DVec3::NEG_Z);
@@ -459,7 +466,7 @@ pub fn bssrdf_map(
                     c.record_estimate(&est.diagnostics);
                     sum += eval_grey(&family, est.coefficients, (x_o.p - x_i.p).length());
                 }
-                *value = sum / (sub * sub) as f64;
+                *value = sum / (k * k) as f64;
             }
             progress(1);
             (row, c)

@@ -12,8 +12,10 @@ use serde_json::json;
 use crate::error::OutputError;
 use crate::film::Film;
 use crate::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
-use crate::output::{write_exr, write_json, write_png};
-use crate::render::{Budget, RenderOptions, Rendered, render};
+use crate::output::{OutputSet, exr_bytes, json_bytes, parent_dir, png_bytes, resolve_output};
+use crate::render::{
+    Budget, ProgressObserver, RenderObserver, RenderOptions, Rendered, render_observed,
+};
 use crate::scene::Scene;
 
 /// Default most surface interactions per camera path.
@@ -99,6 +101,16 @@ impl RenderJob {
             progress: false,
         }
     }
+
+    /// The render loop's options for this job.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            budget: self.budget,
+            seed: self.seed,
+            progress: self.progress,
+            label: self.method.name().to_string(),
+        }
+    }
 }
 
 /// A finished render.
@@ -118,10 +130,27 @@ pub struct RenderOutcome {
     pub method: String,
     /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
     pub warnings: Vec<String>,
+    /// True when the render was interrupted: `spp` counts the completed passes only.
+    pub interrupted: bool,
+    /// True for a checkpoint written while the render goes on (`spp` so far).
+    pub checkpoint: bool,
 }
 
 /// Renders `scene` with `job`.
 pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
+    let (w, h) = scene.camera.resolution();
+    let observer = ProgressObserver::new(&job.options(), w, h);
+    let outcome = render_scene_observed(scene, job, &observer);
+    observer.finish();
+    outcome
+}
+
+/// [`render_scene`] reporting progress and completed passes to `observer`.
+pub fn render_scene_observed(
+    scene: &Scene,
+    job: &RenderJob,
+    observer: &dyn RenderObserver<PathCounters>,
+) -> Result<RenderOutcome, RenderError> {
     let integrator = PathIntegrator::new(
         scene,
         job.method,
@@ -137,18 +166,9 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         spp,
         seconds,
         counters,
+        interrupted,
         ..
-    } = render(
-        w,
-        h,
-        &integrator,
-        &RenderOptions {
-            budget: job.budget,
-            seed: job.seed,
-            progress: job.progress,
-            label: job.method.name().to_string(),
-        },
-    );
+    } = render_observed(w, h, &integrator, &job.options(), observer);
     let mut film = Film::new(w, h);
     film.pixels = pixels;
     Ok(RenderOutcome {
@@ -159,6 +179,8 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         counters,
         method: job.method.name().to_string(),
         warnings: integrator.warnings().to_vec(),
+        interrupted,
+        checkpoint: false,
     })
 }
 
@@ -167,19 +189,20 @@ pub fn sidecar_paths(exr: &Path) -> (PathBuf, PathBuf) {
     (exr.with_extension("png"), exr.with_extension("json"))
 }
 
-/// Checks before a long run that `path` can be written: its directory exists and accepts new
-/// files (see [`check_dir_accepts_files`]), and `path` is not itself a directory.
+/// Checks before a long run that `path` can be written: it is not a directory, device or FIFO
+/// and its parent is a directory ([`resolve_output`]: a symbolic link is checked at its target),
+/// and that directory accepts new files (see [`check_dir_accepts_files`]).
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
-    if path.is_dir() {
-        return Err(OutputError::IsDirectory {
-            path: path.to_path_buf(),
-        });
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    check_dir_accepts_files(&dir, path)
+    let target = resolve_output(path)?;
+    check_dir_accepts_files(&parent_dir(&target), path)
+}
+
+/// [`check_output_path`] for a render's EXR and the PNG and JSON written beside it.
+pub fn check_render_outputs(exr: &Path) -> Result<(), OutputError> {
+    let (png, json) = sidecar_paths(exr);
+    [exr, &png, &json]
+        .into_iter()
+        .try_for_each(check_output_path)
 }
 
 /// Checks that `dir` exists and that a file can be created in it, by creating and removing an
@@ -220,9 +243,7 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    write_exr(&outcome.film, exr)?;
     let (png, json_path) = sidecar_paths(exr);
-    write_png(&outcome.film, &png, exposure)?;
     let profile = match job.method {
         Method::Bssrdf { profile, .. } => Some(
             profile
@@ -252,6 +273,13 @@ pub fn write_render(
         "counters": outcome.counters,
         "warnings": outcome.warnings,
         "mean_rgb": outcome.film.mean().0,
+        "interrupted": outcome.interrupted,
+        "checkpoint": outcome.checkpoint,
     });
-    write_json(&value, &json_path)
+    // Small files first, images last, renamed into place together or not at all.
+    let mut set = OutputSet::new();
+    set.add(&json_path, json_bytes(&value, &json_path)?);
+    set.add(&png, png_bytes(&outcome.film, &png, exposure)?);
+    set.add(exr, exr_bytes(&outcome.film, exr)?);
+    set.commit()
 }
