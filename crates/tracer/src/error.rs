@@ -18,6 +18,16 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MeshError {
+    /// A problem found at a line of a text mesh file (OBJ).
+    #[error("{file}:{line}: {message}")]
+    AtLine {
+        /// Mesh file.
+        file: String,
+        /// Line number, from 1.
+        line: usize,
+        /// What is wrong there.
+        message: String,
+    },
     /// No triangles (or no vertices).
     #[error("{file}: the mesh has no triangles")]
     Empty {
