@@ -13,7 +13,8 @@ use tracer::integrator::Method;
 
 use crate::interrupt;
 use crate::common::{
-    check_writable, parse_method, parse_positive, parse_seconds, progress, warn_counters,
+    check_writable, parse_method, parse_positive, parse_seconds, progress, set_collision_cap,
+    warn_counters,
 };
 
 /// Texture kinds.
@@ -179,6 +180,10 @@ pub struct Args {
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Most collisions of one photon before it is cut (and counted), for `--method pt`
+    /// (default 100,000,000).
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    max_collisions: Option<u64>,
 }
 
 /// Runs one method with a progress bar on stderr.
@@ -257,6 +262,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         n * n * BEAM_BYTES_PER_PIXEL,
     )
     .context("--resolution")?;
+    set_collision_cap(args.max_collisions);
     interrupt::install()?;
     let map = run_method(
         &setup,
@@ -280,7 +286,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         &map,
         &setup,
         &out,
-        serde_json::json!({"seed": args.seed, "interrupted": interrupted.is_some()}),
+        serde_json::json!({
+            "seed": args.seed,
+            "interrupted": interrupted.is_some(),
+            "max_collisions": tracer::integrator::walk::collision_cap(),
+        }),
     )?;
     if let Some(signal) = interrupted {
         bail!(

@@ -25,6 +25,13 @@ pub fn parse_seconds(s: &str) -> Result<Duration, String> {
     Ok(Duration::from_secs_f64(v))
 }
 
+/// Applies `--max-collisions`, if given (see [`tracer::integrator::walk::set_collision_cap`]).
+pub fn set_collision_cap(cap: Option<u64>) {
+    if let Some(cap) = cap {
+        tracer::integrator::walk::set_collision_cap(cap);
+    }
+}
+
 /// Parses a positive integer.
 pub fn parse_positive(s: &str) -> Result<u64, String> {
     match s.parse::<u64>() {
@@ -57,8 +64,12 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
 pub fn warn_counters(c: &PathCounters) {
     if c.capped > 0 {
         eprintln!(
-            "warning: {} paths hit the collision cap (their remaining light is lost)",
-            c.capped
+            "warning: {} of {} paths ({:.3} %) hit the collision cap of {} collisions and were cut \
+             (their remaining light is lost); --max-collisions sets the cap",
+            c.capped,
+            c.paths,
+            100.0 * c.capped as f64 / c.paths.max(1) as f64,
+            tracer::integrator::walk::collision_cap()
         );
     }
     if c.leaks > 0 {

@@ -18,7 +18,7 @@ use tracer::scene::Scene;
 use crate::checkpoint::Checkpoints;
 use crate::common::{
     check_image_memory, note_triangles, parse_method, parse_positive, parse_seconds,
-    warn_counters,
+    set_collision_cap, warn_counters,
 };
 use crate::interrupt;
 
@@ -61,6 +61,10 @@ pub struct Args {
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f64,
+    /// Most collisions of one path inside a medium before it is cut (and counted); bounds the
+    /// time a path can take in an optically huge medium (default 100,000,000).
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    max_collisions: Option<u64>,
     /// Write the image so far (EXR, PNG and JSON, the sidecar marked as a checkpoint) after
     /// each pass that ends at least this many seconds after the previous checkpoint.
     #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
@@ -113,6 +117,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (width, height) = scene.camera.resolution();
     check_image_memory(width, height, &args.scene)?;
     note_triangles(&scene);
+    set_collision_cap(args.max_collisions);
     interrupt::install()?;
     let rays_before = scene.geometry.rays_traced();
     let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {

@@ -9,7 +9,7 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{MINIMAL, Scratch, edit, listing};
+use common::{MINIMAL, Scratch, edit, gradient, listing, with_texture};
 
 /// A running `het-bssrdf`, killed if the test fails before waiting for it.
 struct Running(Option<Child>);
@@ -261,4 +261,70 @@ fn huge_images_are_refused_with_the_figure() {
         1,
         &["--resolution", "beam map", "of memory"],
     );
+}
+
+/// An optically huge medium: `--max-collisions` bounds each path, and the cut paths are
+/// reported (stderr and sidecar) with the cap.
+#[test]
+fn the_collision_cap_is_controlled_and_reported() {
+    let s = Scratch::new();
+    s.write(
+        "thick.toml",
+        edit(&edit(MINIMAL, "sigma_a = 0.1", "sigma_a = 0.0"), "sigma_s = 1.0", "sigma_s = 1000.0"),
+    );
+    let r = s.run(&[
+        "render", "thick.toml", "--method", "pt", "--max-collisions", "50", "--out", "t.exr",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("hit the collision cap of 50 collisions") && r.stderr.contains("--max-collisions"),
+        "{}",
+        r.stderr
+    );
+    let json = sidecar(&s.join("t.json"));
+    assert_eq!(json["max_collisions"], 50, "{json}");
+    assert!(json["counters"]["capped"].as_u64().unwrap() > 0, "{json}");
+}
+
+/// A PNG texture over the image decoder's memory limit: the error names the limit and the
+/// environment variable that raises it, and raising it lets the render run.
+#[test]
+fn a_png_over_the_decoder_limit_names_the_limit_and_the_override() {
+    let s = Scratch::new();
+    tracer::output::write_png(&gradient(1024, 1024), &s.join("big.png"), 0.0).unwrap();
+    s.write("tex.toml", with_texture("big.png"));
+    let run = |limit_mb: &str| {
+        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(["render", "tex.toml", "--method", "pt", "--out", "o.exr"])
+            .env("HET_BSSRDF_TEXTURE_LIMIT_MB", limit_mb)
+            .current_dir(s.path())
+            .output()
+            .unwrap()
+    };
+    let out = run("1");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for needle in ["big.png", "memory limit of 1 MiB", "HET_BSSRDF_TEXTURE_LIMIT_MB"] {
+        assert!(stderr.contains(needle), "`{needle}` missing: {stderr}");
+    }
+    let out = run("64");
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// A scene whose primitives become many triangles says how many.
+#[test]
+fn a_large_triangle_count_is_reported() {
+    let s = Scratch::new();
+    s.write(
+        "sphere.toml",
+        edit(
+            MINIMAL,
+            "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
+            "type = \"sphere\"\nmaterial = \"m\"\ncentre = [0.0, 0.0, 0.0]\nradius = 1.0\nsubdivisions = 8",
+        ),
+    );
+    let r = s.run(&["render", "sphere.toml", "--method", "pt", "--out", "s.exr"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    // 20 · 4⁸ = 1,310,720 triangles.
+    assert!(r.stderr.contains("1.3 million triangles"), "{}", r.stderr);
 }

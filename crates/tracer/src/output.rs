@@ -508,6 +508,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn unfinished_temporaries_are_removed_on_request_and_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        // A write in progress (staged, not committed), as when a second signal arrives.
+        let staged = Staged::write(&path, b"bytes").unwrap();
+        assert!(staged.tmp.exists());
+        assert!(remove_temporary_files() >= 1);
+        assert!(!staged.tmp.exists());
+        drop(staged);
+        // A set whose last file cannot be written leaves nothing, temporaries included.
+        let mut set = OutputSet::new();
+        set.add(&dir.path().join("b.json"), b"{}".to_vec());
+        set.add(&dir.path().join("missing/c.exr"), b"x".to_vec());
+        assert!(set.commit().is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
     fn srgb_round_trip_and_known_values() {
         // IEC 61966-2-1: 0.5 linear encodes to 0.7354; 0.0031308 is the knee.
         assert!((srgb_encode(0.5) - 0.735_356_983_052_449).abs() < 1e-9);

@@ -359,6 +359,76 @@ mod tests {
         assert_eq!(a.pixels, b.pixels);
     }
 
+    /// Records what the render loop reports, and stops it after `stop_after` passes.
+    struct Recorder {
+        stop_after: usize,
+        passes: std::sync::Mutex<Vec<(u32, Vec<Rgb>)>>,
+        advances: std::sync::atomic::AtomicU64,
+        calls: std::sync::atomic::AtomicU64,
+    }
+    impl RenderObserver<()> for Recorder {
+        fn advance(&self, n: u64) {
+            use std::sync::atomic::Ordering::Relaxed;
+            self.advances.fetch_add(n, Relaxed);
+            self.calls.fetch_add(1, Relaxed);
+        }
+        fn stop_requested(&self) -> bool {
+            self.passes.lock().unwrap().len() >= self.stop_after
+        }
+        fn pass_finished(&self, p: &Partial<'_, ()>) {
+            self.passes.lock().unwrap().push((p.spp, p.mean()));
+        }
+    }
+
+    #[test]
+    fn passes_progress_and_interrupts() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let rec = |stop_after| Recorder {
+            stop_after,
+            passes: Default::default(),
+            advances: Default::default(),
+            calls: Default::default(),
+        };
+        // Progress is reported pixel by pixel (a time estimate from the first samples), and
+        // every pixel sample is counted once.
+        let r = rec(usize::MAX);
+        let full = render_observed(13, 7, &Noise, &opts(Budget::Samples(9)), &r);
+        assert!(!full.interrupted);
+        assert_eq!(r.advances.load(Relaxed), 13 * 7 * 9);
+        let passes = r.passes.lock().unwrap().len() as u64;
+        assert_eq!(r.calls.load(Relaxed), 13 * 7 * passes);
+        // Every completed pass is the image of a single-pass render with its spp, computed
+        // here directly: each pixel's samples summed in increasing index.
+        let reference = |spp: u32| -> Vec<Rgb> {
+            let mut out = Vec::new();
+            for y in 0..7u32 {
+                for x in 0..13u32 {
+                    let mut sum = Rgb::ZERO;
+                    for s in 0..spp {
+                        let mut rng = Rng::for_pixel_sample(5, x, y, s);
+                        let fx = f64::from(x) + rng.uniform();
+                        let fy = f64::from(y) + rng.uniform();
+                        sum += Noise.sample(fx, fy, &mut rng, &mut ());
+                    }
+                    out.push(sum * (1.0 / f64::from(spp)));
+                }
+            }
+            out
+        };
+        assert!(passes > 1);
+        for (spp, mean) in r.passes.lock().unwrap().iter() {
+            assert_eq!(&reference(*spp), mean, "pass at {spp} spp");
+        }
+        assert_eq!(full.pixels, reference(9));
+        // Stopped after two passes: the completed ones are kept, marked as interrupted.
+        let r = rec(2);
+        let cut = render_observed(13, 7, &Noise, &opts(Budget::Samples(9)), &r);
+        assert!(cut.interrupted);
+        let (spp, mean) = r.passes.lock().unwrap()[1].clone();
+        assert_eq!((cut.spp, &cut.pixels), (spp, &mean));
+        assert!(cut.spp < 9);
+    }
+
     #[test]
     fn time_budget_equals_fixed_count_with_the_same_spp() {
         let t = render(8, 4, &Noise, &opts(Budget::Time(Duration::from_millis(30))));

@@ -275,6 +275,7 @@ pub fn write_render(
         "mean_rgb": outcome.film.mean().0,
         "interrupted": outcome.interrupted,
         "checkpoint": outcome.checkpoint,
+        "max_collisions": crate::integrator::walk::collision_cap(),
     });
     // Small files first, images last, renamed into place together or not at all.
     let mut set = OutputSet::new();
