@@ -185,7 +185,11 @@ fn many_objects(c: &mut Criterion) {
     let rays: Vec<Ray> = (0..RAYS)
         .map(|_| {
             let o = DVec3::new(0.0, 0.0, 30.0) + 5.0 * dir(&mut rng);
-            let target = DVec3::new(20.0 * rng.uniform() - 10.0, 20.0 * rng.uniform() - 10.0, 0.0);
+            let target = DVec3::new(
+                20.0 * rng.uniform() - 10.0,
+                20.0 * rng.uniform() - 10.0,
+                0.0,
+            );
             Ray::new(o, (target - o).normalize())
         })
         .collect();

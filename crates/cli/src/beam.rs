@@ -11,11 +11,11 @@ use bssrdf_core::{ProfileModel, Scattering};
 use tracer::experiment::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::interrupt;
 use crate::common::{
     check_writable, parse_method, parse_positive, parse_seconds, progress, set_collision_cap,
     warn_counters,
 };
+use crate::interrupt;
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]

@@ -21,7 +21,11 @@ pub struct Checkpoints<'a> {
 
 impl<'a> Checkpoints<'a> {
     /// Checkpoints every `every` (none when `None`) written by `write`.
-    pub fn new(progress: ProgressObserver, every: Option<Duration>, write: &'a WriteCheckpoint<'a>) -> Self {
+    pub fn new(
+        progress: ProgressObserver,
+        every: Option<Duration>,
+        write: &'a WriteCheckpoint<'a>,
+    ) -> Self {
         Self {
             progress,
             every,
@@ -50,7 +54,8 @@ impl RenderObserver<PathCounters> for Checkpoints<'_> {
             return;
         }
         if let Err(e) = (self.write)(partial) {
-            self.progress.suspend(|| eprintln!("warning: checkpoint not written: {e:#}"));
+            self.progress
+                .suspend(|| eprintln!("warning: checkpoint not written: {e:#}"));
         }
         *last = Instant::now();
     }

@@ -66,11 +66,21 @@ fn the_path_tracer_is_invariant_to_translation_up_to_1e6() {
     let s = Scratch::new();
     s.write("origin.toml", scene([0.0, 0.0, 0.0]));
     // Different seeds, so that the two renders are independent and their noise adds.
-    let r = s.run(&["render", "origin.toml", "--method", "pt", "--out", "origin.exr"]);
+    let r = s.run(&[
+        "render",
+        "origin.toml",
+        "--method",
+        "pt",
+        "--out",
+        "origin.exr",
+    ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     let (m0, se0) = mean_and_se(&s, "origin.exr");
     assert!(m0 > 0.01, "the sphere is black: {m0}");
-    for (k, o) in [[1e4, -2e4, 3e4], [1e5, 1e5, -1e5], [1e6, -1e6, 1e6]].iter().enumerate() {
+    for (k, o) in [[1e4, -2e4, 3e4], [1e5, 1e5, -1e5], [1e6, -1e6, 1e6]]
+        .iter()
+        .enumerate()
+    {
         let name = format!("far{k}");
         s.write(&format!("{name}.toml"), scene(*o));
         let r = s.run(&[

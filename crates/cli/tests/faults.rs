@@ -61,7 +61,10 @@ fn signal(child: &Running, signal: &str) {
 fn wait_for(what: &str, cond: impl Fn() -> bool) {
     let start = Instant::now();
     while !cond() {
-        assert!(start.elapsed() < Duration::from_secs(60), "timed out waiting for {what}");
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
 }
@@ -76,14 +79,23 @@ fn sidecar(path: &Path) -> serde_json::Value {
 fn assert_no_temporaries(dir: &Path) {
     let files = listing(dir);
     assert!(
-        !files.iter().any(|f| f.ends_with(".tmp") || f.contains(".het-bssrdf-probe")),
+        !files
+            .iter()
+            .any(|f| f.ends_with(".tmp") || f.contains(".het-bssrdf-probe")),
         "temporary files left: {files:?}"
     );
 }
 
 /// A render whose budget (10⁸ spp of 8 × 8 pixels) cannot finish during the test.
 const ENDLESS: &[&str] = &[
-    "render", "ok.toml", "--method", "pt", "--spp", "100000000", "--out", "out.exr",
+    "render",
+    "ok.toml",
+    "--method",
+    "pt",
+    "--spp",
+    "100000000",
+    "--out",
+    "out.exr",
 ];
 
 /// The first SIGINT or SIGTERM writes the completed passes, says so in the sidecar and exits
@@ -118,10 +130,7 @@ fn an_interrupt_writes_the_completed_passes() {
 fn checkpoints_are_written_and_change_no_pixel() {
     let s = Scratch::new();
     s.write("ok.toml", MINIMAL);
-    let child = spawn(
-        s.path(),
-        &[ENDLESS, &["--checkpoint", "0.2"]].concat(),
-    );
+    let child = spawn(s.path(), &[ENDLESS, &["--checkpoint", "0.2"]].concat());
     let json = s.join("out.json");
     wait_for("a checkpoint", || json.is_file());
     let first = sidecar(&json);
@@ -136,7 +145,13 @@ fn checkpoints_are_written_and_change_no_pixel() {
     let base = ["render", "ok.toml", "--method", "pt", "--spp", "300"];
     let r = s.run(&[&base[..], &["--out", "plain.exr"]].concat());
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    let r = s.run(&[&base[..], &["--out", "ckpt.exr", "--checkpoint", "0.000001"]].concat());
+    let r = s.run(
+        &[
+            &base[..],
+            &["--out", "ckpt.exr", "--checkpoint", "0.000001"],
+        ]
+        .concat(),
+    );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert_eq!(sidecar(&s.join("ckpt.json"))["checkpoint"], false);
     let a = tracer::output::read_exr(&s.join("plain.exr")).unwrap();
@@ -151,8 +166,15 @@ fn an_interrupted_beam_writes_its_photons() {
     let child = spawn(
         s.path(),
         &[
-            "beam", "--method", "pt", "--photons", "100000000000", "--resolution", "8",
-            "--out", "beam.exr",
+            "beam",
+            "--method",
+            "pt",
+            "--photons",
+            "100000000000",
+            "--resolution",
+            "8",
+            "--out",
+            "beam.exr",
         ],
     );
     std::thread::sleep(Duration::from_millis(1500));
@@ -197,9 +219,15 @@ fn a_fifo_output_is_refused_and_kept() {
     assert!(ok);
     let r = s.run(&["render", "ok.toml", "--method", "pt", "--out", "pipe.exr"]);
     assert_eq!(r.code, Some(1), "{}", r.stderr);
-    assert!(r.stderr.contains("pipe.exr") && r.stderr.contains("FIFO"), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("pipe.exr") && r.stderr.contains("FIFO"),
+        "{}",
+        r.stderr
+    );
     use std::os::unix::fs::FileTypeExt;
-    let ft = std::fs::symlink_metadata(s.join("pipe.exr")).unwrap().file_type();
+    let ft = std::fs::symlink_metadata(s.join("pipe.exr"))
+        .unwrap()
+        .file_type();
     assert!(ft.is_fifo(), "the FIFO was replaced");
     assert!(!s.join("pipe.png").exists() && !s.join("pipe.json").exists());
     assert_no_temporaries(s.path());
@@ -231,7 +259,15 @@ fn absurd_subsamples_are_refused() {
     let s = Scratch::new();
     for k in ["65536", "65537", "18446744073709551615"] {
         s.assert_rejected(
-            &["beam", "--resolution", "4", "--subsamples", k, "--out", "b.exr"],
+            &[
+                "beam",
+                "--resolution",
+                "4",
+                "--subsamples",
+                k,
+                "--out",
+                "b.exr",
+            ],
             1,
             &["--subsamples", "points per pixel"],
         );
@@ -252,7 +288,13 @@ fn huge_images_are_refused_with_the_figure() {
         s.assert_rejected(
             &["render", "big.toml", "--out", "big.exr"],
             1,
-            &["big.toml", "render.width", "render", "of memory", "available"],
+            &[
+                "big.toml",
+                "render.width",
+                "render",
+                "of memory",
+                "available",
+            ],
         );
         std::fs::remove_file(s.join("big.toml")).unwrap();
     }
@@ -270,14 +312,26 @@ fn the_collision_cap_is_controlled_and_reported() {
     let s = Scratch::new();
     s.write(
         "thick.toml",
-        edit(&edit(MINIMAL, "sigma_a = 0.1", "sigma_a = 0.0"), "sigma_s = 1.0", "sigma_s = 1000.0"),
+        edit(
+            &edit(MINIMAL, "sigma_a = 0.1", "sigma_a = 0.0"),
+            "sigma_s = 1.0",
+            "sigma_s = 1000.0",
+        ),
     );
     let r = s.run(&[
-        "render", "thick.toml", "--method", "pt", "--max-collisions", "50", "--out", "t.exr",
+        "render",
+        "thick.toml",
+        "--method",
+        "pt",
+        "--max-collisions",
+        "50",
+        "--out",
+        "t.exr",
     ]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(
-        r.stderr.contains("hit the collision cap of 50 collisions") && r.stderr.contains("--max-collisions"),
+        r.stderr.contains("hit the collision cap of 50 collisions")
+            && r.stderr.contains("--max-collisions"),
         "{}",
         r.stderr
     );
@@ -304,11 +358,20 @@ fn a_png_over_the_decoder_limit_names_the_limit_and_the_override() {
     let out = run("1");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    for needle in ["big.png", "memory limit of 1 MiB", "HET_BSSRDF_TEXTURE_LIMIT_MB"] {
+    for needle in [
+        "big.png",
+        "memory limit of 1 MiB",
+        "HET_BSSRDF_TEXTURE_LIMIT_MB",
+    ] {
         assert!(stderr.contains(needle), "`{needle}` missing: {stderr}");
     }
     let out = run("64");
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 /// A scene whose primitives become many triangles says how many.

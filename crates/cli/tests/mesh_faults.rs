@@ -81,7 +81,10 @@ fn render(dir: &Path) -> (Option<i32>, String) {
     loop {
         if child.try_wait().unwrap().is_some() {
             let out = child.wait_with_output().unwrap();
-            return (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned());
+            return (
+                out.status.code(),
+                String::from_utf8_lossy(&out.stderr).into_owned(),
+            );
         }
         if start.elapsed() > Duration::from_secs(30) {
             let _ = child.kill();
@@ -112,7 +115,12 @@ fn the_valid_fixture_renders() {
 #[test]
 fn node_cycles_are_reported_with_the_node() {
     // A node its own child, and 0 → 1 → 0.
-    let s = setup(&gltf(r#"[{"mesh": 0, "children": [0]}]"#, 12, 72, "tetra.bin"));
+    let s = setup(&gltf(
+        r#"[{"mesh": 0, "children": [0]}]"#,
+        12,
+        72,
+        "tetra.bin",
+    ));
     assert_refused(&s, &["node 0", "cycle"]);
     let s = setup(&gltf(
         r#"[{"mesh": 0, "children": [1]}, {"children": [0]}]"#,
@@ -148,9 +156,24 @@ fn obj_errors_name_the_file_line() {
     let s = Scratch::new();
     let cube_lines = CUBE_OBJ.lines().count();
     let cases = [
-        ("nan.obj", edit(CUBE_OBJ, "v 1 0 0\n", "v 1 nan 0\n"), 3, "non-finite"),
-        ("range.obj", format!("{CUBE_OBJ}f 1 2 99\n"), cube_lines + 1, "vertex 99"),
-        ("flat.obj", format!("{CUBE_OBJ}f 1 2 2\nf 1 2 3\n"), cube_lines + 1, "degenerate"),
+        (
+            "nan.obj",
+            edit(CUBE_OBJ, "v 1 0 0\n", "v 1 nan 0\n"),
+            3,
+            "non-finite",
+        ),
+        (
+            "range.obj",
+            format!("{CUBE_OBJ}f 1 2 99\n"),
+            cube_lines + 1,
+            "vertex 99",
+        ),
+        (
+            "flat.obj",
+            format!("{CUBE_OBJ}f 1 2 2\nf 1 2 3\n"),
+            cube_lines + 1,
+            "degenerate",
+        ),
     ];
     for (name, text, line, what) in cases {
         s.write(name, text);

@@ -269,7 +269,12 @@ pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Size
             seconds: start.elapsed().as_secs_f64(),
             counters: &counters,
         });
-        pass = next_pass(options.budget, done, per_sample, start.elapsed().as_secs_f64());
+        pass = next_pass(
+            options.budget,
+            done,
+            per_sample,
+            start.elapsed().as_secs_f64(),
+        );
     }
     let inv = 1.0 / f64::from(done.max(1));
     Rendered {
@@ -288,7 +293,9 @@ pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Size
 /// when the next pass is predicted to overshoot it.
 fn next_pass(budget: Budget, done: u32, per_sample: f64, elapsed: f64) -> u32 {
     let by_time = if per_sample > 0.0 {
-        (PASS_SECONDS / per_sample).floor().clamp(1.0, f64::from(u32::MAX)) as u32
+        (PASS_SECONDS / per_sample)
+            .floor()
+            .clamp(1.0, f64::from(u32::MAX)) as u32
     } else {
         u32::MAX
     };

@@ -45,6 +45,19 @@ const BOX_PAD_REL: f32 = 1.0 / 65536.0;
 /// origin (magnitude < 16 × extent) the extent pad is the larger and nothing changes.
 const BOX_PAD_COORD_ULPS: f64 = 8.0;
 
+/// The padding of an object's world bounds in the conservative box tests (the top-level tree's
+/// leaves): 1e-6 of its extent.
+fn box_pad(lo: DVec3, hi: DVec3) -> DVec3 {
+    let extent = (hi - lo).max_element();
+    DVec3::splat(
+        if extent.is_finite() {
+            1e-6 * extent
+        } else {
+            0.0
+        } + 1e-30,
+    )
+}
+
 /// A triangle's padded bounding box, what the BVH is built on.
 struct PaddedBox(Aabb);
 
@@ -73,6 +86,9 @@ struct ObjectAccel {
     /// World-space bounds.
     lo: DVec3,
     hi: DVec3,
+    /// The bounds padded for the conservative box tests.
+    plo: DVec3,
+    phi: DVec3,
 }
 
 /// Scene geometry: triangle meshes (object id = index) with their BVHs, and the ray queries.
@@ -199,15 +215,15 @@ impl ObjectAccel {
                 inv_scale: 1.0 / scale,
                 lo,
                 hi,
+                plo: lo - box_pad(lo, hi),
+                phi: hi + box_pad(lo, hi),
             };
         }
         let scaled: Vec<[Vec3A; 3]> = mesh
             .triangles
             .iter()
             .map(|t| {
-                t.map(|k| {
-                    Vec3A::from(((mesh.positions[k as usize] - centre) * scale).as_vec3())
-                })
+                t.map(|k| Vec3A::from(((mesh.positions[k as usize] - centre) * scale).as_vec3()))
             })
             .collect();
         // 128 ulps of the extent, but never less than 8 ulps of the largest coordinate: far
@@ -243,6 +259,8 @@ impl ObjectAccel {
             inv_scale: 1.0 / scale,
             lo,
             hi,
+            plo: lo - box_pad(lo, hi),
+            phi: hi + box_pad(lo, hi),
         }
     }
 
@@ -250,8 +268,7 @@ impl ObjectAccel {
     /// `shift` (the returned distances are relative to it): a ray that starts far from the
     /// object (a camera ray) keeps the precision of one that starts near it.
     #[inline]
-    fn scaled_ray(&self, ray: &Ray, t_min: f64, t_max: f64) -> (ScaledRay, f64) {
-        let shift = self.origin_shift(ray);
+    fn scaled_ray(&self, ray: &Ray, t_min: f64, t_max: f64, shift: f64) -> ScaledRay {
         let o = ((ray.origin + shift * ray.dir - self.centre) * self.scale).as_vec3();
         let d = ray.dir.as_vec3();
         let bvh = BvhRay {
@@ -261,11 +278,17 @@ impl ObjectAccel {
             tmin: ((t_min - shift).max(0.0) * self.scale) as f32,
             tmax: ((t_max - shift) * self.scale).min(f64::from(f32::MAX)) as f32,
         };
-        let r = ScaledRay {
+        ScaledRay {
             bvh,
             sheared: ShearedRay::new(o.to_array(), d.to_array()),
-        };
-        (r, shift)
+        }
+    }
+
+    /// [`ObjectAccel::origin_shift`] when the ray is known to enter the padded bounds at
+    /// `enter`: one extent before it.
+    #[inline]
+    fn shift_from_entry(&self, enter: f64) -> f64 {
+        (enter - (self.hi - self.lo).max_element()).max(0.0)
     }
 
     /// How far along the ray its origin can move toward the object before the `f32` tests:
@@ -275,42 +298,32 @@ impl ObjectAccel {
     fn origin_shift(&self, ray: &Ray) -> f64 {
         let extent = (self.hi - self.lo).max_element();
         let far = (ray.origin - self.centre).abs().max_element();
-        if !(far > 4.0 * extent) {
+        if far.is_nan() || far <= 4.0 * extent {
             return 0.0;
         }
         let pad = extent + 1e-30;
-        match slab(
+        slab(
             self.lo - pad,
             self.hi + pad,
             ray.origin,
             DVec3::ONE / ray.dir,
             0.0,
             f64::INFINITY,
-        ) {
-            Some(enter) => enter,
-            None => 0.0,
-        }
+        )
+        .unwrap_or(0.0)
     }
 
     /// The world bounds padded for the conservative box tests.
     #[inline]
     fn padded_bounds(&self) -> (DVec3, DVec3) {
-        let pad = 1e-6 * (self.hi - self.lo).max_element() + 1e-30;
-        (self.lo - pad, self.hi + pad)
-    }
-
-    /// Slab test of the world bounds against `[t_min, t_max]` (conservative: padded).
-    #[inline]
-    fn may_hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> bool {
-        let (lo, hi) = self.padded_bounds();
-        slab(lo, hi, ray.origin, DVec3::ONE / ray.dir, t_min, t_max).is_some()
+        (self.plo, self.phi)
     }
 
     /// Closest hit in `[t_min, t_max]` (world units): `(leaf, t_world)`.
     #[inline]
-    fn closest(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(u32, f64)> {
+    fn closest(&self, ray: &Ray, t_min: f64, t_max: f64, shift: f64) -> Option<(u32, f64)> {
         let bvh = self.bvh.as_ref()?;
-        let (r, shift) = self.scaled_ray(ray, t_min, t_max);
+        let r = self.scaled_ray(ray, t_min, t_max, shift);
         let mut hit = RayHit::none();
         let tris = &self.tris;
         let sheared = r.sheared;
@@ -327,11 +340,11 @@ impl ObjectAccel {
     }
 
     #[inline]
-    fn any(&self, ray: &Ray) -> bool {
+    fn any(&self, ray: &Ray, shift: f64) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
-        let (r, _) = self.scaled_ray(ray, ray.t_min, ray.t_max);
+        let r = self.scaled_ray(ray, ray.t_min, ray.t_max, shift);
         let tris = &self.tris;
         let sheared = r.sheared;
         !bvh.ray_traverse_miss(r.bvh, |br, id| {
@@ -404,20 +417,22 @@ impl Geometry {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.counter.add(1);
         let mut best: Option<(u32, u32, f64)> = None;
-        self.tlas
-            .traverse(ray.origin, ray.dir, ray.t_min, ray.t_max, |k, t_max| {
+        self.tlas.traverse(
+            ray.origin,
+            ray.dir,
+            ray.t_min,
+            ray.t_max,
+            |k, enter, t_max| {
                 let obj = &self.objects[k as usize];
-                if !obj.may_hit(ray, ray.t_min, t_max) {
-                    return Some(t_max);
-                }
-                match obj.closest(ray, ray.t_min, t_max) {
+                match obj.closest(ray, ray.t_min, t_max, obj.shift_from_entry(enter)) {
                     Some((leaf, t)) => {
                         best = Some((k, leaf, t));
                         Some(t)
                     }
                     None => Some(t_max),
                 }
-            });
+            },
+        );
         best.map(|(k, leaf, t)| self.make_hit(k, leaf, ray, t))
     }
 
@@ -426,7 +441,7 @@ impl Geometry {
     pub fn intersect_object(&self, object: u32, ray: &Ray) -> Option<Hit> {
         self.counter.add(1);
         let obj = &self.objects[object as usize];
-        obj.closest(ray, ray.t_min, ray.t_max)
+        obj.closest(ray, ray.t_min, ray.t_max, obj.origin_shift(ray))
             .map(|(leaf, t)| self.make_hit(object, leaf, ray, t))
     }
 
@@ -436,16 +451,21 @@ impl Geometry {
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.counter.add(1);
         let mut hit = false;
-        self.tlas
-            .traverse(ray.origin, ray.dir, ray.t_min, ray.t_max, |k, t_max| {
+        self.tlas.traverse(
+            ray.origin,
+            ray.dir,
+            ray.t_min,
+            ray.t_max,
+            |k, enter, t_max| {
                 let obj = &self.objects[k as usize];
-                if obj.may_hit(ray, ray.t_min, ray.t_max) && obj.any(ray) {
+                if obj.any(ray, obj.shift_from_entry(enter)) {
                     hit = true;
                     None
                 } else {
                     Some(t_max)
                 }
-            });
+            },
+        );
         hit
     }
 
@@ -459,7 +479,8 @@ impl Geometry {
         let Some(bvh) = obj.bvh.as_ref() else {
             return;
         };
-        let (r, shift) = obj.scaled_ray(ray, ray.t_min, ray.t_max);
+        let shift = obj.origin_shift(ray);
+        let r = obj.scaled_ray(ray, ray.t_min, ray.t_max, shift);
         let mut buf = CrossingBuf::new();
         let tris = &obj.tris;
         let sheared = r.sheared;

@@ -232,12 +232,7 @@ fn add_mesh(
         let uvs: Option<Vec<Vec2>> = rd
             .read_tex_coords(0)
             .map(|tc| tc.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
-        check_count(
-            prim.get(&gltf::Semantic::Positions),
-            n,
-            "positions",
-            err,
-        )?;
+        check_count(prim.get(&gltf::Semantic::Positions), n, "positions", err)?;
         let idx: Vec<u32> = match rd.read_indices() {
             Some(i) => i.into_u32().collect(),
             None => (0..n as u32).collect(),

@@ -13,13 +13,15 @@ use crate::error::MeshError;
 /// validated here: call [`TriangleMesh::prepare`].
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
     let file = path.display().to_string();
-    let (models, _materials) =
-        tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| {
-            located(path, MeshError::Load {
+    let (models, _materials) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| {
+        located(
+            path,
+            MeshError::Load {
                 file: file.clone(),
                 message: e.to_string(),
-            })
-        })?;
+            },
+        )
+    })?;
     let mut mesh = TriangleMesh::default();
     for m in &models {
         let m = &m.mesh;

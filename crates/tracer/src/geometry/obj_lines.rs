@@ -24,7 +24,10 @@ pub(crate) fn first_problem(text: &str) -> Option<(usize, String)> {
                     Err(_) => return Some((line, format!("`{tag}` has an unreadable number"))),
                 };
                 if values.len() < need {
-                    return Some((line, format!("`{tag}` needs {need} numbers, got {}", values.len())));
+                    return Some((
+                        line,
+                        format!("`{tag}` needs {need} numbers, got {}", values.len()),
+                    ));
                 }
                 if let Some(v) = values.iter().find(|v| !v.is_finite()) {
                     return Some((line, format!("`{tag}` has a non-finite value {v}")));
@@ -54,7 +57,9 @@ pub(crate) fn first_problem(text: &str) -> Option<(usize, String)> {
                             let what = ["vertex", "texture coordinate", "normal"][slot];
                             return Some((
                                 line,
-                                format!("face refers to {what} {i}, but only {count} are defined above it"),
+                                format!(
+                                    "face refers to {what} {i}, but only {count} are defined above it"
+                                ),
                             ));
                         }
                         if slot == 0 {
@@ -63,12 +68,18 @@ pub(crate) fn first_problem(text: &str) -> Option<(usize, String)> {
                     }
                 }
                 if corners.len() < 3 {
-                    return Some((line, format!("a face needs 3 vertices, got {}", corners.len())));
+                    return Some((
+                        line,
+                        format!("a face needs 3 vertices, got {}", corners.len()),
+                    ));
                 }
                 for i in 1..corners.len() - 1 {
                     let (a, b, c) = (corners[0], corners[i], corners[i + 1]);
                     if (b - a).cross(c - a) == DVec3::ZERO {
-                        return Some((line, "face is degenerate: a triangle of it has zero area".into()));
+                        return Some((
+                            line,
+                            "face is degenerate: a triangle of it has zero area".into(),
+                        ));
                     }
                 }
             }

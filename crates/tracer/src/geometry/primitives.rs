@@ -98,10 +98,7 @@ pub fn half_space(
 pub fn icosphere(centre: DVec3, radius: f64, subdivisions: u32) -> TriangleMesh {
     let (dirs, triangles) = unit_icosphere(subdivisions);
     TriangleMesh {
-        positions: dirs
-            .iter()
-            .map(|d| centre + radius * *d)
-            .collect(),
+        positions: dirs.iter().map(|d| centre + radius * *d).collect(),
         normals: Some(dirs.iter().map(|d| d.as_vec3()).collect()),
         uvs: None,
         triangles,

@@ -9,8 +9,9 @@
 
 use glam::DVec3;
 
-/// Objects per leaf.
-const LEAF_OBJECTS: usize = 2;
+/// Objects per leaf: one, so that a leaf's box is its object's and the object needs no box
+/// test of its own.
+const LEAF_OBJECTS: usize = 1;
 
 #[derive(Debug, Clone, Copy)]
 struct Node {
@@ -106,8 +107,9 @@ impl Tlas {
     }
 
     /// Visits, nearest box first, every object whose box the ray enters within
-    /// `[t_min, t_max]`, where `visit(object, t_max)` returns the (possibly shrunk) `t_max`, or
-    /// `None` to stop the traversal.
+    /// `[t_min, t_max]`, where `visit(object, t_enter, t_max)` (`t_enter`: where the ray enters
+    /// the object's box) returns the (possibly shrunk) `t_max`, or `None` to stop the
+    /// traversal.
     #[inline]
     pub fn traverse(
         &self,
@@ -115,30 +117,31 @@ impl Tlas {
         dir: DVec3,
         t_min: f64,
         mut t_max: f64,
-        mut visit: impl FnMut(u32, f64) -> Option<f64>,
+        mut visit: impl FnMut(u32, f64, f64) -> Option<f64>,
     ) {
         if self.nodes.is_empty() {
             return;
         }
         let inv = DVec3::ONE / dir;
-        let mut stack = [0u32; 64];
-        let mut top = 0;
+        // Nodes to visit with their entry distances; each box is tested once, when pushed.
+        let mut stack = [(0u32, 0f64); 64];
         let root = &self.nodes[0];
-        if slab(root.lo, root.hi, origin, inv, t_min, t_max).is_none() {
+        let Some(enter) = slab(root.lo, root.hi, origin, inv, t_min, t_max) else {
             return;
-        }
-        stack[0] = 0;
-        top += 1;
+        };
+        stack[0] = (0, enter);
+        let mut top = 1;
         while top > 0 {
             top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if slab(node.lo, node.hi, origin, inv, t_min, t_max).is_none() {
+            let (index, enter) = stack[top];
+            if enter > t_max {
                 continue;
             }
+            let node = &self.nodes[index as usize];
             if node.count > 0 {
                 let first = node.first as usize;
                 for &o in &self.order[first..first + node.count as usize] {
-                    match visit(o, t_max) {
+                    match visit(o, enter, t_max) {
                         Some(t) => t_max = t,
                         None => return,
                     }
@@ -146,16 +149,32 @@ impl Tlas {
                 continue;
             }
             let (a, b) = (node.first as usize, node.first as usize + 1);
-            let ta = slab(self.nodes[a].lo, self.nodes[a].hi, origin, inv, t_min, t_max);
-            let tb = slab(self.nodes[b].lo, self.nodes[b].hi, origin, inv, t_min, t_max);
+            let ta = slab(
+                self.nodes[a].lo,
+                self.nodes[a].hi,
+                origin,
+                inv,
+                t_min,
+                t_max,
+            );
+            let tb = slab(
+                self.nodes[b].lo,
+                self.nodes[b].hi,
+                origin,
+                inv,
+                t_min,
+                t_max,
+            );
             // Push the farther child first so that the nearer one is visited first.
             let (near, far) = match (ta, tb) {
                 (Some(x), Some(y)) if y < x => ((b, Some(y)), (a, Some(x))),
                 _ => ((a, ta), (b, tb)),
             };
             for (child, t) in [far, near] {
-                if t.is_some() && top < stack.len() {
-                    stack[top] = child as u32;
+                if let Some(t) = t
+                    && top < stack.len()
+                {
+                    stack[top] = (child as u32, t);
                     top += 1;
                 }
             }

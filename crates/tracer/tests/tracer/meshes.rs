@@ -258,16 +258,7 @@ fn transforms_scale_rotate_translate_in_that_order() {
         translation: DVec3::new(0.0, 0.0, 10.0),
     });
     // (1,0,0) → scale (2,0,0) → rotate 90° about z (0,2,0) → translate (0,2,10).
-    assert!(
-        m.positions[0]
-            .abs_diff_eq(DVec3::new(0.0, 2.0, 10.0), 1e-6)
-    );
-    assert!(
-        m.positions[1]
-            .abs_diff_eq(DVec3::new(-3.0, 0.0, 10.0), 1e-6)
-    );
-    assert!(
-        m.positions[2]
-            .abs_diff_eq(DVec3::new(0.0, 0.0, 14.0), 1e-6)
-    );
+    assert!(m.positions[0].abs_diff_eq(DVec3::new(0.0, 2.0, 10.0), 1e-6));
+    assert!(m.positions[1].abs_diff_eq(DVec3::new(-3.0, 0.0, 10.0), 1e-6));
+    assert!(m.positions[2].abs_diff_eq(DVec3::new(0.0, 0.0, 14.0), 1e-6));
 }
