@@ -54,10 +54,11 @@ pub fn progress(len: u64, prefix: &str, unit: &str) -> ProgressBar {
     bar
 }
 
-/// Fails early, before a long run, if `path` (the `--out` value or its default) cannot be
-/// written. The library error names the path; the context names the flag.
+/// Fails early, before a long run, if `path` (the `--out` value or its default) or the PNG and
+/// JSON written beside it cannot be written. The library error names the path; the context
+/// names the flag.
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    tracer::experiment::run::check_output_path(path).context("invalid --out")
+    tracer::experiment::run::check_render_outputs(path).context("invalid --out")
 }
 
 /// One line per rare event that happened, so that no cap or fallback is silent.

@@ -7,8 +7,7 @@ use std::time::Duration;
 use anyhow::{Context, bail};
 use bssrdf_core::{ProfileModel, Scattering};
 use tracer::experiment::run::{
-    RenderJob, RenderOutcome, check_render_outputs, render_scene_observed, sidecar_paths,
-    write_render,
+    RenderJob, RenderOutcome, render_scene_observed, sidecar_paths, write_render,
 };
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters};
@@ -17,8 +16,8 @@ use tracer::scene::Scene;
 
 use crate::checkpoint::Checkpoints;
 use crate::common::{
-    check_image_memory, note_triangles, parse_method, parse_positive, parse_seconds,
-    set_collision_cap, warn_counters,
+    check_image_memory, check_writable, note_triangles, parse_method, parse_positive,
+    parse_seconds, set_collision_cap, warn_counters,
 };
 use crate::interrupt;
 
@@ -113,7 +112,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}.exr", method.name())));
-    check_render_outputs(&out).context("invalid --out")?;
+    check_writable(&out)?;
     let (width, height) = scene.camera.resolution();
     check_image_memory(width, height, &args.scene)?;
     note_triangles(&scene);

@@ -38,10 +38,13 @@ pub fn remove_temporary_files() -> usize {
     n
 }
 
-/// What kind of filesystem object a non-regular, non-directory file is, in words.
-fn kind_of(ft: &fs::FileType) -> &'static str {
+/// What kind of filesystem object something that is not a regular file is, in words
+/// (`"directory"`, `"character device"`, `"FIFO"`…).
+pub fn file_kind(ft: &fs::FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;
-    if ft.is_char_device() {
+    if ft.is_dir() {
+        "directory"
+    } else if ft.is_char_device() {
         "character device"
     } else if ft.is_block_device() {
         "block device"
@@ -89,7 +92,7 @@ pub fn resolve_output(path: &Path) -> Result<PathBuf, OutputError> {
             Ok(m) if !m.is_file() => {
                 return Err(OutputError::NotRegular {
                     path: path.to_path_buf(),
-                    kind: kind_of(&m.file_type()),
+                    kind: file_kind(&m.file_type()),
                 });
             }
             Ok(_) => {}

@@ -110,9 +110,9 @@ fn check_buffer_uris(
         match std::fs::metadata(&file) {
             Ok(m) if !m.is_file() => {
                 return Err(err(format!(
-                    "buffer {} uri `{uri}` names {}, not a regular file",
+                    "buffer {} uri `{uri}` names a {}, not a regular file",
                     buffer.index(),
-                    file_kind(&m.file_type())
+                    crate::output::file_kind(&m.file_type())
                 )));
             }
             _ => {} // missing files are reported by the importer
@@ -140,22 +140,6 @@ fn percent_decode(uri: &str) -> String {
         }
     }
     String::from_utf8_lossy(&out).into_owned()
-}
-
-/// A file type in words.
-fn file_kind(ft: &std::fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
-    if ft.is_dir() {
-        "a directory"
-    } else if ft.is_char_device() || ft.is_block_device() {
-        "a device"
-    } else if ft.is_fifo() {
-        "a FIFO"
-    } else if ft.is_socket() {
-        "a socket"
-    } else {
-        "a special file"
-    }
 }
 
 /// Every buffer must hold exactly its declared `byteLength` (the importer pads the data to a
