@@ -391,3 +391,22 @@ fn a_large_triangle_count_is_reported() {
     // 20 · 4⁸ = 1,310,720 triangles.
     assert!(r.stderr.contains("1.3 million triangles"), "{}", r.stderr);
 }
+
+/// Primitives whose triangles would not fit in memory are refused, with the figure, before
+/// they are generated (4,000 spheres of 5,242,880 triangles: 2 × 10¹⁰ triangles).
+#[test]
+fn huge_tessellations_are_refused_with_the_figure() {
+    let s = Scratch::new();
+    let sphere = "[[shape]]\ntype = \"sphere\"\nmaterial = \"m\"\ncentre = [0.0, 0.0, -5.0]\nradius = 1.0\nsubdivisions = 9\n";
+    s.write("many.toml", format!("{MINIMAL}\n{}", sphere.repeat(4000)));
+    s.assert_rejected(
+        &["render", "many.toml", "--out", "m.exr"],
+        1,
+        &[
+            "many.toml",
+            "subdivisions",
+            "million triangles",
+            "of memory",
+        ],
+    );
+}
