@@ -412,11 +412,15 @@ impl Geometry {
         self.counter.total()
     }
 
-    /// The closest intersection over all objects in `[ray.t_min, ray.t_max]`.
+    /// Walks the top-level tree for `ray`, nearest object box first, calling
+    /// `visit(object, its structure, origin shift, t_max)`, which returns the new `t_max` or
+    /// `None` to stop.
     #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        self.counter.add(1);
-        let mut best: Option<(u32, u32, f64)> = None;
+    fn visit_objects(
+        &self,
+        ray: &Ray,
+        mut visit: impl FnMut(u32, &ObjectAccel, f64, f64) -> Option<f64>,
+    ) {
         self.tlas.traverse(
             ray.origin,
             ray.dir,
@@ -424,15 +428,25 @@ impl Geometry {
             ray.t_max,
             |k, enter, t_max| {
                 let obj = &self.objects[k as usize];
-                match obj.closest(ray, ray.t_min, t_max, obj.shift_from_entry(enter)) {
-                    Some((leaf, t)) => {
-                        best = Some((k, leaf, t));
-                        Some(t)
-                    }
-                    None => Some(t_max),
-                }
+                visit(k, obj, obj.shift_from_entry(enter), t_max)
             },
         );
+    }
+
+    /// The closest intersection over all objects in `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.counter.add(1);
+        let mut best: Option<(u32, u32, f64)> = None;
+        self.visit_objects(ray, |k, obj, shift, t_max| {
+            match obj.closest(ray, ray.t_min, t_max, shift) {
+                Some((leaf, t)) => {
+                    best = Some((k, leaf, t));
+                    Some(t)
+                }
+                None => Some(t_max),
+            }
+        });
         best.map(|(k, leaf, t)| self.make_hit(k, leaf, ray, t))
     }
 
@@ -451,21 +465,14 @@ impl Geometry {
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.counter.add(1);
         let mut hit = false;
-        self.tlas.traverse(
-            ray.origin,
-            ray.dir,
-            ray.t_min,
-            ray.t_max,
-            |k, enter, t_max| {
-                let obj = &self.objects[k as usize];
-                if obj.any(ray, obj.shift_from_entry(enter)) {
-                    hit = true;
-                    None
-                } else {
-                    Some(t_max)
-                }
-            },
-        );
+        self.visit_objects(ray, |_, obj, shift, t_max| {
+            if obj.any(ray, shift) {
+                hit = true;
+                None
+            } else {
+                Some(t_max)
+            }
+        });
         hit
     }
 
