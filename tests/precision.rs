@@ -530,12 +530,12 @@ fn closed_meshes() -> Vec<(String, TriangleMesh)> {
 
 /// Every vertex and every edge midpoint of a mesh (f64, from the f32 vertices).
 fn edge_points(mesh: &TriangleMesh) -> Vec<DVec3> {
-    let mut pts: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
+    let mut pts: Vec<DVec3> = mesh.positions.clone();
     for t in &mesh.triangles {
         for e in 0..3 {
             let (a, b) = (t[e] as usize, t[(e + 1) % 3] as usize);
             if a < b {
-                pts.push(0.5 * (mesh.positions[a].as_dvec3() + mesh.positions[b].as_dvec3()));
+                pts.push(0.5 * (mesh.positions[a] + mesh.positions[b]));
             }
         }
     }

@@ -11,8 +11,11 @@ use bssrdf_core::{ProfileModel, Scattering};
 use experiments::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, write_beam_map};
 use tracer::integrator::Method;
 
-use crate::common::{check_writable, parse_exr_out, parse_positive, parse_seconds, warn_counters};
+use crate::common::{
+    check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
+};
 use crate::flags::{Given, check_method_flags};
+use crate::interrupt;
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -178,6 +181,10 @@ pub struct Args {
     /// Output EXR (default `beam-<texture>-<method>.exr`); PNG and JSON are written beside it.
     #[arg(short, long, value_parser = parse_exr_out)]
     out: Option<PathBuf>,
+    /// Most collisions of one photon before it is cut (and counted), for `--method pt`
+    /// (default 100,000,000).
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    max_collisions: Option<u64>,
 }
 
 /// Runs one method with a progress bar on stderr.
@@ -211,6 +218,25 @@ pub fn run_method(
     Ok(map)
 }
 
+/// Most `--subsamples` K: K × K = 1,048,576 points per pixel.
+const MAX_SUBSAMPLES: u64 = 1024;
+
+/// Checks `--subsamples K` (K × K points per pixel, computed in 64 bits).
+fn check_subsamples(k: u64) -> anyhow::Result<u32> {
+    if k > MAX_SUBSAMPLES {
+        bail!(
+            "--subsamples {k} means {} points per pixel; at most {MAX_SUBSAMPLES} ({} points) are allowed",
+            u128::from(k) * u128::from(k),
+            MAX_SUBSAMPLES * MAX_SUBSAMPLES
+        );
+    }
+    Ok(u32::try_from(k).expect("at most MAX_SUBSAMPLES"))
+}
+
+/// Bytes per pixel of a beam map: the photon counts, the values and their standard errors
+/// (8 bytes each), a batch's counts per thread, and the EXR and PNG buffers.
+const BEAM_BYTES_PER_PIXEL: f64 = 8.0 * 3.0 + 4.0 * 16.0 + 8.0 + 6.0;
+
 /// Runs the subcommand.
 pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     check_method_flags(
@@ -233,7 +259,15 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         (Some(n), None) => PhotonBudget::Count(n),
         (None, None) => PhotonBudget::Count(1 << 20),
     };
-    let sub = u32::try_from(args.subsamples).context("--subsamples is too large")?;
+    let sub = check_subsamples(args.subsamples)?;
+    let n = f64::from(setup.resolution);
+    tracer::memory::check(
+        || format!("a {0}x{0} beam map", setup.resolution),
+        n * n * BEAM_BYTES_PER_PIXEL,
+    )
+    .context("--resolution")?;
+    set_collision_cap(args.max_collisions);
+    interrupt::install()?;
     let map = run_method(
         &setup,
         args.method.with_estimator_samples(
@@ -246,7 +280,29 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.seed,
         true,
     )?;
-    write_beam_map(&map, &setup, &out, serde_json::json!({"seed": args.seed}))?;
+    let interrupted = interrupt::received().map(interrupt::name);
+    if let Some(signal) = interrupted
+        && map.samples == 0
+    {
+        bail!("{signal} before the first batch completed; nothing written");
+    }
+    write_beam_map(
+        &map,
+        &setup,
+        &out,
+        serde_json::json!({
+            "seed": args.seed,
+            "interrupted": interrupted.is_some(),
+            "max_collisions": tracer::integrator::walk::collision_cap(),
+        }),
+    )?;
+    if let Some(signal) = interrupted {
+        bail!(
+            "{signal}: wrote the {} samples completed to {} (the sidecar says \"interrupted\": true)",
+            map.samples,
+            out.display()
+        );
+    }
     eprintln!(
         "{}: {} samples in {:.2} s; wrote {}",
         map.method,

@@ -19,6 +19,13 @@ pub fn parse_seconds(s: &str) -> Result<Duration, String> {
     Ok(Duration::from_secs_f64(v))
 }
 
+/// Applies `--max-collisions`, if given (see [`tracer::integrator::walk::set_collision_cap`]).
+pub fn set_collision_cap(cap: Option<u64>) {
+    if let Some(cap) = cap {
+        tracer::integrator::walk::set_collision_cap(cap);
+    }
+}
+
 /// Parses a positive integer.
 pub fn parse_positive(s: &str) -> Result<u64, String> {
     match s.parse::<u64>() {
@@ -41,18 +48,23 @@ pub fn parse_exr_out(s: &str) -> Result<PathBuf, String> {
     }
 }
 
-/// Fails early, before a long run, if `path` (the `--out` value or its default) cannot be
-/// written. The library error names the path; the context names the flag.
+/// Fails early, before a long run, if `path` (the `--out` value or its default) or the PNG and
+/// JSON written beside it cannot be written. The library error names the path; the context
+/// names the flag.
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    experiments::run::check_output_path(path).context("invalid --out")
+    experiments::run::check_render_outputs(path).context("invalid --out")
 }
 
 /// One line per rare event that happened, so that no cap or fallback is silent.
 pub fn warn_counters(c: &PathCounters) {
     if c.capped > 0 {
         eprintln!(
-            "warning: {} paths hit the collision cap (their remaining light is lost)",
-            c.capped
+            "warning: {} of {} paths ({:.3} %) hit the collision cap of {} collisions and were cut \
+             (their remaining light is lost); --max-collisions sets the cap",
+            c.capped,
+            c.paths,
+            100.0 * c.capped as f64 / c.paths.max(1) as f64,
+            tracer::integrator::walk::collision_cap()
         );
     }
     if c.leaks > 0 {
@@ -71,6 +83,29 @@ pub fn warn_counters(c: &PathCounters) {
         eprintln!(
             "note: {} estimates fell back to the endpoint average (every projection missed)",
             c.estimator_fallbacks
+        );
+    }
+}
+
+/// Refuses, before anything is allocated, a render of the scene's `width × height` that would
+/// not fit in memory; the error names the scene's keys and the figure.
+pub fn check_image_memory(width: u32, height: u32, scene: &Path) -> anyhow::Result<()> {
+    tracer::memory::check_render(width, height)
+        .with_context(|| format!("{}: render.width, render.height", scene.display()))
+}
+
+/// Triangle count above which a render says how many triangles its shapes became.
+const MANY_TRIANGLES: usize = 1_000_000;
+
+/// Says how many triangles the scene's shapes became when that is many (spheres and other
+/// primitives are tessellated), so that a slow build or a large memory use is explained.
+pub fn note_triangles(scene: &tracer::scene::Scene) {
+    let n = scene.geometry.triangle_count();
+    if n >= MANY_TRIANGLES {
+        eprintln!(
+            "note: the scene's {} objects are {:.1} million triangles",
+            scene.geometry.object_count(),
+            n as f64 / 1e6
         );
     }
 }

@@ -2,17 +2,20 @@
 //! crates, prints results, maps errors to exit codes.
 //!
 //! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
-//! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap).
+//! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap);
+//! 130 or 143 when `render` or `beam` was interrupted by SIGINT or SIGTERM (see `interrupt`).
 //!
 //! Numeric flags accept values starting with `-`, so that `--photons -5` is reported as an
 //! invalid value of `--photons` rather than as an unknown argument `-5`.
 
 mod beam;
+mod checkpoint;
 mod choices;
 mod common;
 mod compare;
 mod converge;
 mod flags;
+mod interrupt;
 mod profile;
 mod render;
 mod reproduce;
@@ -110,7 +113,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {}", message(&err));
-            ExitCode::from(1)
+            ExitCode::from(interrupt::exit_status().unwrap_or(1))
         }
     }
 }

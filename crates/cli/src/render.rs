@@ -4,16 +4,24 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use bssrdf_core::{ProfileModel, Scattering};
-use experiments::run::{RenderJob, render_scene, sidecar_paths, write_render};
+use experiments::run::{
+    RenderJob, RenderOutcome, render_scene_observed, sidecar_paths, write_render,
+};
 use het_estimate::{Estimator, SoneParams};
-use tracer::integrator::Method;
-use tracer::render::Budget;
+use tracer::film::Film;
+use tracer::integrator::{Method, PathCounters};
+use tracer::render::{Budget, Partial};
 use tracer::scene::Scene;
 
-use crate::common::{check_writable, parse_exr_out, parse_positive, parse_seconds, warn_counters};
+use crate::checkpoint::Checkpoints;
+use crate::common::{
+    check_image_memory, check_writable, note_triangles, parse_exr_out, parse_positive,
+    parse_seconds, set_collision_cap, warn_counters,
+};
 use crate::flags::check_method_flags;
+use crate::interrupt;
 
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
@@ -54,6 +62,14 @@ pub struct Args {
     /// Exposure of the PNG preview, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     exposure: f64,
+    /// Most collisions of one path inside a medium before it is cut (and counted); bounds the
+    /// time a path can take in an optically huge medium (default 100,000,000).
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    max_collisions: Option<u64>,
+    /// Write the image so far (EXR, PNG and JSON, the sidecar marked as a checkpoint) after
+    /// each pass that ends at least this many seconds after the previous checkpoint.
+    #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
+    checkpoint: Option<Duration>,
 }
 
 /// Runs the subcommand.
@@ -104,10 +120,50 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}.exr", method.name())));
     check_writable(&out)?;
-    let outcome = render_scene(&scene, &job)
-        .with_context(|| format!("cannot render `{}`", args.scene.display()))?;
-    write_render(&outcome, &scene, &job, &out, args.exposure)?;
+    let (width, height) = scene.camera.resolution();
+    check_image_memory(width, height, &args.scene)?;
+    note_triangles(&scene);
+    set_collision_cap(args.max_collisions);
+    interrupt::install()?;
+    let rays_before = scene.geometry.rays_traced();
+    let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {
+        let mut film = Film::new(partial.width, partial.height);
+        film.pixels = partial.mean();
+        let outcome = RenderOutcome::checkpoint(
+            film,
+            partial.spp,
+            partial.seconds,
+            scene.geometry.rays_traced() - rays_before,
+            *partial.counters,
+            method.name().to_string(),
+        );
+        write_render(&outcome, &scene, &job, &out, args.exposure)?;
+        Ok(())
+    };
+    let observer = Checkpoints::new(
+        experiments::progress::RenderBar::new(method.name(), width, height, job.progress),
+        args.checkpoint,
+        &write_checkpoint,
+    );
+    let outcome = render_scene_observed(&scene, &job, &observer);
+    observer.finish();
+    let outcome = outcome.with_context(|| format!("cannot render `{}`", args.scene.display()))?;
     let (png, json) = sidecar_paths(&out);
+    if outcome.interrupted {
+        let signal = interrupt::received().map_or("interrupt", interrupt::name);
+        if outcome.spp == 0 {
+            bail!("{signal} before the first pass completed; nothing written");
+        }
+        write_render(&outcome, &scene, &job, &out, args.exposure)?;
+        bail!(
+            "{signal}: wrote the {} spp completed ({}, {}, {}; the sidecar says \"interrupted\": true)",
+            outcome.spp,
+            out.display(),
+            png.display(),
+            json.display()
+        );
+    }
+    write_render(&outcome, &scene, &job, &out, args.exposure)?;
     eprintln!(
         "{}: {} spp in {:.2} s ({:.2} Mrays/s); wrote {}, {}, {}",
         outcome.method,

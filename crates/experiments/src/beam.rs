@@ -330,9 +330,12 @@ pub fn trace_photons(
     };
     loop {
         let pass_start = Instant::now();
+        // After an interrupt (crate::interrupt) the batches not yet started are skipped; the
+        // completed ones are kept and counted, so the map stays normalised by its photons.
         let results: Vec<(Vec<u32>, ExitCounts, PathCounters)> = (batches_done
             ..batches_done + next)
             .into_par_iter()
+            .filter(|_| !tracer::interrupt::requested())
             .map(|b| {
                 let mut local = vec![0u32; n * n];
                 let mut ex = ExitCounts::default();
@@ -385,6 +388,9 @@ pub fn trace_photons(
             counters.merge(c);
         }
         batches_done += next;
+        if tracer::interrupt::requested() {
+            break;
+        }
         let PhotonBudget::Time(limit) = budget else {
             break;
         };
@@ -447,9 +453,10 @@ pub fn bssrdf_map(
             let mut c = PathCounters::default();
             for (j, value) in row.iter_mut().enumerate() {
                 let mut sum = 0.0;
-                for s in 0..sub * sub {
-                    let mut rng = Rng::from_keys(seed, &[0xb55, i as u64, j as u64, s as u64]);
-                    let (a, b) = ((s % sub) as f64, (s / sub) as f64);
+                let k = u64::from(sub);
+                for s in 0..k * k {
+                    let mut rng = Rng::from_keys(seed, &[0xb55, i as u64, j as u64, s]);
+                    let (a, b) = ((s % k) as f64, (s / k) as f64);
                     let x = -e + (j as f64 + (a + rng.uniform()) / sub as f64) * delta;
                     let y = e - (i as f64 + (b + rng.uniform()) / sub as f64) * delta;
                     let down = Ray::new(DVec3::new(x, y, 1.0), DVec3::NEG_Z);
@@ -463,7 +470,7 @@ pub fn bssrdf_map(
                     let r = (x_o.p - x_i.p).length();
                     sum += c.eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r);
                 }
-                *value = sum / (sub * sub) as f64;
+                *value = sum / (k * k) as f64;
             }
             progress(1);
             (row, c)

@@ -1,9 +1,9 @@
 //! Progress bars on stderr (hidden automatically when stderr is not a terminal), and the
-//! tracer's [`Progress`] callback drawn as one.
+//! tracer's render observer drawn as one.
 
 pub use indicatif::ProgressBar;
 use indicatif::ProgressStyle;
-use tracer::render::Progress;
+use tracer::render::RenderObserver;
 
 /// A progress bar over `len` units named `unit`, labelled `prefix`.
 pub fn bar(len: u64, prefix: &str, unit: &str) -> ProgressBar {
@@ -19,26 +19,65 @@ pub fn bar(len: u64, prefix: &str, unit: &str) -> ProgressBar {
     bar
 }
 
-/// A render's rows as a progress bar; each pass of a time-budget render restarts it.
+/// A render's progress as a bar over every pixel sample of the budget (of the current pass for
+/// a time budget), so that a time estimate shows from the first samples; stopped by the
+/// tracer's interrupt flag (the default of [`RenderObserver::stop_requested`]).
 #[derive(Debug)]
-pub struct RowBar(ProgressBar);
+pub struct RenderBar {
+    bar: ProgressBar,
+    pixels: u64,
+}
 
-impl RowBar {
-    /// A bar labelled `label`.
-    pub fn new(label: &str) -> Self {
-        RowBar(bar(0, label, "rows"))
+impl RenderBar {
+    /// A bar labelled `label` for a `width × height` render; hidden when `show` is false.
+    pub fn new(label: &str, width: u32, height: u32, show: bool) -> Self {
+        let bar = if show {
+            let b = ProgressBar::new(0);
+            b.set_style(
+                ProgressStyle::with_template(
+                    "{prefix:>12} [{bar:40}] {percent:>3}%  {elapsed}<{eta}",
+                )
+                .expect("static template")
+                .progress_chars("=> "),
+            );
+            b.set_prefix(label.to_string());
+            b
+        } else {
+            ProgressBar::hidden()
+        };
+        Self {
+            bar,
+            pixels: u64::from(width) * u64::from(height),
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+
+    /// Runs `f` (which prints) with the bar hidden.
+    pub fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        self.bar.suspend(f)
     }
 }
 
-impl Progress for RowBar {
-    fn start_pass(&self, rows: u64) {
-        self.0.reset();
-        self.0.set_length(rows);
+impl<C> RenderObserver<C> for RenderBar {
+    fn pass_started(&self, first: u32, end: u32, total: Option<u32>) {
+        match total {
+            Some(n) => {
+                if first == 0 {
+                    self.bar.set_length(self.pixels * u64::from(n));
+                    self.bar.reset();
+                }
+            }
+            None => {
+                self.bar.set_length(self.pixels * u64::from(end - first));
+                self.bar.reset();
+            }
+        }
     }
-    fn row_done(&self) {
-        self.0.inc(1);
-    }
-    fn finish(&self) {
-        self.0.finish_and_clear();
+    fn advance(&self, pixel_samples: u64) {
+        self.bar.inc(pixel_samples);
     }
 }

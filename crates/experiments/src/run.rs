@@ -10,8 +10,10 @@ use serde_json::json;
 use tracer::error::OutputError;
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions, RenderError};
-use tracer::output::{ExrAttribute, write_exr_with_attributes, write_json, write_png};
-use tracer::render::{Budget, NoProgress, Progress, RenderOptions, Rendered, render_with_progress};
+use tracer::output::{
+    ExrAttribute, OutputSet, exr_bytes, json_bytes, parent_dir, png_bytes, resolve_output,
+};
+use tracer::render::{Budget, RenderObserver, RenderOptions, Rendered, render_observed};
 use tracer::scene::Scene;
 
 /// Default most surface interactions per camera path.
@@ -46,6 +48,14 @@ impl RenderJob {
             progress: false,
         }
     }
+
+    /// The render loop's options for this job.
+    pub fn options(&self) -> RenderOptions {
+        RenderOptions {
+            budget: self.budget,
+            seed: self.seed,
+        }
+    }
 }
 
 /// A finished render.
@@ -66,10 +76,52 @@ pub struct RenderOutcome {
     pub method: String,
     /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
     pub warnings: Vec<String>,
+    /// True when the render was interrupted: `spp` counts the completed passes only.
+    pub interrupted: bool,
+    /// True for a checkpoint written while the render goes on (`spp` so far).
+    pub checkpoint: bool,
+}
+
+impl RenderOutcome {
+    /// The image of the passes completed so far, to be written as a checkpoint while the
+    /// render goes on (`checkpoint` set, no warnings yet).
+    pub fn checkpoint(
+        film: Film,
+        spp: u32,
+        seconds: f64,
+        rays: u64,
+        counters: PathCounters,
+        method: String,
+    ) -> Self {
+        Self {
+            film,
+            spp,
+            seconds,
+            rays,
+            counters,
+            method,
+            warnings: Vec::new(),
+            interrupted: false,
+            checkpoint: true,
+        }
+    }
 }
 
 /// Renders `scene` with `job`.
 pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
+    let (w, h) = scene.camera.resolution();
+    let observer = crate::progress::RenderBar::new(job.method.name(), w, h, job.progress);
+    let outcome = render_scene_observed(scene, job, &observer);
+    observer.finish();
+    outcome
+}
+
+/// [`render_scene`] reporting progress and completed passes to `observer`.
+pub fn render_scene_observed(
+    scene: &Scene,
+    job: &RenderJob,
+    observer: &dyn RenderObserver<PathCounters>,
+) -> Result<RenderOutcome, RenderError> {
     let integrator = PathIntegrator::new(
         scene,
         job.method,
@@ -85,21 +137,9 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         spp,
         seconds,
         counters,
+        interrupted,
         ..
-    } = {
-        let bar;
-        let progress: &dyn Progress = if job.progress {
-            bar = crate::progress::RowBar::new(job.method.name());
-            &bar
-        } else {
-            &NoProgress
-        };
-        let options = RenderOptions {
-            budget: job.budget,
-            seed: job.seed,
-        };
-        render_with_progress(w, h, &integrator, &options, progress)
-    };
+    } = render_observed(w, h, &integrator, &job.options(), observer);
     let mut film = Film::new(w, h);
     film.pixels = pixels;
     Ok(RenderOutcome {
@@ -110,6 +150,8 @@ pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, Ren
         counters,
         method: job.method.name().to_string(),
         warnings: integrator.warnings().to_vec(),
+        interrupted,
+        checkpoint: false,
     })
 }
 
@@ -118,19 +160,20 @@ pub fn sidecar_paths(exr: &Path) -> (PathBuf, PathBuf) {
     (exr.with_extension("png"), exr.with_extension("json"))
 }
 
-/// Checks before a long run that `path` can be written: its directory exists and accepts new
-/// files (see [`check_dir_accepts_files`]), and `path` is not itself a directory.
+/// Checks before a long run that `path` can be written: it is not a directory, device or FIFO
+/// and its parent is a directory ([`resolve_output`]: a symbolic link is checked at its target),
+/// and that directory accepts new files (see [`check_dir_accepts_files`]).
 pub fn check_output_path(path: &Path) -> Result<(), OutputError> {
-    if path.is_dir() {
-        return Err(OutputError::IsDirectory {
-            path: path.to_path_buf(),
-        });
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    check_dir_accepts_files(&dir, path)
+    let target = resolve_output(path)?;
+    check_dir_accepts_files(&parent_dir(&target), path)
+}
+
+/// [`check_output_path`] for a render's EXR and the PNG and JSON written beside it.
+pub fn check_render_outputs(exr: &Path) -> Result<(), OutputError> {
+    let (png, json) = sidecar_paths(exr);
+    [exr, &png, &json]
+        .into_iter()
+        .try_for_each(check_output_path)
 }
 
 /// Checks that `dir` exists and that a file can be created in it, by creating and removing an
@@ -184,30 +227,25 @@ pub fn write_render(
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
     };
-    write_exr_with_attributes(
-        &outcome.film,
-        exr,
-        &[
-            (
-                "generator",
-                ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
-            ),
-            (
-                "samplesPerPixel",
-                ExrAttribute::Int(i32::try_from(outcome.spp).unwrap_or(i32::MAX)),
-            ),
-            ("seed", ExrAttribute::Text(job.seed.to_string())),
-            ("method", ExrAttribute::Text(outcome.method.clone())),
-            (
-                "profile",
-                ExrAttribute::Text(profile.clone().unwrap_or_else(|| "none".into())),
-            ),
-            // No render time here: a duration makes every file unique, and the bytes of an EXR
-            // must be reproducible for a given seed (its hash is a render's fingerprint). The
-            // time is the sidecar's `wall_seconds`.
-        ],
-    )?;
-    write_png(&outcome.film, &png, exposure)?;
+    let attributes = [
+        (
+            "generator",
+            ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
+        ),
+        (
+            "samplesPerPixel",
+            ExrAttribute::Int(i32::try_from(outcome.spp).unwrap_or(i32::MAX)),
+        ),
+        ("seed", ExrAttribute::Text(job.seed.to_string())),
+        ("method", ExrAttribute::Text(outcome.method.clone())),
+        (
+            "profile",
+            ExrAttribute::Text(profile.clone().unwrap_or_else(|| "none".into())),
+        ),
+        // No render time here: a duration makes every file unique, and the bytes of an EXR
+        // must be reproducible for a given seed (its hash is a render's fingerprint). The
+        // time is the sidecar's `wall_seconds`.
+    ];
     let value = json!({
         "scene": scene.source_path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name.clone()),
         "method": outcome.method,
@@ -225,6 +263,17 @@ pub fn write_render(
         "counters": outcome.counters,
         "warnings": outcome.warnings,
         "mean_rgb": outcome.film.mean().0,
+        "interrupted": outcome.interrupted,
+        "checkpoint": outcome.checkpoint,
+        "max_collisions": tracer::integrator::walk::collision_cap(),
     });
-    write_json(&crate::provenance::stamped(value), &json_path)
+    // Small files first, images last, renamed into place together or not at all.
+    let mut set = OutputSet::new();
+    set.add(
+        &json_path,
+        json_bytes(&crate::provenance::stamped(value), &json_path)?,
+    );
+    set.add(&png, png_bytes(&outcome.film, &png, exposure)?);
+    set.add(exr, exr_bytes(&outcome.film, exr, &attributes)?);
+    set.commit()
 }

@@ -18,6 +18,16 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum MeshError {
+    /// A problem found at a line of a text mesh file (OBJ).
+    #[error("{file}:{line}: {message}")]
+    AtLine {
+        /// Mesh file.
+        file: String,
+        /// Line number, from 1.
+        line: usize,
+        /// What is wrong there.
+        message: String,
+    },
     /// No triangles (or no vertices).
     #[error("{file}: the mesh has no triangles")]
     Empty {
@@ -311,6 +321,23 @@ pub enum OutputError {
         /// The requested output path.
         path: PathBuf,
     },
+    /// The path names something that is neither a regular file nor a directory (a device, a
+    /// FIFO, a socket): it is never replaced by a file.
+    #[error("cannot write `{}`: it is a {kind}, not a regular file; choose another output path", path.display())]
+    NotRegular {
+        /// The requested output path.
+        path: PathBuf,
+        /// What it is (`"character device"`, `"FIFO"`…).
+        kind: &'static str,
+    },
+    /// A component of the path's parent is a file, not a directory.
+    #[error("cannot write `{}`: `{}` is a file, not a directory", path.display(), parent.display())]
+    ParentIsFile {
+        /// The requested output path.
+        path: PathBuf,
+        /// The parent component that is a file.
+        parent: PathBuf,
+    },
     /// Any other I/O failure (permission denied, disk full…).
     #[error("cannot {action} `{}`: {source}", path.display())]
     Io {
@@ -345,4 +372,32 @@ pub enum OutputError {
         /// The cargo feature to enable.
         feature: &'static str,
     },
+}
+/// Work that would need more memory than the machine has available, refused before anything
+/// is allocated.
+#[derive(Debug, thiserror::Error)]
+#[error("{what} would need about {} of memory, more than the {} available", human_bytes(*bytes), human_bytes(*available))]
+pub struct TooLarge {
+    /// What is too large, with its size (`"a 20000x20000 render"`).
+    pub what: String,
+    /// The estimate, in bytes.
+    pub bytes: f64,
+    /// The memory available, in bytes.
+    pub available: f64,
+}
+
+/// A byte count in words: `9.6 GB`, `512 MB`, `12 kB` (decimal units).
+pub fn human_bytes(bytes: f64) -> String {
+    const UNITS: [&str; 7] = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = bytes;
+    let mut i = 0;
+    while v >= 1000.0 && i + 1 < UNITS.len() {
+        v /= 1000.0;
+        i += 1;
+    }
+    if i == 0 {
+        format!("{v:.0} bytes")
+    } else {
+        format!("{v:.1} {}", UNITS[i])
+    }
 }

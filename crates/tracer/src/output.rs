@@ -3,11 +3,15 @@
 //! Every writer is atomic: the file is encoded in memory, written to a temporary file in the
 //! destination directory (`.<name>.<pid>.<n>.tmp`) and renamed into place. On any error the
 //! temporary file is removed and nothing is left behind; an existing file at the destination is
-//! replaced only on success. Errors name the path.
+//! replaced only on success. Errors name the path. A symbolic link at the destination is written
+//! through (its target gets the bytes); a device, FIFO or socket is refused, never replaced.
+//! [`OutputSet`] commits several files (EXR, PNG, JSON) together or not at all, and
+//! [`remove_temporary_files`] lets an interrupted process remove its unfinished temporaries.
 
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use bssrdf_core::Rgb;
@@ -17,62 +21,245 @@ use crate::film::Film;
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// Writes `bytes` to `path` atomically (see the module docs).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
-    if path.is_dir() {
-        return Err(OutputError::IsDirectory {
-            path: path.to_path_buf(),
-        });
+/// Temporary files being written right now, so that an interrupted process can remove them
+/// ([`remove_temporary_files`]) before it exits.
+static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    PENDING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every temporary file an atomic write of this process has not finished; for a
+/// signal handler that is about to exit the process. Returns how many were removed.
+pub fn remove_temporary_files() -> usize {
+    let mut list = pending();
+    let n = list.iter().filter(|p| fs::remove_file(p).is_ok()).count();
+    list.clear();
+    n
+}
+
+/// What kind of filesystem object something that is not a regular file is, in words
+/// (`"directory"`, `"character device"`, `"FIFO"`…).
+pub fn file_kind(ft: &fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_dir() {
+        "directory"
+    } else if ft.is_char_device() {
+        "character device"
+    } else if ft.is_block_device() {
+        "block device"
+    } else if ft.is_fifo() {
+        "FIFO"
+    } else if ft.is_socket() {
+        "socket"
+    } else {
+        "special file"
     }
-    let name = path.file_name().ok_or_else(|| OutputError::IsDirectory {
-        path: path.to_path_buf(),
-    })?;
-    let dir = match path.parent() {
+}
+
+/// The directory that holds `path` (`.` for a bare file name).
+pub fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
-    };
-    if !dir.is_dir() {
-        return Err(OutputError::MissingDirectory {
-            path: path.to_path_buf(),
-            dir,
-        });
     }
-    let tmp = dir.join(format!(
-        ".{}.{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id(),
-        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-    ));
-    let io = |action, source| OutputError::Io {
+}
+
+/// Where the bytes written to `path` should go, checked without writing anything:
+/// - a missing path or a regular file: `path` itself;
+/// - a symbolic link: its final target (written through, the link is kept), checked the same
+///   way;
+/// - a directory, a device, a FIFO or a socket: an error (never replaced by a file);
+/// - a missing parent directory, or a parent that is a file: an error saying which.
+pub fn resolve_output(path: &Path) -> Result<PathBuf, OutputError> {
+    let mut target = path.to_path_buf();
+    for _ in 0..40 {
+        match fs::symlink_metadata(&target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = fs::read_link(&target).map_err(|source| OutputError::Io {
+                    path: path.to_path_buf(),
+                    action: "read the symbolic link",
+                    source,
+                })?;
+                target = parent_dir(&target).join(link);
+                continue;
+            }
+            Ok(m) if m.is_dir() => {
+                return Err(OutputError::IsDirectory {
+                    path: path.to_path_buf(),
+                });
+            }
+            Ok(m) if !m.is_file() => {
+                return Err(OutputError::NotRegular {
+                    path: path.to_path_buf(),
+                    kind: file_kind(&m.file_type()),
+                });
+            }
+            Ok(_) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) if e.raw_os_error() == Some(20) => {
+                // ENOTDIR: a component of the parent is a file; found below.
+            }
+            Err(source) => {
+                return Err(OutputError::Io {
+                    path: path.to_path_buf(),
+                    action: "inspect",
+                    source,
+                });
+            }
+        }
+        if target.file_name().is_none() {
+            return Err(OutputError::IsDirectory {
+                path: path.to_path_buf(),
+            });
+        }
+        let dir = parent_dir(&target);
+        if !dir.is_dir() {
+            let file_parent = dir.ancestors().find(|a| a.is_file()).map(Path::to_path_buf);
+            return Err(match file_parent {
+                Some(parent) => OutputError::ParentIsFile {
+                    path: path.to_path_buf(),
+                    parent,
+                },
+                None => OutputError::MissingDirectory {
+                    path: path.to_path_buf(),
+                    dir,
+                },
+            });
+        }
+        return Ok(target);
+    }
+    Err(OutputError::NotRegular {
         path: path.to_path_buf(),
-        action,
-        source,
-    };
-    let result = (|| {
+        kind: "chain of more than 40 symbolic links",
+    })
+}
+
+/// A temporary file written beside its destination and not yet renamed into place; removed
+/// when dropped unless committed.
+struct Staged {
+    tmp: PathBuf,
+    dest: PathBuf,
+    /// The path the caller asked for (named in errors).
+    path: PathBuf,
+}
+
+impl Staged {
+    /// Writes `bytes` to a new temporary file beside `path`'s target (see [`resolve_output`]).
+    fn write(path: &Path, bytes: &[u8]) -> Result<Staged, OutputError> {
+        let dest = resolve_output(path)?;
+        let name = dest
+            .file_name()
+            .expect("resolve_output checks the file name");
+        let tmp = parent_dir(&dest).join(format!(
+            ".{}.{}.{}.tmp",
+            name.to_string_lossy(),
+            std::process::id(),
+            TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+        ));
+        pending().push(tmp.clone());
+        let staged = Staged {
+            tmp,
+            dest,
+            path: path.to_path_buf(),
+        };
+        let io = |action, source| OutputError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        };
         let mut f = fs::OpenOptions::new()
             .write(true)
             .create_new(true)
-            .open(&tmp)
+            .open(&staged.tmp)
             .map_err(|e| io("create a temporary file for", e))?;
         f.write_all(bytes).map_err(|e| io("write", e))?;
         f.sync_all().map_err(|e| io("flush", e))?;
-        drop(f);
-        fs::rename(&tmp, path).map_err(|e| io("rename into place", e))
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
+        Ok(staged)
     }
-    result
+
+    /// Renames the temporary file into place.
+    fn commit(self) -> Result<(), OutputError> {
+        let result = fs::rename(&self.tmp, &self.dest).map_err(|source| OutputError::Io {
+            path: self.path.clone(),
+            action: "rename into place",
+            source,
+        });
+        if result.is_ok() {
+            pending().retain(|p| p != &self.tmp);
+        }
+        // On success the temporary name no longer exists and Drop's removal is a no-op.
+        result
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.tmp);
+        pending().retain(|p| p != &self.tmp);
+    }
+}
+
+/// Writes `bytes` to `path` atomically (see the module docs). A symbolic link is written
+/// through (its target is replaced, the link kept); a directory, device, FIFO or socket is
+/// refused.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    Staged::write(path, bytes)?.commit()
+}
+
+/// Files that belong together (an image, its preview and its sidecar), written all or none:
+/// every file is encoded in memory, then every one is written to its temporary name (smallest
+/// first), and only when all of them are on disk are they renamed into place. A failure before
+/// the renames (a full disk, a bad destination) leaves none of them and no temporary file.
+#[derive(Debug, Default)]
+pub struct OutputSet {
+    files: Vec<(PathBuf, Vec<u8>)>,
+}
+
+impl OutputSet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a file.
+    pub fn add(&mut self, path: &Path, bytes: Vec<u8>) {
+        self.files.push((path.to_path_buf(), bytes));
+    }
+
+    /// Checks every destination ([`resolve_output`]) without writing anything.
+    pub fn check_paths<'a>(paths: impl IntoIterator<Item = &'a Path>) -> Result<(), OutputError> {
+        paths
+            .into_iter()
+            .try_for_each(|p| resolve_output(p).map(drop))
+    }
+
+    /// Writes the set (see the type's docs).
+    pub fn commit(mut self) -> Result<(), OutputError> {
+        Self::check_paths(self.files.iter().map(|(p, _)| p.as_path()))?;
+        self.files.sort_by_key(|(_, b)| b.len());
+        let staged = self
+            .files
+            .iter()
+            .map(|(p, b)| Staged::write(p, b))
+            .collect::<Result<Vec<_>, _>>()?;
+        staged.into_iter().try_for_each(Staged::commit)
+    }
 }
 
 /// Writes a pretty-printed JSON sidecar atomically.
 pub fn write_json(value: &serde_json::Value, path: &Path) -> Result<(), OutputError> {
+    write_atomic(path, &json_bytes(value, path)?)
+}
+
+/// The bytes [`write_json`] writes (`path` is named in errors only).
+pub fn json_bytes(value: &serde_json::Value, path: &Path) -> Result<Vec<u8>, OutputError> {
     let mut s = serde_json::to_string_pretty(value).map_err(|e| OutputError::Encode {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
     s.push('\n');
-    write_atomic(path, s.as_bytes())
+    Ok(s.into_bytes())
 }
 
 /// The sRGB transfer function (sRGB: IEC 61966-2-1): linear `[0, 1]` → encoded `[0, 1]`.
@@ -110,6 +297,11 @@ pub fn preview_byte(linear: f64, exposure_stops: f64) -> u8 {
 /// Writes the film as an 8-bit sRGB PNG preview: exposure `2^exposure_stops`, then the sRGB
 /// curve (applied here, not by the encoder), then clamping.
 pub fn write_png(film: &Film, path: &Path, exposure_stops: f64) -> Result<(), OutputError> {
+    write_atomic(path, &png_bytes(film, path, exposure_stops)?)
+}
+
+/// The bytes [`write_png`] writes (`path` is named in errors only).
+pub fn png_bytes(film: &Film, path: &Path, exposure_stops: f64) -> Result<Vec<u8>, OutputError> {
     #[cfg(feature = "png")]
     {
         let mut buf = Vec::with_capacity(film.pixels.len() * 3);
@@ -130,7 +322,7 @@ pub fn write_png(film: &Film, path: &Path, exposure_stops: f64) -> Result<(), Ou
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })?;
-        write_atomic(path, &bytes.into_inner())
+        Ok(bytes.into_inner())
     }
     #[cfg(not(feature = "png"))]
     {
@@ -166,12 +358,21 @@ pub const METADATA_ATTRIBUTE: &str = "hetBssrdf";
 
 /// [`write_exr`] with render metadata in the header (names and values must be Latin-1), as
 /// pbrt-v4 records its own; they are joined into the one string attribute
-/// [`METADATA_ATTRIBUTE`] so that the file's bytes stay reproducible.
+/// [`METADATA_ATTRIBUTE`] so that the file's bytes stay reproducible. Written atomically.
 pub fn write_exr_with_attributes(
     film: &Film,
     path: &Path,
     attributes: &[(&str, ExrAttribute)],
 ) -> Result<(), OutputError> {
+    write_atomic(path, &exr_bytes(film, path, attributes)?)
+}
+
+/// The bytes [`write_exr_with_attributes`] writes (`path` is named in errors only).
+pub fn exr_bytes(
+    film: &Film,
+    path: &Path,
+    attributes: &[(&str, ExrAttribute)],
+) -> Result<Vec<u8>, OutputError> {
     #[cfg(feature = "exr")]
     {
         use exr::meta::attribute::{AttributeValue, Text};
@@ -243,7 +444,10 @@ pub fn write_grey_exr(
             fixed_order(),
             channels,
         );
-        encode_exr(path, |bytes| image.write().to_buffered(bytes))
+        write_atomic(
+            path,
+            &encode_exr(path, |bytes| image.write().to_buffered(bytes))?,
+        )
     }
     #[cfg(not(feature = "exr"))]
     {
@@ -267,18 +471,18 @@ fn fixed_order() -> exr::prelude::Encoding {
     }
 }
 
-/// Encodes an EXR into memory with `write` and writes it atomically to `path`.
+/// Encodes an EXR into memory with `write` (`path` is named in errors).
 #[cfg(feature = "exr")]
 fn encode_exr(
     path: &Path,
     write: impl FnOnce(&mut std::io::Cursor<Vec<u8>>) -> exr::error::UnitResult,
-) -> Result<(), OutputError> {
+) -> Result<Vec<u8>, OutputError> {
     let mut bytes = std::io::Cursor::new(Vec::new());
     write(&mut bytes).map_err(|e| OutputError::Encode {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    write_atomic(path, &bytes.into_inner())
+    Ok(bytes.into_inner())
 }
 
 #[cfg(feature = "exr")]
@@ -388,6 +592,26 @@ pub(crate) fn decode_exr_rgb(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>), E
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unfinished_temporaries_are_removed_on_request_and_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.exr");
+        // A write in progress (staged, not committed) is registered for
+        // remove_temporary_files (not called here: it is process-wide, and other tests write
+        // files concurrently), and removed and unregistered when abandoned.
+        let staged = Staged::write(&path, b"bytes").unwrap();
+        let tmp = staged.tmp.clone();
+        assert!(tmp.exists() && pending().contains(&tmp));
+        drop(staged);
+        assert!(!tmp.exists() && !pending().contains(&tmp));
+        // A set whose last file cannot be written leaves nothing, temporaries included.
+        let mut set = OutputSet::new();
+        set.add(&dir.path().join("b.json"), b"{}".to_vec());
+        set.add(&dir.path().join("missing/c.exr"), b"x".to_vec());
+        assert!(set.commit().is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
 
     #[test]
     fn srgb_round_trip_and_known_values() {

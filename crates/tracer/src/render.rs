@@ -5,7 +5,9 @@
 //! pixel's samples are added to its running sum in increasing `s` by one thread, so the image is
 //! bit-identical whatever the number of threads or the scheduling order. A time-budget render
 //! adds passes of doubling size to the same running sums, so it equals a fixed-count render
-//! with the sample count it reached.
+//! with the sample count it reached. Renders run in passes (see [`render_observed`]), which
+//! neither change a pixel nor depend on the thread count; an interrupt
+//! ([`crate::interrupt`]) keeps the completed passes.
 
 use std::time::{Duration, Instant};
 
@@ -60,6 +62,9 @@ pub struct Rendered<C> {
     pub seconds: f64,
     /// Merged integrator counters.
     pub counters: C,
+    /// True when [`RenderObserver::stop_requested`] ended the render before its budget: the
+    /// image holds the passes completed before the request (`spp` of them).
+    pub interrupted: bool,
 }
 
 /// Options of [`render`].
@@ -71,26 +76,65 @@ pub struct RenderOptions {
     pub seed: u64,
 }
 
-/// Receives the progress of a render (to draw a progress bar, log, or ignore it). Calls come
-/// from the rendering threads.
-pub trait Progress: Sync {
-    /// A pass over `rows` rows starts (a time-budget render makes several passes).
-    fn start_pass(&self, rows: u64);
-    /// One row of the current pass is finished.
-    fn row_done(&self);
-    /// The render is finished.
-    fn finish(&self);
+/// The image after a completed pass, for checkpoints.
+#[derive(Debug)]
+pub struct Partial<'a, C> {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Sum of the samples of each pixel (row-major); divide by `spp` for the mean.
+    pub sums: &'a [Rgb],
+    /// Samples per pixel completed.
+    pub spp: u32,
+    /// Wall-clock seconds so far.
+    pub seconds: f64,
+    /// Counters of the completed passes.
+    pub counters: &'a C,
 }
 
-/// A [`Progress`] that ignores every call.
+impl<C> Partial<'_, C> {
+    /// The mean radiance per pixel so far.
+    pub fn mean(&self) -> Vec<Rgb> {
+        let inv = 1.0 / f64::from(self.spp.max(1));
+        self.sums.iter().map(|&s| s * inv).collect()
+    }
+}
+
+/// What the render loop reports while it runs, and how it is stopped early. Called from the
+/// worker threads, hence `Sync`.
+pub trait RenderObserver<C>: Sync {
+    /// A pass of samples `first..end` starts; `total` is the budget's sample count when it is
+    /// fixed.
+    fn pass_started(&self, first: u32, end: u32, total: Option<u32>) {
+        let _ = (first, end, total);
+    }
+    /// `pixel_samples` more pixel samples were taken (reported pixel by pixel, so a time
+    /// estimate is available from the first samples, not after the first row).
+    fn advance(&self, pixel_samples: u64) {
+        let _ = pixel_samples;
+    }
+    /// True to stop: the pass in progress is abandoned and the render returns the completed
+    /// ones. Polled once per pixel. The default follows [`crate::interrupt`].
+    fn stop_requested(&self) -> bool {
+        crate::interrupt::requested()
+    }
+    /// A pass completed; `partial` is the image so far (for checkpoints).
+    fn pass_finished(&self, partial: &Partial<'_, C>) {
+        let _ = partial;
+    }
+}
+
+/// The observer [`render`] uses: no progress, stopped by [`crate::interrupt`]. Applications
+/// draw progress with an observer of their own (the experiments crate's bar).
 #[derive(Debug, Clone, Copy, Default)]
-pub struct NoProgress;
+pub struct NoObserver;
 
-impl Progress for NoProgress {
-    fn start_pass(&self, _: u64) {}
-    fn row_done(&self) {}
-    fn finish(&self) {}
-}
+impl<C> RenderObserver<C> for NoObserver {}
+
+/// A pass is not made longer than this (seconds, predicted), so that an interrupt loses at most
+/// about this much work and checkpoints can be written between passes.
+const PASS_SECONDS: f64 = 2.0;
 
 /// Renders `width × height` pixels with `estimator` (see the module docs), reporting no
 /// progress.
@@ -100,37 +144,51 @@ pub fn render<E: PixelEstimator>(
     estimator: &E,
     options: &RenderOptions,
 ) -> Rendered<E::Counters> {
-    render_with_progress(width, height, estimator, options, &NoProgress)
+    render_observed(width, height, estimator, options, &NoObserver)
 }
 
-/// [`render`], reporting each finished row to `progress`.
-pub fn render_with_progress<E: PixelEstimator>(
+/// [`render`] reporting to `observer` (progress, early stops, checkpoints).
+///
+/// The samples are taken in passes: `1, 1, 2, 4, …` samples per pixel, doubling while a pass
+/// is predicted to take under 2 s. A pass is accumulated into a copy of the running
+/// sums, each pixel's samples in increasing index, and replaces them only when it completes, so
+/// the pass boundaries (and whether checkpoints are written, or an interrupt abandons a pass)
+/// never change a pixel: the image is the same as a single pass's.
+pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Sized>(
     width: u32,
     height: u32,
     estimator: &E,
     options: &RenderOptions,
-    progress: &dyn Progress,
+    observer: &O,
 ) -> Rendered<E::Counters> {
     let start = Instant::now();
-    let n = width as usize * height as usize;
+    let w = width as usize;
+    let n = w * height as usize;
     let mut sums = vec![Rgb::ZERO; n];
+    let mut next_sums = vec![Rgb::ZERO; n];
     let mut counters = E::Counters::default();
-    // Fixed count: one pass. Time budget: passes of 1, 1, 2, 4, … samples.
-    let mut done = 0u32;
-    let mut pass = match options.budget {
-        Budget::Samples(s) => s.max(1),
-        Budget::Time(_) => 1,
+    let total = match options.budget {
+        Budget::Samples(s) => Some(s.max(1)),
+        Budget::Time(_) => None,
     };
-    loop {
-        progress.start_pass(height as u64);
+    let mut done = 0u32;
+    let mut pass = 1u32;
+    let mut interrupted = false;
+    while pass > 0 {
         let end = done.saturating_add(pass);
+        observer.pass_started(done, end, total);
         let pass_start = Instant::now();
-        let row_counters: Vec<E::Counters> = sums
-            .par_chunks_mut(width as usize)
+        let rows: Vec<Option<E::Counters>> = next_sums
+            .par_chunks_mut(w.max(1))
+            .zip(sums.par_chunks(w.max(1)))
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(y, (row, old))| {
                 let mut c = E::Counters::default();
+                row.copy_from_slice(old);
                 for (x, sum) in row.iter_mut().enumerate() {
+                    if observer.stop_requested() {
+                        return None;
+                    }
                     for s in done..end {
                         let mut rng = Rng::for_pixel_sample(options.seed, x as u32, y as u32, s);
                         let fx = x as f64 + rng.uniform();
@@ -139,29 +197,37 @@ pub fn render_with_progress<E: PixelEstimator>(
                         debug_assert!(v.is_finite(), "non-finite sample at ({x}, {y})");
                         *sum += v;
                     }
+                    observer.advance(u64::from(end - done));
                 }
-                progress.row_done();
-                c
+                Some(c)
             })
             .collect();
-        for c in &row_counters {
+        if observer.stop_requested() || rows.iter().any(Option::is_none) {
+            interrupted = true;
+            break;
+        }
+        for c in rows.iter().flatten() {
             counters.merge(c);
         }
-        let per_sample = pass_start.elapsed().as_secs_f64() / (end - done) as f64;
+        std::mem::swap(&mut sums, &mut next_sums);
+        let per_sample = pass_start.elapsed().as_secs_f64() / f64::from(end - done);
         done = end;
-        let Budget::Time(limit) = options.budget else {
-            break;
-        };
-        // The next pass doubles the count; stop if it is predicted to overshoot the budget.
-        let next = done;
-        let predicted = start.elapsed().as_secs_f64() + per_sample * next as f64;
-        if predicted > limit.as_secs_f64() || done >= u32::MAX / 2 {
-            break;
-        }
-        pass = next;
+        observer.pass_finished(&Partial {
+            width,
+            height,
+            sums: &sums,
+            spp: done,
+            seconds: start.elapsed().as_secs_f64(),
+            counters: &counters,
+        });
+        pass = next_pass(
+            options.budget,
+            done,
+            per_sample,
+            start.elapsed().as_secs_f64(),
+        );
     }
-    progress.finish();
-    let inv = 1.0 / done as f64;
+    let inv = 1.0 / f64::from(done.max(1));
     Rendered {
         width,
         height,
@@ -169,6 +235,32 @@ pub fn render_with_progress<E: PixelEstimator>(
         spp: done,
         seconds: start.elapsed().as_secs_f64(),
         counters,
+        interrupted,
+    }
+}
+
+/// The size of the pass after `done` samples per pixel (0: stop): double the samples so far,
+/// but no more than [`PASS_SECONDS`] of predicted work, nor past the budget. A time budget stops
+/// when the next pass is predicted to overshoot it.
+fn next_pass(budget: Budget, done: u32, per_sample: f64, elapsed: f64) -> u32 {
+    let by_time = if per_sample > 0.0 {
+        (PASS_SECONDS / per_sample)
+            .floor()
+            .clamp(1.0, f64::from(u32::MAX)) as u32
+    } else {
+        u32::MAX
+    };
+    let pass = done.min(by_time).max(1);
+    match budget {
+        Budget::Samples(total) => pass.min(total.max(1).saturating_sub(done)),
+        Budget::Time(limit) => {
+            if done >= u32::MAX / 2 || elapsed + per_sample * f64::from(pass) > limit.as_secs_f64()
+            {
+                0
+            } else {
+                pass
+            }
+        }
     }
 }
 
@@ -203,6 +295,76 @@ mod tests {
         let b = two.install(|| render(13, 7, &Noise, &opts(Budget::Samples(5))));
         assert_eq!(a.spp, 5);
         assert_eq!(a.pixels, b.pixels);
+    }
+
+    /// Records what the render loop reports, and stops it after `stop_after` passes.
+    struct Recorder {
+        stop_after: usize,
+        passes: std::sync::Mutex<Vec<(u32, Vec<Rgb>)>>,
+        advances: std::sync::atomic::AtomicU64,
+        calls: std::sync::atomic::AtomicU64,
+    }
+    impl RenderObserver<()> for Recorder {
+        fn advance(&self, n: u64) {
+            use std::sync::atomic::Ordering::Relaxed;
+            self.advances.fetch_add(n, Relaxed);
+            self.calls.fetch_add(1, Relaxed);
+        }
+        fn stop_requested(&self) -> bool {
+            self.passes.lock().unwrap().len() >= self.stop_after
+        }
+        fn pass_finished(&self, p: &Partial<'_, ()>) {
+            self.passes.lock().unwrap().push((p.spp, p.mean()));
+        }
+    }
+
+    #[test]
+    fn passes_progress_and_interrupts() {
+        use std::sync::atomic::Ordering::Relaxed;
+        let rec = |stop_after| Recorder {
+            stop_after,
+            passes: Default::default(),
+            advances: Default::default(),
+            calls: Default::default(),
+        };
+        // Progress is reported pixel by pixel (a time estimate from the first samples), and
+        // every pixel sample is counted once.
+        let r = rec(usize::MAX);
+        let full = render_observed(13, 7, &Noise, &opts(Budget::Samples(9)), &r);
+        assert!(!full.interrupted);
+        assert_eq!(r.advances.load(Relaxed), 13 * 7 * 9);
+        let passes = r.passes.lock().unwrap().len() as u64;
+        assert_eq!(r.calls.load(Relaxed), 13 * 7 * passes);
+        // Every completed pass is the image of a single-pass render with its spp, computed
+        // here directly: each pixel's samples summed in increasing index.
+        let reference = |spp: u32| -> Vec<Rgb> {
+            let mut out = Vec::new();
+            for y in 0..7u32 {
+                for x in 0..13u32 {
+                    let mut sum = Rgb::ZERO;
+                    for s in 0..spp {
+                        let mut rng = Rng::for_pixel_sample(5, x, y, s);
+                        let fx = f64::from(x) + rng.uniform();
+                        let fy = f64::from(y) + rng.uniform();
+                        sum += Noise.sample(fx, fy, &mut rng, &mut ());
+                    }
+                    out.push(sum * (1.0 / f64::from(spp)));
+                }
+            }
+            out
+        };
+        assert!(passes > 1);
+        for (spp, mean) in r.passes.lock().unwrap().iter() {
+            assert_eq!(&reference(*spp), mean, "pass at {spp} spp");
+        }
+        assert_eq!(full.pixels, reference(9));
+        // Stopped after two passes: the completed ones are kept, marked as interrupted.
+        let r = rec(2);
+        let cut = render_observed(13, 7, &Noise, &opts(Budget::Samples(9)), &r);
+        assert!(cut.interrupted);
+        let (spp, mean) = r.passes.lock().unwrap()[1].clone();
+        assert_eq!((cut.spp, &cut.pixels), (spp, &mean));
+        assert!(cut.spp < 9);
     }
 
     #[test]

@@ -125,17 +125,26 @@ impl Texture {
             file: file.to_string(),
             source,
         })?;
-        let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+        let limit_mb = decoder_limit_mb();
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .map_err(|e| TextureError::Decode {
                 file: file.to_string(),
                 message: e.to_string(),
-            })?
-            .decode()
-            .map_err(|e| TextureError::Decode {
-                file: file.to_string(),
-                message: e.to_string(),
             })?;
+        let mut limits = image::Limits::default();
+        limits.max_alloc = Some(limit_mb.saturating_mul(1 << 20));
+        reader.limits(limits);
+        let img = reader.decode().map_err(|e| TextureError::Decode {
+            file: file.to_string(),
+            message: match e {
+                image::ImageError::Limits(l) => format!(
+                    "{l}: the image needs more than the decoder's memory limit of {limit_mb} MiB; \
+                     set {TEXTURE_LIMIT_VAR}=<MiB> to raise it"
+                ),
+                e => e.to_string(),
+            },
+        })?;
         let (w, h) = (img.width(), img.height());
         let texels: Vec<[f32; 3]> = match &img {
             DynamicImage::ImageLuma8(_)
@@ -242,6 +251,22 @@ impl Texture {
             }
         }
     }
+}
+
+/// The environment variable that overrides the image decoder's memory limit (MiB).
+#[cfg_attr(not(feature = "png"), allow(dead_code))]
+pub const TEXTURE_LIMIT_VAR: &str = "HET_BSSRDF_TEXTURE_LIMIT_MB";
+
+/// The image decoder's memory limit in MiB: [`TEXTURE_LIMIT_VAR`] when set to a positive whole
+/// number, else 512 (the `image` crate's default), which refuses decompression bombs (a 20000²
+/// PNG) before they are allocated.
+#[cfg_attr(not(feature = "png"), allow(dead_code))]
+pub fn decoder_limit_mb() -> u64 {
+    std::env::var(TEXTURE_LIMIT_VAR)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .filter(|&v| v > 0)
+        .unwrap_or(512)
 }
 
 #[cfg(test)]

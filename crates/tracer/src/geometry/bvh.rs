@@ -3,8 +3,10 @@
 //!
 //! One BVH per object makes the per-object queries of the BSSRDF methods
 //! ([`Geometry::intersect_object`], [`Geometry::for_each_object_hit`]) traverse only that
-//! object; the all-object queries loop over the objects (few in our scenes) after a bounding
-//! box test, shrinking the ray as hits are found.
+//! object; the all-object queries walk a top-level tree over the objects' boxes
+//! ([`super::tlas`]), shrinking the ray as hits are found. Each object's triangles are stored
+//! in its own local frame (relative to its centre, scaled by a power of two), and rays are
+//! moved into that frame in `f64`, so precision does not depend on where the object is.
 
 use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -18,6 +20,7 @@ use obvhs::ploc::PlocBuilder;
 use obvhs::ray::{Ray as BvhRay, RayHit};
 use obvhs::{Boundable, BvhBuildParams};
 
+use super::tlas::{Tlas, slab};
 use super::watertight::{LeafTri, ShearedRay, refine_f64};
 use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
 
@@ -42,6 +45,19 @@ const BOX_PAD_REL: f32 = 1.0 / 65536.0;
 /// origin (magnitude < 16 × extent) the extent pad is the larger and nothing changes.
 const BOX_PAD_COORD_ULPS: f64 = 8.0;
 
+/// The padding of an object's world bounds in the conservative box tests (the top-level tree's
+/// leaves): 1e-6 of its extent.
+fn box_pad(lo: DVec3, hi: DVec3) -> DVec3 {
+    let extent = (hi - lo).max_element();
+    DVec3::splat(
+        if extent.is_finite() {
+            1e-6 * extent
+        } else {
+            0.0
+        } + 1e-30,
+    )
+}
+
 /// A triangle's padded bounding box, what the BVH is built on.
 struct PaddedBox(Aabb);
 
@@ -55,8 +71,13 @@ impl Boundable for PaddedBox {
 #[derive(Debug)]
 struct ObjectAccel {
     bvh: Option<CwBvh>,
-    /// Triangles in BVH leaf order, scaled by `scale`.
+    /// Triangles in BVH leaf order, in the object's local frame: `(p − centre) · scale`.
     tris: Vec<LeafTri>,
+    /// Origin of the local frame: the centre of the world bounds. Storing the triangles
+    /// relative to it keeps their `f32` precision relative to the object's size wherever the
+    /// object is (far from the world origin, world coordinates would round to a large fraction
+    /// of the object).
+    centre: DVec3,
     /// Leaf index → triangle index in the object's mesh.
     prims: Vec<u32>,
     /// Power of two mapping world to scaled coordinates.
@@ -65,6 +86,9 @@ struct ObjectAccel {
     /// World-space bounds.
     lo: DVec3,
     hi: DVec3,
+    /// The bounds padded for the conservative box tests.
+    plo: DVec3,
+    phi: DVec3,
 }
 
 /// Scene geometry: triangle meshes (object id = index) with their BVHs, and the ray queries.
@@ -74,6 +98,8 @@ struct ObjectAccel {
 #[derive(Debug)]
 pub struct Geometry {
     objects: Vec<ObjectAccel>,
+    /// The top-level tree over the objects that have triangles.
+    tlas: Tlas,
     meshes: Vec<TriangleMesh>,
     triangles: usize,
     counter: RayCounter,
@@ -162,7 +188,12 @@ impl ObjectAccel {
     fn build(mesh: &TriangleMesh) -> Self {
         let (lo, hi) = mesh.bounds();
         let extent = (hi - lo).max_element();
-        let magnitude = lo.abs().max(hi.abs()).max_element();
+        let centre = if extent.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            DVec3::ZERO
+        };
+        let magnitude = (lo - centre).abs().max((hi - centre).abs()).max_element();
         let scale = if extent > 0.0 && extent.is_finite() {
             let e = SCALED_EXTENT_LOG2 - extent.log2().ceil() as i32;
             let e_max = if magnitude > 0.0 {
@@ -178,18 +209,21 @@ impl ObjectAccel {
             return Self {
                 bvh: None,
                 tris: Vec::new(),
+                centre,
                 prims: Vec::new(),
                 scale,
                 inv_scale: 1.0 / scale,
                 lo,
                 hi,
+                plo: lo - box_pad(lo, hi),
+                phi: hi + box_pad(lo, hi),
             };
         }
         let scaled: Vec<[Vec3A; 3]> = mesh
             .triangles
             .iter()
             .map(|t| {
-                t.map(|k| Vec3A::from((mesh.positions[k as usize].as_dvec3() * scale).as_vec3()))
+                t.map(|k| Vec3A::from(((mesh.positions[k as usize] - centre) * scale).as_vec3()))
             })
             .collect();
         // 128 ulps of the extent, but never less than 8 ulps of the largest coordinate: far
@@ -219,24 +253,30 @@ impl ObjectAccel {
         Self {
             bvh: Some(bvh),
             tris,
+            centre,
             prims,
             scale,
             inv_scale: 1.0 / scale,
             lo,
             hi,
+            plo: lo - box_pad(lo, hi),
+            phi: hi + box_pad(lo, hi),
         }
     }
 
+    /// The ray in the object's local frame, its origin first moved in `f64` along the ray to
+    /// `shift` (the returned distances are relative to it): a ray that starts far from the
+    /// object (a camera ray) keeps the precision of one that starts near it.
     #[inline]
-    fn scaled_ray(&self, ray: &Ray, t_min: f64, t_max: f64) -> ScaledRay {
-        let o = (ray.origin * self.scale).as_vec3();
+    fn scaled_ray(&self, ray: &Ray, t_min: f64, t_max: f64, shift: f64) -> ScaledRay {
+        let o = ((ray.origin + shift * ray.dir - self.centre) * self.scale).as_vec3();
         let d = ray.dir.as_vec3();
         let bvh = BvhRay {
             origin: o.into(),
             direction: d.into(),
             inv_direction: Vec3A::new(safe_inv(d.x), safe_inv(d.y), safe_inv(d.z)),
-            tmin: (t_min * self.scale) as f32,
-            tmax: (t_max * self.scale) as f32,
+            tmin: ((t_min - shift).max(0.0) * self.scale) as f32,
+            tmax: ((t_max - shift) * self.scale).min(f64::from(f32::MAX)) as f32,
         };
         ScaledRay {
             bvh,
@@ -244,26 +284,46 @@ impl ObjectAccel {
         }
     }
 
-    /// Slab test of the world bounds against `[t_min, t_max]` (conservative: padded).
+    /// [`ObjectAccel::origin_shift`] when the ray is known to enter the padded bounds at
+    /// `enter`: one extent before it.
     #[inline]
-    fn may_hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> bool {
-        let pad = 1e-6 * (self.hi - self.lo).max_element() + 1e-30;
-        let inv = DVec3::ONE / ray.dir;
-        let t0 = (self.lo - pad - ray.origin) * inv;
-        let t1 = (self.hi + pad - ray.origin) * inv;
-        let near = t0.min(t1);
-        let far = t0.max(t1);
-        // NaN (0 · inf) components are ignored by max/min of f64 (they return the other).
-        let enter = near.max_element().max(t_min);
-        let exit = far.min_element().min(t_max);
-        enter <= exit
+    fn shift_from_entry(&self, enter: f64) -> f64 {
+        (enter - (self.hi - self.lo).max_element()).max(0.0)
+    }
+
+    /// How far along the ray its origin can move toward the object before the `f32` tests:
+    /// to one object extent before the padded bounds (0 for a ray that starts near or inside
+    /// them, or does not reach them after `t_min`).
+    #[inline]
+    fn origin_shift(&self, ray: &Ray) -> f64 {
+        let extent = (self.hi - self.lo).max_element();
+        let far = (ray.origin - self.centre).abs().max_element();
+        if far.is_nan() || far <= 4.0 * extent {
+            return 0.0;
+        }
+        let pad = extent + 1e-30;
+        slab(
+            self.lo - pad,
+            self.hi + pad,
+            ray.origin,
+            DVec3::ONE / ray.dir,
+            0.0,
+            f64::INFINITY,
+        )
+        .unwrap_or(0.0)
+    }
+
+    /// The world bounds padded for the conservative box tests.
+    #[inline]
+    fn padded_bounds(&self) -> (DVec3, DVec3) {
+        (self.plo, self.phi)
     }
 
     /// Closest hit in `[t_min, t_max]` (world units): `(leaf, t_world)`.
     #[inline]
-    fn closest(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(u32, f64)> {
+    fn closest(&self, ray: &Ray, t_min: f64, t_max: f64, shift: f64) -> Option<(u32, f64)> {
         let bvh = self.bvh.as_ref()?;
-        let r = self.scaled_ray(ray, t_min, t_max);
+        let r = self.scaled_ray(ray, t_min, t_max, shift);
         let mut hit = RayHit::none();
         let tris = &self.tris;
         let sheared = r.sheared;
@@ -273,18 +333,18 @@ impl ObjectAccel {
                 None => f32::INFINITY,
             }
         }) {
-            Some((hit.primitive_id, hit.t as f64 * self.inv_scale))
+            Some((hit.primitive_id, shift + hit.t as f64 * self.inv_scale))
         } else {
             None
         }
     }
 
     #[inline]
-    fn any(&self, ray: &Ray) -> bool {
+    fn any(&self, ray: &Ray, shift: f64) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
-        let r = self.scaled_ray(ray, ray.t_min, ray.t_max);
+        let r = self.scaled_ray(ray, ray.t_min, ray.t_max, shift);
         let tris = &self.tris;
         let sheared = r.sheared;
         !bvh.ray_traverse_miss(r.bvh, |br, id| {
@@ -300,10 +360,16 @@ impl Geometry {
     /// Builds one BVH per mesh; object `i` is `meshes[i]`. Meshes should have been validated
     /// ([`TriangleMesh::prepare`]); an empty mesh gives an object that is never hit.
     pub fn build(meshes: Vec<TriangleMesh>) -> Geometry {
-        let objects = meshes.iter().map(ObjectAccel::build).collect();
+        let objects: Vec<ObjectAccel> = meshes.iter().map(ObjectAccel::build).collect();
         let triangles = meshes.iter().map(|m| m.triangles.len()).sum();
+        let boxes: Vec<(DVec3, DVec3)> = objects.iter().map(ObjectAccel::padded_bounds).collect();
+        let ids = (0..objects.len() as u32)
+            .filter(|&k| objects[k as usize].bvh.is_some())
+            .collect();
+        let tlas = Tlas::build(&boxes, ids);
         Geometry {
             objects,
+            tlas,
             meshes,
             triangles,
             counter: RayCounter::new(),
@@ -346,21 +412,41 @@ impl Geometry {
         self.counter.total()
     }
 
+    /// Walks the top-level tree for `ray`, nearest object box first, calling
+    /// `visit(object, its structure, origin shift, t_max)`, which returns the new `t_max` or
+    /// `None` to stop.
+    #[inline]
+    fn visit_objects(
+        &self,
+        ray: &Ray,
+        mut visit: impl FnMut(u32, &ObjectAccel, f64, f64) -> Option<f64>,
+    ) {
+        self.tlas.traverse(
+            ray.origin,
+            ray.dir,
+            ray.t_min,
+            ray.t_max,
+            |k, enter, t_max| {
+                let obj = &self.objects[k as usize];
+                visit(k, obj, obj.shift_from_entry(enter), t_max)
+            },
+        );
+    }
+
     /// The closest intersection over all objects in `[ray.t_min, ray.t_max]`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         self.counter.add(1);
         let mut best: Option<(u32, u32, f64)> = None;
-        let mut t_max = ray.t_max;
-        for (k, obj) in self.objects.iter().enumerate() {
-            if !obj.may_hit(ray, ray.t_min, t_max) {
-                continue;
+        self.visit_objects(ray, |k, obj, shift, t_max| {
+            match obj.closest(ray, ray.t_min, t_max, shift) {
+                Some((leaf, t)) => {
+                    best = Some((k, leaf, t));
+                    Some(t)
+                }
+                None => Some(t_max),
             }
-            if let Some((leaf, t)) = obj.closest(ray, ray.t_min, t_max) {
-                t_max = t;
-                best = Some((k as u32, leaf, t));
-            }
-        }
+        });
         best.map(|(k, leaf, t)| self.make_hit(k, leaf, ray, t))
     }
 
@@ -369,7 +455,7 @@ impl Geometry {
     pub fn intersect_object(&self, object: u32, ray: &Ray) -> Option<Hit> {
         self.counter.add(1);
         let obj = &self.objects[object as usize];
-        obj.closest(ray, ray.t_min, ray.t_max)
+        obj.closest(ray, ray.t_min, ray.t_max, obj.origin_shift(ray))
             .map(|(leaf, t)| self.make_hit(object, leaf, ray, t))
     }
 
@@ -378,9 +464,16 @@ impl Geometry {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.counter.add(1);
-        self.objects
-            .iter()
-            .any(|o| o.may_hit(ray, ray.t_min, ray.t_max) && o.any(ray))
+        let mut hit = false;
+        self.visit_objects(ray, |_, obj, shift, t_max| {
+            if obj.any(ray, shift) {
+                hit = true;
+                None
+            } else {
+                Some(t_max)
+            }
+        });
+        hit
     }
 
     /// Calls `f` for every crossing of the ray with `object` in `[ray.t_min, ray.t_max]`, in
@@ -393,7 +486,8 @@ impl Geometry {
         let Some(bvh) = obj.bvh.as_ref() else {
             return;
         };
-        let r = obj.scaled_ray(ray, ray.t_min, ray.t_max);
+        let shift = obj.origin_shift(ray);
+        let r = obj.scaled_ray(ray, ray.t_min, ray.t_max, shift);
         let mut buf = CrossingBuf::new();
         let tris = &obj.tris;
         let sheared = r.sheared;
@@ -417,7 +511,7 @@ impl Geometry {
                 }
             }
             last = Some(*c);
-            let hit = self.make_hit(object, c.leaf, ray, c.t as f64 * obj.inv_scale);
+            let hit = self.make_hit(object, c.leaf, ray, shift + c.t as f64 * obj.inv_scale);
             f(&hit);
         }
     }
@@ -427,14 +521,10 @@ impl Geometry {
     #[inline]
     fn make_hit(&self, object: u32, leaf: u32, ray: &Ray, t_approx: f64) -> Hit {
         let obj = &self.objects[object as usize];
-        let tri = &obj.tris[leaf as usize];
         let prim = obj.prims[leaf as usize];
-        let s = obj.inv_scale;
-        let v = [
-            tri.vertex_f64(0) * s,
-            tri.vertex_f64(1) * s,
-            tri.vertex_f64(2) * s,
-        ];
+        let c = obj.centre;
+        // The mesh's own f64 vertices (the f32 leaf copy only decides hit or miss).
+        let v = self.meshes[object as usize].triangle_vertices(prim as usize);
         let (t, b) = refine_f64(ray.origin, ray.dir, v).unwrap_or((t_approx, [1.0 / 3.0; 3]));
         let p = b[0] * v[0] + b[1] * v[1] + b[2] * v[2];
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
@@ -459,7 +549,9 @@ impl Geometry {
         }
         let lo = v[0].min(v[1]).min(v[2]);
         let hi = v[0].max(v[1]).max(v[2]);
-        let p_error = OFFSET_REL * (p.abs().max_element() + (hi - lo).max_element());
+        // The f32 test sees the object in its local frame: the error scales with the
+        // distance from the object's centre, not from the world origin.
+        let p_error = OFFSET_REL * ((p - c).abs().max_element() + (hi - lo).max_element());
         Hit {
             t,
             p,

@@ -12,8 +12,9 @@ use crate::error::MeshError;
 /// image); the glTF loader converts.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriangleMesh {
-    /// Vertex positions.
-    pub positions: Vec<Vec3>,
+    /// Vertex positions (`f64`, so that a mesh far from the origin keeps its shape: in `f32`
+    /// a unit sphere at 1e6 rounds to steps of 0.06).
+    pub positions: Vec<DVec3>,
     /// Per-vertex shading normals (need not be unit; normalised after interpolation).
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex texture coordinates.
@@ -123,7 +124,7 @@ impl Transform {
 
 impl TriangleMesh {
     /// A mesh without normals or texture coordinates.
-    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
+    pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
         Self {
             positions,
             normals: None,
@@ -141,7 +142,7 @@ impl TriangleMesh {
     #[inline]
     pub fn triangle_vertices(&self, i: usize) -> [DVec3; 3] {
         let t = self.triangles[i];
-        t.map(|k| self.positions[k as usize].as_dvec3())
+        t.map(|k| self.positions[k as usize])
     }
 
     /// Axis-aligned bounds of the referenced vertices, `(min, max)`; `(0, 0)` when empty.
@@ -150,7 +151,7 @@ impl TriangleMesh {
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
         for t in &self.triangles {
             for &k in t {
-                let p = self.positions[k as usize].as_dvec3();
+                let p = self.positions[k as usize];
                 lo = lo.min(p);
                 hi = hi.max(p);
             }
@@ -200,7 +201,7 @@ impl TriangleMesh {
                     file: file_s(),
                     attribute: "position",
                     vertex: i,
-                    value: p.to_array(),
+                    value: p.as_vec3().to_array(),
                 });
             }
         }
@@ -355,7 +356,7 @@ impl TriangleMesh {
     /// part; the winding is reversed when the map mirrors (negative determinant).
     pub fn apply_affine(&mut self, m: &DAffine3) {
         for p in &mut self.positions {
-            *p = m.transform_point3(p.as_dvec3()).as_vec3();
+            *p = m.transform_point3(*p);
         }
         let lin: DMat3 = m.matrix3;
         if let Some(normals) = &mut self.normals {
@@ -456,7 +457,7 @@ mod tests {
         // Normals still radial (outward) from the new centre.
         let n = m.normals.as_ref().unwrap();
         for (p, n) in m.positions.iter().zip(n) {
-            let radial = (p.as_dvec3() - DVec3::new(5.0, 0.0, 0.0)).normalize();
+            let radial = (*p - DVec3::new(5.0, 0.0, 0.0)).normalize();
             // Scaled sphere: the normal is not radial, but it points outward.
             assert!(radial.dot(n.as_dvec3()) > 0.0);
         }
@@ -481,7 +482,7 @@ mod tests {
         ));
         assert!(e.to_string().contains("i.obj"));
         let mut m = good.clone();
-        m.positions[2].y = f32::NAN;
+        m.positions[2].y = f64::NAN;
         assert!(matches!(
             m.validate("n.obj"),
             Err(MeshError::NonFinite { vertex: 2, .. })

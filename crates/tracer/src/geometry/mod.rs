@@ -28,10 +28,13 @@ pub mod gltf;
 pub mod mesh;
 #[cfg(feature = "obj")]
 pub mod obj;
+#[cfg(feature = "obj")]
+mod obj_lines;
 #[cfg(feature = "ply")]
 pub mod ply;
 pub mod primitives;
 pub mod surface;
+mod tlas;
 mod watertight;
 
 pub use bvh::Geometry;
@@ -131,7 +134,8 @@ pub struct Hit {
     /// Barycentrics `(b1, b2)` of vertices 1 and 2: `p = (1-b1-b2)·v0 + b1·v1 + b2·v2`.
     pub bary: DVec2,
     /// Bound on the distance between `p` and the surface as the `f32` intersection test sees
-    /// it (scene units): [`OFFSET_REL`] × (`|p|_∞` + the triangle's largest extent).
+    /// it (scene units): [`OFFSET_REL`] × (`|p − c|_∞` + the triangle's largest extent), `c`
+    /// the centre of the object's local frame (the triangles are stored relative to it).
     pub p_error: f64,
 }
 

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use super::TriangleMesh;
 use crate::error::MeshError;
@@ -13,11 +13,15 @@ use crate::error::MeshError;
 /// validated here: call [`TriangleMesh::prepare`].
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
     let file = path.display().to_string();
-    let (models, _materials) =
-        tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| MeshError::Load {
-            file: file.clone(),
-            message: e.to_string(),
-        })?;
+    let (models, _materials) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| {
+        located(
+            path,
+            MeshError::Load {
+                file: file.clone(),
+                message: e.to_string(),
+            },
+        )
+    })?;
     let mut mesh = TriangleMesh::default();
     for m in &models {
         let m = &m.mesh;
@@ -26,7 +30,7 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
             positions: m
                 .positions
                 .chunks_exact(3)
-                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .map(|c| DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
                 .collect(),
             normals: (m.normals.len() == 3 * n && n > 0).then(|| {
                 m.normals
@@ -48,5 +52,23 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
         };
         mesh.append(&part);
     }
+    // Validated here too, so that a failure can be traced back to its line.
+    mesh.validate(&file).map_err(|e| located(path, e))?;
     Ok(mesh)
+}
+
+/// `error` with the OBJ file line that causes it, when one can be found
+/// ([`super::obj_lines::first_problem`]); otherwise `error` itself.
+fn located(path: &Path, error: MeshError) -> MeshError {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return error;
+    };
+    match super::obj_lines::first_problem(&text) {
+        Some((line, message)) => MeshError::AtLine {
+            file: path.display().to_string(),
+            line,
+            message,
+        },
+        None => error,
+    }
 }

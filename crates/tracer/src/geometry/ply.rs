@@ -44,7 +44,8 @@ pub fn load_ply(path: &Path) -> Result<TriangleMesh, MeshError> {
     for (i, e) in vertices.iter().enumerate() {
         positions.push(
             vec3(e, ["x", "y", "z"])
-                .ok_or_else(|| fail(format!("vertex {i} lacks a numeric x, y or z")))?,
+                .ok_or_else(|| fail(format!("vertex {i} lacks a numeric x, y or z")))?
+                .as_dvec3(),
         );
     }
     let normals: Option<Vec<Vec3>> = vertices

@@ -47,7 +47,7 @@ pub fn subdivided_cuboid(min: DVec3, max: DVec3, n: [u32; 3]) -> TriangleMesh {
                     p[a] = side;
                     p[b] = coord(b, i);
                     p[c] = coord(c, j);
-                    mesh.positions.push(p.as_vec3());
+                    mesh.positions.push(p);
                     mesh.uvs
                         .as_mut()
                         .unwrap()
@@ -98,10 +98,7 @@ pub fn half_space(
 pub fn icosphere(centre: DVec3, radius: f64, subdivisions: u32) -> TriangleMesh {
     let (dirs, triangles) = unit_icosphere(subdivisions);
     TriangleMesh {
-        positions: dirs
-            .iter()
-            .map(|d| (centre + radius * *d).as_vec3())
-            .collect(),
+        positions: dirs.iter().map(|d| centre + radius * *d).collect(),
         normals: Some(dirs.iter().map(|d| d.as_vec3()).collect()),
         uvs: None,
         triangles,
@@ -180,7 +177,7 @@ pub fn quad(corner: DVec3, edge_u: DVec3, edge_v: DVec3) -> TriangleMesh {
         corner + edge_v,
     ];
     TriangleMesh {
-        positions: p.iter().map(|q| q.as_vec3()).collect(),
+        positions: p.to_vec(),
         normals: None,
         uvs: Some(vec![
             Vec2::new(0.0, 0.0),

@@ -22,14 +22,6 @@ impl LeafTri {
             v: [v0.to_array(), v1.to_array(), v2.to_array()],
         }
     }
-    #[inline]
-    pub fn vertex_f64(&self, i: usize) -> DVec3 {
-        DVec3::new(
-            self.v[i][0] as f64,
-            self.v[i][1] as f64,
-            self.v[i][2] as f64,
-        )
-    }
 }
 
 /// The per-ray constants of the test: the dominant axis `kz` (with `kx`, `ky` swapped when

@@ -14,7 +14,8 @@
 //! Termination: a path ends when it is absorbed (probability σa/σ̄ at each tentative collision)
 //! or leaves the object. With σa = 0 inside a *closed, finite* object every walk still leaves
 //! with probability 1 (the expected number of collisions grows like (size·σt)², e.g. ~1e6 for a
-//! unit cube at σt = 1e3); a hard cap of [`MAX_COLLISIONS`] guards against pathological inputs,
+//! unit cube at σt = 1e3); a hard cap ([`MAX_COLLISIONS`] unless [`set_collision_cap`] changes
+//! it) guards against pathological inputs,
 //! and every capped path is counted ([`PathCounters::capped`]) rather than dropped silently.
 
 use glam::DVec3;
@@ -24,8 +25,24 @@ use crate::integrator::counters::PathCounters;
 use crate::rng::Rng;
 use crate::volume::{ChannelMedium, Interaction, TrackingCounters, sample_hg, sample_interaction};
 
-/// Collisions allowed in one walk before it is stopped and counted as capped.
+/// Collisions allowed in one walk before it is stopped and counted as capped, by default.
 pub const MAX_COLLISIONS: u64 = 100_000_000;
+
+static COLLISION_CAP: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(MAX_COLLISIONS);
+
+/// Sets the collision cap of every walk started afterwards (`render`/`beam`
+/// `--max-collisions`): a walk longer than this is stopped and counted in
+/// [`PathCounters::capped`], which the commands report. A lower cap bounds the time one path can
+/// take in an optically huge medium, at the cost of the light those paths would have carried.
+pub fn set_collision_cap(cap: u64) {
+    COLLISION_CAP.store(cap.max(1), std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The collision cap in force (see [`set_collision_cap`]).
+pub fn collision_cap() -> u64 {
+    COLLISION_CAP.load(std::sync::atomic::Ordering::Relaxed)
+}
 
 /// The boundary interface of a translucent object.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -160,6 +177,7 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
         let mut origin = start;
         let mut d = dir;
         let mut collisions = 0u64;
+        let cap = collision_cap();
         let mut tracking = TrackingCounters::default();
         let end = loop {
             let Some(boundary) = self.geometry.intersect(&Ray::new(origin, d)) else {
@@ -170,7 +188,7 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
                 Interaction::Absorb { .. } => break WalkEnd::Absorbed,
                 Interaction::Scatter { t } => {
                     collisions += 1;
-                    if collisions > MAX_COLLISIONS {
+                    if collisions > cap {
                         counters.capped += 1;
                         break WalkEnd::Capped;
                     }

@@ -118,6 +118,21 @@ impl Cx {
         }
     }
 
+    /// Refuses, before they are generated, primitives whose `triangles` so far would not fit
+    /// in memory (see [`crate::memory`]).
+    fn check_tessellation(&self, triangles: f64, key: &str) -> Result<(), SceneError> {
+        crate::memory::check(
+            || {
+                format!(
+                    "the scene's primitives ({:.1} million triangles)",
+                    triangles / 1e6
+                )
+            },
+            triangles * crate::memory::BYTES_PER_TRIANGLE,
+        )
+        .map_err(|e| self.invalid(key, e.to_string()))
+    }
+
     fn invalid(&self, key: &str, message: impl Into<String>) -> SceneError {
         SceneError::Invalid {
             file: self.file.clone(),
@@ -731,7 +746,24 @@ impl Cx {
         const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\" | \"ply\"";
         let mut out: Vec<ShapePlan> = Vec::new();
         let mut names = HashSet::new();
-        for (i, (key, v)) in self.elements(t, "shape")?.into_iter().enumerate() {
+        let shapes = self.elements(t, "shape")?;
+        // The primitives' triangles, counted before any is generated.
+        let mut tessellated = 0.0;
+        for (key, v) in &shapes {
+            tessellated += match self.type_of(v, key, KINDS)? {
+                "sphere" => {
+                    let d: SphereDesc = self.de(v, key)?;
+                    20.0 * 4f64.powi(d.subdivisions.unwrap_or(5).min(9) as i32)
+                }
+                "half_space" => {
+                    let d: HalfSpaceDesc = self.de(v, key)?;
+                    2.0 * f64::from(d.subdivisions.unwrap_or(32).min(1024)).powi(2) + 10.0
+                }
+                _ => 0.0,
+            };
+            self.check_tessellation(tessellated, &format!("{key}.subdivisions"))?;
+        }
+        for (i, (key, v)) in shapes.into_iter().enumerate() {
             let k = |sub: &str| format!("{key}.{sub}");
             let (common, mesh, source) = match self.type_of(v, &key, KINDS)? {
                 "box" => {

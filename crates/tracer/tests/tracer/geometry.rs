@@ -1,6 +1,6 @@
 //! BVH queries against brute force, watertightness, crossings, counters.
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use rayon::prelude::*;
 use tracer::geometry::{Geometry, Ray, TriangleMesh, primitives};
 use tracer::rng::Rng;
@@ -15,7 +15,7 @@ fn test_geometry() -> Geometry {
         let c = DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
         for _ in 0..3 {
             let p = c + 0.4 * (DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5);
-            soup.positions.push(p.as_vec3());
+            soup.positions.push(p);
         }
         soup.triangles.push([3 * k, 3 * k + 1, 3 * k + 2]);
     }
@@ -194,14 +194,14 @@ fn closed_icosphere_has_no_leaks() {
     // Structured rays: from the exact centre through every vertex and every edge midpoint (rays
     // that run exactly along shared edges).
     let m = g.mesh(0);
-    let mut dirs: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3() - centre).collect();
+    let mut dirs: Vec<DVec3> = m.positions.iter().map(|p| *p - centre).collect();
     for t in &m.triangles {
         for e in 0..3 {
             let (a, b) = (
                 m.positions[t[e] as usize],
                 m.positions[t[(e + 1) % 3] as usize],
             );
-            dirs.push((0.5 * (a + b)).as_dvec3() - centre);
+            dirs.push(0.5 * (a + b) - centre);
         }
     }
     for d in dirs {
@@ -300,7 +300,7 @@ fn crossings_of_lines_through_a_sphere_and_a_box() {
     assert_eq!(ts.len(), 2, "{ts:?}");
     // Through a vertex of the icosphere from the centre outward: one crossing; the full line
     // through the centre and that vertex: two.
-    let v = g.mesh(0).positions[0].as_dvec3();
+    let v = g.mesh(0).positions[0];
     let d = (v - centre).normalize();
     let mut n = 0;
     g.for_each_object_hit(0, &Ray::new(centre, d), |_| n += 1);
@@ -338,7 +338,7 @@ fn empty_and_tiny_objects() {
     // absolute 1e-4, which the BVH's scaled space keeps out of the way).
     let lo = DVec3::new(1e-5, 2e-5, 3e-5);
     let tiny = primitives::cuboid(lo, lo + 1e-5);
-    let g = Geometry::build(vec![TriangleMesh::new(vec![Vec3::ZERO], vec![]), tiny]);
+    let g = Geometry::build(vec![TriangleMesh::new(vec![DVec3::ZERO], vec![]), tiny]);
     let o = lo + DVec3::new(0.5e-5, 0.5e-5, -5e-7);
     let h = g
         .intersect(&Ray::new(o, DVec3::Z))

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 use tracer::error::MeshError;
 use tracer::geometry::gltf::load_gltf;
 use tracer::geometry::obj::load_obj;
@@ -246,9 +246,9 @@ fn bunny_loads_closed() {
 fn transforms_scale_rotate_translate_in_that_order() {
     let mut m = TriangleMesh::new(
         vec![
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(0.0, 0.0, 1.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.0, 0.0, 1.0),
         ],
         vec![[0, 1, 2]],
     );
@@ -258,19 +258,7 @@ fn transforms_scale_rotate_translate_in_that_order() {
         translation: DVec3::new(0.0, 0.0, 10.0),
     });
     // (1,0,0) → scale (2,0,0) → rotate 90° about z (0,2,0) → translate (0,2,10).
-    assert!(
-        m.positions[0]
-            .as_dvec3()
-            .abs_diff_eq(DVec3::new(0.0, 2.0, 10.0), 1e-6)
-    );
-    assert!(
-        m.positions[1]
-            .as_dvec3()
-            .abs_diff_eq(DVec3::new(-3.0, 0.0, 10.0), 1e-6)
-    );
-    assert!(
-        m.positions[2]
-            .as_dvec3()
-            .abs_diff_eq(DVec3::new(0.0, 0.0, 14.0), 1e-6)
-    );
+    assert!(m.positions[0].abs_diff_eq(DVec3::new(0.0, 2.0, 10.0), 1e-6));
+    assert!(m.positions[1].abs_diff_eq(DVec3::new(-3.0, 0.0, 10.0), 1e-6));
+    assert!(m.positions[2].abs_diff_eq(DVec3::new(0.0, 0.0, 14.0), 1e-6));
 }

@@ -75,7 +75,11 @@ fn ascii_and_binary_cubes_load_closed_with_uvs() {
         std::fs::write(&p, bytes).unwrap();
         let m = load_ply(&p).unwrap();
         assert_eq!(m.triangles.len(), 12, "{name}: quads are triangulated");
-        assert_eq!(m.positions, CORNERS.map(Vec3::from).to_vec(), "{name}");
+        assert_eq!(
+            m.positions,
+            CORNERS.map(|c| Vec3::from(c).as_dvec3()).to_vec(),
+            "{name}"
+        );
         let uvs: Vec<Vec2> = (0..8).map(|i| Vec2::from(uv(i))).collect();
         assert_eq!(m.uvs.as_ref(), Some(&uvs), "{name}");
         assert!(m.normals.is_none(), "{name}: the file has no normals");
