@@ -16,9 +16,10 @@ use het_bssrdf::tracer::render::{Budget, RenderOptions, render};
 use het_bssrdf::tracer::scene::Scene;
 
 fn renders(c: &mut Criterion) {
-    let mut scene = Scene::from_toml_str(CHECKER_SLAB, std::path::Path::new("."), "checker-slab")
-        .expect("built-in scene");
-    scene.camera = scene.camera.with_resolution(32, 32).expect("positive");
+    let scene = Scene::from_toml_str(CHECKER_SLAB, std::path::Path::new("."), "checker-slab")
+        .expect("built-in scene")
+        .with_resolution(32, 32)
+        .expect("positive");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()

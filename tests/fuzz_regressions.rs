@@ -30,5 +30,5 @@ fn half_space_with_15_subdivisions_loads() {
         "fuzz_regressions/cwbvh_validation_half_space_15.toml"
     ))
     .expect("valid scene");
-    assert_eq!(scene.objects.len(), 4); // slab, box, ball, and the quad light's geometry
+    assert_eq!(scene.objects().len(), 4); // slab, box, ball, and the quad light's geometry
 }

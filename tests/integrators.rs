@@ -14,7 +14,7 @@ use tracer::render::{Budget, RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
-use crate::common::half_space::{half_space_scene, mean_and_se};
+use crate::common::half_space::{half_space_scene, half_space_scene_with, mean_and_se};
 
 #[test]
 fn path_tracer_emergent_radiance_matches_chandrasekhar() {
@@ -53,7 +53,6 @@ fn bssrdf_render_of_a_half_space_matches_the_dipole_closed_form() {
     // must return it exactly, but the field's bounds are not constant, so none of them takes
     // the constant-field short-circuit: they all project, look up and average.
     let (sigma_a, sigma_s) = (0.05, 1.0);
-    let mut scene = half_space_scene(sigma_a, sigma_s, DVec3::Z, 1.0);
     let stripes = |a: f64, b: f64| {
         Field::stripe(
             1000.0,
@@ -67,10 +66,7 @@ fn bssrdf_render_of_a_half_space_matches_the_dipole_closed_form() {
     // the field's bounds, so only a downward error (lost samples, a wrong count) can show.
     let medium = MediumField::new(stripes(sigma_a, 0.01), stripes(sigma_s, 0.2));
     assert!(!medium.is_constant());
-    let Material::Translucent(t) = &mut scene.objects[0].material else {
-        unreachable!()
-    };
-    t.medium = medium;
+    let scene = half_space_scene_with(medium, DVec3::Z, 1.0);
     let f_dr = -1.440 + 0.710 + 0.668 + 0.0636; // Egan–Hilgeman at η = 1
     let a = (1.0 + f_dr) / (1.0 - f_dr);
     let alpha = sigma_s / (sigma_a + sigma_s);
@@ -179,7 +175,7 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
         "the test wants a partial cap: r_max = {r_max}"
     );
     let x_o = scene
-        .geometry
+        .geometry()
         .intersect(&Ray::new(DVec3::new(0.1, 0.2, 5.0), DVec3::NEG_Z))
         .unwrap();
     let mut rng = Rng::from_keys(77, &[]);
@@ -191,7 +187,7 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
     let n = 200_000;
     let sums: Vec<f64> = (0..n)
         .map(|_| {
-            probe(&scene.geometry, 0, &x_o, c, &sampler, &mut rng)
+            probe(scene.geometry(), 0, &x_o, c, &sampler, &mut rng)
                 .iter()
                 .map(|h| h.weight)
                 .sum()
@@ -205,7 +201,10 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = std::f64::consts::TAU * u2;
             let d = DVec3::new(r * phi.cos(), r * phi.sin(), z);
-            let hit = scene.geometry.intersect(&Ray::new(DVec3::ZERO, d)).unwrap();
+            let hit = scene
+                .geometry()
+                .intersect(&Ray::new(DVec3::ZERO, d))
+                .unwrap();
             let inside = (hit.p - x_o.p).length() < r_max;
             let area_pdf = d.dot(hit.ng).abs() / (4.0 * std::f64::consts::PI * hit.t * hit.t);
             if inside { 1.0 / area_pdf } else { 0.0 }
@@ -243,7 +242,7 @@ fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
     use tracer::rng::Rng;
     let (sa, ss) = (0.05, 1.0);
     let scene = half_space_scene(sa, ss, DVec3::Z, 1.0);
-    let Material::Translucent(t) = &scene.objects[0].material else {
+    let Material::Translucent(t) = &scene.objects()[0].material else {
         unreachable!()
     };
     let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.0).unwrap();
@@ -252,7 +251,7 @@ fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
     let radial = table.sampler(sa, ss).unwrap();
     let r_max = radial.radius_for_fraction(PROBE_ENERGY_FRACTION);
     let x_o = scene
-        .geometry
+        .geometry()
         .intersect(&Ray::new(DVec3::new(0.3, -0.2, 1.0), DVec3::NEG_Z))
         .unwrap();
     // Equal-probability bin edges of p_r on [0, r_max], by a fine midpoint rule.
@@ -278,7 +277,7 @@ fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
     let n = 100_000;
     for _ in 0..n {
         let set = probe(
-            &scene.geometry,
+            scene.geometry(),
             0,
             &x_o,
             Coefficients::grey(sa, ss),

@@ -79,15 +79,15 @@ fn diffuse_transfer(
     use tracer::volume::direction_about;
     let scene = setup.scene().unwrap();
     let entry = scene
-        .geometry
+        .geometry()
         .intersect(&Ray::new(DVec3::new(from[0], from[1], 1.0), DVec3::NEG_Z))
         .unwrap();
-    let Material::Translucent(t) = &scene.objects[0].material else {
+    let Material::Translucent(t) = &scene.objects()[0].material else {
         unreachable!()
     };
     let view = ChannelView::new(&t.medium, 0);
     let walk = WalkMedium {
-        geometry: &scene.geometry,
+        geometry: scene.geometry(),
         object: 0,
         medium: &view,
         g: t.g,

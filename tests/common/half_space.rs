@@ -16,6 +16,12 @@ use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 /// (4 × 4 pixels), lit by a directional light travelling along `−light_to` with unit
 /// irradiance on a surface perpendicular to it.
 pub fn half_space_scene(sigma_a: f64, sigma_s: f64, light_to: DVec3, eta: f64) -> Scene {
+    let medium = MediumField::homogeneous(Coefficients::grey(sigma_a, sigma_s)).unwrap();
+    half_space_scene_with(medium, light_to, eta)
+}
+
+/// [`half_space_scene`] with any medium field.
+pub fn half_space_scene_with(medium: MediumField, light_to: DVec3, eta: f64) -> Scene {
     let n = 4;
     let camera = Camera::orthographic(
         DVec3::new(0.0, 0.0, 1.0),
@@ -27,7 +33,6 @@ pub fn half_space_scene(sigma_a: f64, sigma_s: f64, light_to: DVec3, eta: f64) -
         n,
     )
     .unwrap();
-    let medium = MediumField::homogeneous(Coefficients::grey(sigma_a, sigma_s)).unwrap();
     SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
         .light(Light::directional(-light_to.normalize(), Rgb::ONE).unwrap())
         .object(
@@ -57,7 +62,7 @@ pub fn mean_and_se(
         },
     )
     .unwrap();
-    let (w, h) = scene.camera.resolution();
+    let (w, h) = scene.camera().resolution();
     let means: Vec<f64> = (0..seeds)
         .map(|seed| {
             let r = render(

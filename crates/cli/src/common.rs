@@ -100,11 +100,11 @@ const MANY_TRIANGLES: usize = 1_000_000;
 /// Says how many triangles the scene's shapes became when that is many (spheres and other
 /// primitives are tessellated), so that a slow build or a large memory use is explained.
 pub fn note_triangles(scene: &tracer::scene::Scene) {
-    let n = scene.geometry.triangle_count();
+    let n = scene.geometry().triangle_count();
     if n >= MANY_TRIANGLES {
         eprintln!(
             "note: the scene's {} objects are {:.1} million triangles",
-            scene.geometry.object_count(),
+            scene.geometry().object_count(),
             n as f64 / 1e6
         );
     }

@@ -288,7 +288,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
     }
     let summary = summarize(&runs);
-    let title = format!("{} — error against time", scene.display_name);
+    let title = format!("{} — error against time", scene.display_name());
     write_outputs(
         out,
         &title,

@@ -79,7 +79,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(m) => m,
         None => Method::Bssrdf {
             estimator: scene
-                .settings
+                .settings()
                 .estimator
                 .unwrap_or(Estimator::Sone(SoneParams::paper())),
             profile: None,
@@ -120,12 +120,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}.exr", method.name())));
     check_writable(&out)?;
-    let (width, height) = scene.camera.resolution();
+    let (width, height) = scene.camera().resolution();
     check_image_memory(width, height, &args.scene)?;
     note_triangles(&scene);
     set_collision_cap(args.max_collisions);
     interrupt::install()?;
-    let rays_before = scene.geometry.rays_traced();
+    let rays_before = scene.geometry().rays_traced();
     let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {
         let mut film = Film::new(partial.width, partial.height);
         film.pixels = partial.mean();
@@ -133,7 +133,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             film,
             partial.spp,
             partial.seconds,
-            scene.geometry.rays_traced() - rays_before,
+            scene.geometry().rays_traced() - rays_before,
             *partial.counters,
             method.name().to_string(),
         );

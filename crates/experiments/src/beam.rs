@@ -285,7 +285,7 @@ fn entry_point(scene: &Scene) -> Result<(Hit, DVec3), SceneError> {
             message: "the scene has no beam light".into(),
         })?;
     let hit = scene
-        .geometry
+        .geometry()
         .intersect(&Ray::new(beam.origin, beam.direction))
         .ok_or_else(|| SceneError::Invalid {
             file: "<beam experiment>".into(),
@@ -306,12 +306,12 @@ pub fn trace_photons(
 ) -> Result<BeamMap, SceneError> {
     let scene = setup.scene()?;
     let (entry, dir) = entry_point(&scene)?;
-    let Material::Translucent(t) = &scene.objects[entry.object as usize].material else {
+    let Material::Translucent(t) = &scene.objects()[entry.object as usize].material else {
         unreachable!("the beam scene's only object is translucent")
     };
     let view = ChannelView::new(&t.medium, 0);
     let walk = WalkMedium {
-        geometry: &scene.geometry,
+        geometry: scene.geometry(),
         object: entry.object,
         medium: &view,
         g: t.g,
@@ -433,7 +433,7 @@ pub fn bssrdf_map(
     };
     let scene = setup.scene()?;
     let (x_i, _) = entry_point(&scene)?;
-    let Material::Translucent(t) = &scene.objects[x_i.object as usize].material else {
+    let Material::Translucent(t) = &scene.objects()[x_i.object as usize].material else {
         unreachable!("the beam scene's only object is translucent")
     };
     let family = ProfileFamily::new(profile, setup.scattering, t.g, 1.0)
@@ -460,7 +460,7 @@ pub fn bssrdf_map(
                     let x = -e + (j as f64 + (a + rng.uniform()) / sub as f64) * delta;
                     let y = e - (i as f64 + (b + rng.uniform()) / sub as f64) * delta;
                     let down = Ray::new(DVec3::new(x, y, 1.0), DVec3::NEG_Z);
-                    let Some(x_o) = scene.geometry.intersect_object(x_i.object, &down) else {
+                    let Some(x_o) = scene.geometry().intersect_object(x_i.object, &down) else {
                         c.probe_misses += 1;
                         continue;
                     };

@@ -270,14 +270,10 @@ pub fn reproduce(
     // 2. The checker slab (Figure 5).
     let slab_dir = out.join("slab");
     mkdir(&slab_dir)?;
-    let mut scene =
-        Scene::from_toml_str(CHECKER_SLAB, Path::new("."), "checker-slab.toml (built in)")?;
     let r = scale.slab_resolution;
-    scene.camera = scene
-        .camera
+    let scene = Scene::from_toml_str(CHECKER_SLAB, Path::new("."), "checker-slab.toml (built in)")?
         .with_resolution(r, r)
         .expect("positive resolution");
-    (scene.settings.width, scene.settings.height) = (r, r);
     let base = RenderJob {
         seed,
         ..RenderJob::from_scene(&scene, Method::PathTraced)

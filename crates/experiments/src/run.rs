@@ -41,10 +41,10 @@ impl RenderJob {
     pub fn from_scene(scene: &Scene, method: Method) -> Self {
         Self {
             method,
-            budget: Budget::Samples(scene.settings.spp),
-            seed: scene.settings.seed,
-            scattering: scene.settings.scattering.unwrap_or_default(),
-            max_depth: scene.settings.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
+            budget: Budget::Samples(scene.settings().spp),
+            seed: scene.settings().seed,
+            scattering: scene.settings().scattering.unwrap_or_default(),
+            max_depth: scene.settings().max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             progress: false,
         }
     }
@@ -109,7 +109,7 @@ impl RenderOutcome {
 
 /// Renders `scene` with `job`.
 pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
-    let (w, h) = scene.camera.resolution();
+    let (w, h) = scene.camera().resolution();
     let observer = crate::progress::RenderBar::new(job.method.name(), w, h, job.progress);
     let outcome = render_scene_observed(scene, job, &observer);
     observer.finish();
@@ -130,8 +130,8 @@ pub fn render_scene_observed(
             max_depth: job.max_depth,
         },
     )?;
-    let (w, h) = scene.camera.resolution();
-    let rays_before = scene.geometry.rays_traced();
+    let (w, h) = scene.camera().resolution();
+    let rays_before = scene.geometry().rays_traced();
     let Rendered {
         pixels,
         spp,
@@ -146,7 +146,7 @@ pub fn render_scene_observed(
         film,
         spp,
         seconds,
-        rays: scene.geometry.rays_traced() - rays_before,
+        rays: scene.geometry().rays_traced() - rays_before,
         counters,
         method: job.method.name().to_string(),
         warnings: integrator.warnings().to_vec(),
@@ -247,7 +247,7 @@ pub fn write_render(
         // time is the sidecar's `wall_seconds`.
     ];
     let value = json!({
-        "scene": scene.source_path.as_ref().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name.clone()),
+        "scene": scene.source_path().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name().to_string()),
         "method": outcome.method,
         "profile": profile,
         "estimator_parameters": estimator,

@@ -46,10 +46,10 @@ pub enum StudyError {
 pub fn reference_key(scene: &Scene, job: &RenderJob, spp: u32) -> std::io::Result<u64> {
     let mut h = Fnv1a::default();
     h.write(env!("CARGO_PKG_VERSION").as_bytes());
-    if let Some(p) = &scene.source_path {
+    if let Some(p) = &scene.source_path() {
         h.write(&std::fs::read(p)?);
     } else {
-        h.write(scene.display_name.as_bytes());
+        h.write(scene.display_name().as_bytes());
     }
     for p in scene.input_files() {
         h.write(p.to_string_lossy().as_bytes());

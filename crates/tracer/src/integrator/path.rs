@@ -386,8 +386,8 @@ impl<'s> PathIntegrator<'s> {
         if method == Method::PathTraced {
             scene.require_path_traceable()?;
         }
-        let mut objects = Vec::with_capacity(scene.objects.len());
-        for object in &scene.objects {
+        let mut objects = Vec::with_capacity(scene.objects().len());
+        for object in scene.objects() {
             objects.push(match &object.material {
                 Material::Translucent(t) => {
                     let bssrdf = match method {
@@ -424,7 +424,7 @@ impl<'s> PathIntegrator<'s> {
             method,
             options,
             objects,
-            lights: LightSet::new(&scene.lights),
+            lights: LightSet::new(scene.lights()),
             warnings,
             strategy: LightStrategy::Mis,
         })
@@ -468,7 +468,7 @@ impl<'s> PathIntegrator<'s> {
                     ray = Ray::new(ray.origin, dir);
                     hit
                 }
-                None => match self.scene.geometry.intersect(&ray) {
+                None => match self.scene.geometry().intersect(&ray) {
                     Some(hit) => hit,
                     None => {
                         let le = self.escaped(&ray, st.prev);
@@ -492,7 +492,7 @@ impl<'s> PathIntegrator<'s> {
                     None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
                     Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
                 },
-                ObjectKind::Opaque => match &self.scene.objects[hit.object as usize].material {
+                ObjectKind::Opaque => match &self.scene.objects()[hit.object as usize].material {
                     Material::Emissive { .. } => {
                         let le = self.emitted(&hit, &ray, st.prev);
                         st.add(st.beta * le, st.order, st.entered, filter);
@@ -523,7 +523,7 @@ impl<'s> PathIntegrator<'s> {
     /// Environment radiance along an escaped ray, MIS-weighted against light sampling.
     fn escaped(&self, ray: &Ray, prev: Prev) -> Rgb {
         let mut le = Rgb::ZERO;
-        for (i, light) in self.scene.lights.iter().enumerate() {
+        for (i, light) in self.scene.lights().iter().enumerate() {
             if let Light::Environment(_) = light {
                 let w = match prev {
                     Prev::Specular => 1.0,
@@ -540,10 +540,10 @@ impl<'s> PathIntegrator<'s> {
 
     /// Emission of an emissive object hit by chance, MIS-weighted.
     fn emitted(&self, hit: &Hit, ray: &Ray, prev: Prev) -> Rgb {
-        let Some(i) = self.scene.objects[hit.object as usize].emitter else {
+        let Some(i) = self.scene.objects()[hit.object as usize].emitter else {
             return Rgb::ZERO;
         };
-        let light = &self.scene.lights[i];
+        let light = &self.scene.lights()[i];
         let le = light.emitted(hit, -ray.dir);
         match prev {
             Prev::Specular => le,
@@ -586,7 +586,7 @@ impl<'s> PathIntegrator<'s> {
         let Some(i) = self.lights.select(u) else {
             return Direct::NONE;
         };
-        let light = &self.scene.lights[i];
+        let light = &self.scene.lights()[i];
         let Some(ls) = light.sample_li(p, u2) else {
             return Direct::NONE;
         };
@@ -634,7 +634,7 @@ impl<'s> PathIntegrator<'s> {
         let mut through_medium = false;
         for _ in 0..MAX_SHADOW_CROSSINGS {
             let ray = Ray::with_range(origin, dir, 0.0, remaining);
-            let hit = self.scene.geometry.intersect(&ray);
+            let hit = self.scene.geometry().intersect(&ray);
             if let Some(m) = inside {
                 // The segment up to the hit (or to its end) lies inside medium `m`; a ray that
                 // finds no boundary inside a closed object has leaked and is left as it is.
@@ -851,7 +851,7 @@ impl<'s> PathIntegrator<'s> {
         let channels = st.channels;
         let view = ChannelView::new(&material.medium, channels.medium_channel());
         let walk = WalkMedium {
-            geometry: &self.scene.geometry,
+            geometry: self.scene.geometry(),
             object,
             medium: &view,
             g: material.g,
@@ -957,13 +957,13 @@ impl<'s> PathIntegrator<'s> {
         }
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
-        let set = probe(&self.scene.geometry, object, hit, at_xo, &b.sampler, rng);
+        let set = probe(self.scene.geometry(), object, hit, at_xo, &b.sampler, rng);
         if set.is_empty() {
             counters.probe_misses += 1;
             return Step::Stop;
         }
         let surface = ObjectSurface {
-            geometry: &self.scene.geometry,
+            geometry: self.scene.geometry(),
             object,
         };
         let eta = material.eta;
@@ -1043,7 +1043,7 @@ impl<'s> PathIntegrator<'s> {
 impl PixelEstimator for PathIntegrator<'_> {
     type Counters = PathCounters;
     fn sample(&self, fx: f64, fy: f64, rng: &mut Rng, counters: &mut PathCounters) -> Rgb {
-        let ray = self.scene.camera.ray(fx, fy);
+        let ray = self.scene.camera().ray(fx, fy);
         self.li(ray, rng, counters)
     }
 }

@@ -9,12 +9,12 @@ use crate::scene::Scene;
 /// The warnings for rendering `scene` with `method`.
 pub fn scene_warnings(scene: &Scene, method: Method) -> Vec<String> {
     let mut warnings = Vec::new();
-    if !scene.objects.iter().any(|o| o.emitter.is_none()) {
+    if !scene.objects().iter().any(|o| o.emitter.is_none()) {
         warnings.push("the scene has no shapes: only lights seen directly can appear".to_string());
     }
-    if scene.lights.is_empty() {
+    if scene.lights().is_empty() {
         warnings.push("the scene has no lights: the image is black".to_string());
-    } else if scene.lights.iter().all(|l| matches!(l, Light::Beam(_))) {
+    } else if scene.lights().iter().all(|l| matches!(l, Light::Beam(_))) {
         warnings.push(
             "the scene's only lights are beams, which `render` does not trace (they light the \
              beam experiment): the image is black; add a directional, point, quad or \
@@ -36,21 +36,26 @@ fn unreachable_lights(scene: &Scene) -> Vec<String> {
     let refractive: Vec<String> = scene
         .translucent_objects()
         .filter(|(_, t)| t.eta != 1.0)
-        .map(|(i, t)| format!("`{}` (eta = {})", scene.objects[i as usize].name, t.eta))
+        .map(|(i, t)| format!("`{}` (eta = {})", scene.objects()[i as usize].name, t.eta))
         .collect();
     if refractive.is_empty() {
         return Vec::new();
     }
-    let (lo, hi) = scene.geometry.bounds();
+    let (lo, hi) = scene.geometry().bounds();
     let radius = if lo.x <= hi.x {
         0.5 * (hi - lo).length()
     } else {
         1.0
     };
-    let sampled = || scene.lights.iter().filter(|l| !matches!(l, Light::Beam(_)));
+    let sampled = || {
+        scene
+            .lights()
+            .iter()
+            .filter(|l| !matches!(l, Light::Beam(_)))
+    };
     let total: f64 = sampled().map(|l| l.power(radius)).sum();
     let mut warnings = Vec::new();
-    for (j, light) in scene.lights.iter().enumerate() {
+    for (j, light) in scene.lights().iter().enumerate() {
         if matches!(light, Light::Beam(_)) || !light.is_delta() {
             continue;
         }
@@ -85,10 +90,10 @@ fn hidden_cores(scene: &Scene) -> Vec<String> {
                 "object `{}` lies inside or crosses the translucent object `{}`: BSSRDF methods \
                  model `{}` as filled with its medium and do not see `{}` inside it (only where \
                  it blocks light outside); render with `--method pt` to include it",
-                scene.objects[o as usize].name,
-                scene.objects[t as usize].name,
-                scene.objects[t as usize].name,
-                scene.objects[o as usize].name
+                scene.objects()[o as usize].name,
+                scene.objects()[t as usize].name,
+                scene.objects()[t as usize].name,
+                scene.objects()[o as usize].name
             )
         })
         .collect()

@@ -39,7 +39,7 @@ use crate::light::Light;
 /// )
 /// .build()
 /// .unwrap();
-/// assert_eq!(scene.objects.len(), 1);
+/// assert_eq!(scene.objects().len(), 1);
 /// ```
 #[derive(Debug, Clone)]
 pub struct SceneBuilder {

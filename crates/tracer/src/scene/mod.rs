@@ -46,7 +46,9 @@ pub mod desc;
 
 pub use builder::SceneBuilder;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use crate::camera::CameraError;
 
 use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
@@ -160,7 +162,7 @@ impl Material {
     }
 }
 
-/// One object of the scene: `scene.geometry`'s object with the same index.
+/// One object of the scene: `scene.geometry()`'s object with the same index.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Object {
     /// Object name (`shape[i]` by default, `light[j]` for quad lights).
@@ -169,7 +171,7 @@ pub struct Object {
     pub material: Material,
     /// Topology of its mesh (closedness, orientation).
     pub report: MeshReport,
-    /// Index into `scene.lights` when the object is a light's geometry.
+    /// Index into `scene.lights()` when the object is a light's geometry.
     pub emitter: Option<usize>,
     /// Key in the scene file (`shape[3]`, `light[0]`).
     pub key: String,
@@ -182,25 +184,53 @@ pub struct Object {
 /// A validated scene: camera, lights, objects with their materials, and the geometry.
 #[derive(Debug)]
 pub struct Scene {
-    /// The camera (its resolution equals `settings.width × settings.height`).
-    pub camera: Camera,
-    /// Every light (quad lights are also objects).
-    pub lights: Vec<Light>,
-    /// Objects; `objects[i]` is object `i` of `geometry`.
-    pub objects: Vec<Object>,
-    /// The meshes and their BVHs.
-    pub geometry: Geometry,
-    /// `[render]`.
-    pub settings: RenderSettings,
-    /// The scene file, when loaded from one.
-    pub source_path: Option<PathBuf>,
-    /// The name used in messages (the file path, or the builder's name).
-    pub display_name: String,
-    /// The mesh and texture files read while loading.
+    camera: Camera,
+    lights: Vec<Light>,
+    objects: Vec<Object>,
+    geometry: Geometry,
+    settings: RenderSettings,
+    source_path: Option<PathBuf>,
+    display_name: String,
     inputs: Vec<PathBuf>,
 }
 
 impl Scene {
+    /// The camera. Its resolution is always `settings().width × settings().height`.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+    /// Every light (quad lights are also objects).
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+    /// The objects: `objects()[i]` is object `i` of [`Scene::geometry`].
+    pub fn objects(&self) -> &[Object] {
+        &self.objects
+    }
+    /// The meshes and their BVHs.
+    pub fn geometry(&self) -> &Geometry {
+        &self.geometry
+    }
+    /// `[render]`.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+    /// The scene file, when loaded from one.
+    pub fn source_path(&self) -> Option<&Path> {
+        self.source_path.as_deref()
+    }
+    /// The name used in messages (the file path, or the builder's name).
+    pub fn display_name(&self) -> &str {
+        &self.display_name
+    }
+    /// The same scene rendered at `width × height` pixels: the camera and `[render]` change
+    /// together, so that they always agree. A zero size is an error.
+    pub fn with_resolution(mut self, width: u32, height: u32) -> Result<Self, CameraError> {
+        self.camera = self.camera.with_resolution(width, height)?;
+        (self.settings.width, self.settings.height) = (width, height);
+        Ok(self)
+    }
+
     /// The files read while loading besides the scene file itself: every mesh, and every
     /// texture of a used material (for cache keys and provenance).
     pub fn input_files(&self) -> &[PathBuf] {

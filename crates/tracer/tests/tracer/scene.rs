@@ -191,78 +191,78 @@ fn load_full() -> (tempfile::TempDir, Scene) {
 fn full_scene_loads() {
     let (dir, s) = load_full();
     assert_eq!(
-        s.source_path.as_deref(),
+        s.source_path(),
         Some(dir.path().join("full.toml").as_path())
     );
-    let r = &s.settings;
+    let r = &s.settings();
     assert_eq!(
         (r.width, r.height, r.spp, r.seed, r.max_depth),
         (64, 48, 16, 7, Some(256))
     );
     assert_eq!(r.estimator.map(|e| e.name()), Some("sone"));
     assert_eq!(r.scattering, Some(Scattering::Multiple));
-    assert!(matches!(s.camera, Camera::Perspective(_)));
-    assert_eq!(s.camera.resolution(), (64, 48));
-    assert_eq!(s.lights.len(), 5);
+    assert!(matches!(s.camera(), Camera::Perspective(_)));
+    assert_eq!(s.camera().resolution(), (64, 48));
+    assert_eq!(s.lights().len(), 5);
     assert_eq!(s.beams().count(), 1);
     // 5 shapes + the quad light.
-    assert_eq!(s.objects.len(), 6);
-    assert_eq!(s.geometry.object_count(), 6);
-    let names: Vec<&str> = s.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(s.objects().len(), 6);
+    assert_eq!(s.geometry().object_count(), 6);
+    let names: Vec<&str> = s.objects().iter().map(|o| o.name.as_str()).collect();
     assert_eq!(
         names,
         ["slab", "shape[1]", "ball", "cube", "tet", "light[2]"]
     );
-    let quad = &s.objects[5];
+    let quad = &s.objects()[5];
     assert_eq!(quad.emitter, Some(2));
     assert!(matches!(quad.material, Material::Emissive { .. }));
-    let Light::Quad(q) = s.lights[2] else {
+    let Light::Quad(q) = s.lights()[2] else {
         panic!()
     };
     assert_eq!(q.object, Some(5));
     // The quad is hittable by a camera ray from below.
     let h = s
-        .geometry
+        .geometry()
         .intersect(&Ray::new(DVec3::new(0.0, 0.0, 29.0), DVec3::Z))
         .unwrap();
     assert_eq!(h.object, 5);
-    assert!(s.lights[2].emitted(&h, DVec3::NEG_Z) == Rgb::splat(4.0));
+    assert!(s.lights()[2].emitted(&h, DVec3::NEG_Z) == Rgb::splat(4.0));
 
     // Materials.
-    let Material::Translucent(stripes) = &s.objects[0].material else {
+    let Material::Translucent(stripes) = &s.objects()[0].material else {
         panic!()
     };
     assert_eq!(stripes.profile, Some(ProfileModel::Dipole));
     assert!(matches!(stripes.medium.sigma_a(), Field::Pattern { .. }));
     assert!(stripes.medium.is_grey() && stripes.medium.is_volumetric());
-    let Material::Translucent(checker) = &s.objects[1].material else {
+    let Material::Translucent(checker) = &s.objects()[1].material else {
         panic!()
     };
     assert!(!checker.medium.is_grey());
     assert_eq!((checker.g, checker.eta), (0.3, 1.3));
-    let Material::Translucent(marble) = &s.objects[2].material else {
+    let Material::Translucent(marble) = &s.objects()[2].material else {
         panic!()
     };
     assert_eq!(marble.unit_scale, 10.0);
     // sigma_s = 10 · 2 · texel: the EXR's largest texel is 3.
     assert_eq!(marble.medium.sigma_s().max(), Rgb::splat(60.0));
-    let Material::Translucent(painted) = &s.objects[3].material else {
+    let Material::Translucent(painted) = &s.objects()[3].material else {
         panic!()
     };
     assert!(!painted.medium.is_volumetric());
-    assert!(matches!(s.objects[4].material, Material::Diffuse { .. }));
+    assert!(matches!(s.objects()[4].material, Material::Diffuse { .. }));
 
     // Geometry: the half-space top at z = 0, the box translated, the cube scaled.
-    let (lo, hi) = s.geometry.object_bounds(0);
+    let (lo, hi) = s.geometry().object_bounds(0);
     assert_eq!((lo.z, hi.z), (-100.0, 0.0));
-    let (lo, _) = s.geometry.object_bounds(1);
+    let (lo, _) = s.geometry().object_bounds(1);
     assert!(lo.abs_diff_eq(DVec3::new(18.0, -2.0, 0.0), 1e-6));
-    let (lo, hi) = s.geometry.object_bounds(3);
+    let (lo, hi) = s.geometry().object_bounds(3);
     assert!(
         lo.abs_diff_eq(DVec3::new(0.0, 20.0, 0.0), 1e-6)
             && hi.abs_diff_eq(DVec3::new(2.0, 22.0, 2.0), 1e-6)
     );
-    assert!(s.objects.iter().take(5).all(|o| o.report.is_closed()));
+    assert!(s.objects().iter().take(5).all(|o| o.report.is_closed()));
 
     // The stripe field read on the slab's surface is the shared pattern at (x, y).
     let pat = het_estimate::pattern::Stripe {
@@ -272,7 +272,7 @@ fn full_scene_loads() {
     use het_estimate::pattern::BinaryPattern;
     for (x, y) in [(0.3, 0.1), (1.2, 0.4), (-3.0, 2.2), (7.5, -1.0)] {
         let h = s
-            .geometry
+            .geometry()
             .intersect_object(0, &Ray::new(DVec3::new(x, y, 10.0), DVec3::NEG_Z))
             .unwrap();
         let c = stripes.medium.coefficients(&h);
@@ -344,7 +344,7 @@ max = [1.0, 1.0, 0.0]
 #[test]
 fn minimal_scene_loads_and_orthographic_camera_works() {
     let s = Scene::from_toml_str(MINIMAL, Path::new("."), "minimal.toml").unwrap();
-    let r = s.camera.ray(0.5, 0.5);
+    let r = s.camera().ray(0.5, 0.5);
     assert!(r.origin.abs_diff_eq(
         DVec3::new(-10.0 / 2.0 + 10.0 / 16.0, 5.0 - 10.0 / 16.0, 5.0),
         1e-12
