@@ -86,25 +86,6 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
     }
 }
 
-/// The error and its causes joined by `: `, outermost first, like `{err:#}`, except that a
-/// cause whose text the message already contains is skipped: the library's error types print
-/// their source in their own message (`cannot read `x`: No such file…`) and also return it
-/// from `source()`, which `{err:#}` would print a second time.
-fn message(err: &anyhow::Error) -> String {
-    let mut msg = String::new();
-    for cause in err.chain() {
-        let text = cause.to_string();
-        if msg.contains(&text) {
-            continue;
-        }
-        if !msg.is_empty() {
-            msg.push_str(": ");
-        }
-        msg.push_str(&text);
-    }
-    msg
-}
-
 fn main() -> ExitCode {
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
@@ -112,7 +93,9 @@ fn main() -> ExitCode {
     match run(cli, given) {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {}", message(&err));
+            // The libraries' errors do not repeat their sources in their messages (they return
+            // them from `source()`), so the cause chain prints each cause once.
+            eprintln!("error: {err:#}");
             ExitCode::from(interrupt::exit_status().unwrap_or(1))
         }
     }

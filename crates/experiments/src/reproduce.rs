@@ -114,7 +114,7 @@ pub enum ReproduceError {
     #[error(transparent)]
     Write(#[from] WriteError),
     /// Creating a directory.
-    #[error("cannot create the directory `{path}`: {source}")]
+    #[error("cannot create the directory `{path}`")]
     Dir {
         /// The directory.
         path: PathBuf,

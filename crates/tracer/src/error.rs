@@ -107,7 +107,7 @@ pub enum MeshError {
 #[non_exhaustive]
 pub enum TextureError {
     /// The file cannot be opened or read.
-    #[error("{file}: cannot read texture: {source}")]
+    #[error("{file}: cannot read texture")]
     Io {
         /// Image file.
         file: String,
@@ -218,7 +218,7 @@ pub enum SceneError {
         message: String,
     },
     /// A file (the scene itself, a mesh or a texture) cannot be read.
-    #[error("{}: cannot read `{}`: {source}", Loc(file, key, line), path.display())]
+    #[error("{}: cannot read `{}`", Loc(file, key, line), path.display())]
     Io {
         /// Scene file.
         file: PathBuf,
@@ -232,7 +232,7 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// A mesh is unusable.
-    #[error("{}: {source}", Loc(file, key, line))]
+    #[error("{}", Loc(file, key, line))]
     Mesh {
         /// Scene file.
         file: PathBuf,
@@ -244,7 +244,7 @@ pub enum SceneError {
         source: Box<MeshError>,
     },
     /// A texture is unusable.
-    #[error("{}: {source}", Loc(file, key, line))]
+    #[error("{}", Loc(file, key, line))]
     Texture {
         /// Scene file.
         file: PathBuf,
@@ -339,7 +339,7 @@ pub enum OutputError {
         parent: PathBuf,
     },
     /// Any other I/O failure (permission denied, disk full…).
-    #[error("cannot {action} `{}`: {source}", path.display())]
+    #[error("cannot {action} `{}`", path.display())]
     Io {
         /// The path.
         path: PathBuf,

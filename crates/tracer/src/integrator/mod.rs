@@ -21,7 +21,7 @@ pub enum RenderError {
     #[error(transparent)]
     Scene(#[from] crate::error::SceneError),
     /// A material's parameters are invalid for the chosen profile or estimator.
-    #[error("object `{object}`: invalid {what}: {source}")]
+    #[error("object `{object}`: invalid {what}")]
     Param {
         /// The object.
         object: String,

@@ -303,9 +303,15 @@ fn load_err(text: &str) -> SceneError {
     }
 }
 
-/// Asserts the error names bad.toml and `key`, and contains `words`.
+/// Asserts the error names bad.toml and `key`, and its cause chain contains `words` (the
+/// message itself does not repeat its source, which `source()` returns).
 fn check(e: &SceneError, key: &str, words: &[&str]) {
-    let msg = e.to_string();
+    let mut msg = e.to_string();
+    let mut cause = std::error::Error::source(e);
+    while let Some(c) = cause {
+        msg = format!("{msg}: {c}");
+        cause = c.source();
+    }
     assert!(msg.contains("bad.toml"), "no file name in: {msg}");
     assert_eq!(e.key(), key, "{msg}");
     assert!(msg.contains(&format!("`{key}`")), "no key in: {msg}");
