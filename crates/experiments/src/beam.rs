@@ -324,11 +324,12 @@ pub fn trace_photons(
     let mut exits = ExitCounts::default();
     let mut counters = PathCounters::default();
     let mut batches_done = 0u64;
-    let mut next = match budget {
-        PhotonBudget::Count(p) => p.div_ceil(BATCH).max(1),
-        PhotonBudget::Time(_) => 1,
+    let (total, limit) = match budget {
+        PhotonBudget::Count(p) => (Some(p.div_ceil(BATCH).max(1)), None),
+        PhotonBudget::Time(t) => (None, Some(t.as_secs_f64())),
     };
-    loop {
+    let mut next = 1;
+    while next > 0 {
         let pass_start = Instant::now();
         // After an interrupt (crate::interrupt) the batches not yet started are skipped; the
         // completed ones are kept and counted, so the map stays normalised by its photons.
@@ -391,14 +392,14 @@ pub fn trace_photons(
         if tracer::interrupt::requested() {
             break;
         }
-        let PhotonBudget::Time(limit) = budget else {
-            break;
-        };
         let per_batch = pass_start.elapsed().as_secs_f64() / next as f64;
-        if start.elapsed().as_secs_f64() + per_batch * batches_done as f64 > limit.as_secs_f64() {
-            break;
-        }
-        next = batches_done;
+        next = tracer::render::next_pass_size(
+            batches_done,
+            per_batch,
+            start.elapsed().as_secs_f64(),
+            total,
+            limit,
+        );
     }
     let photons = exits.photons as f64;
     let norm = 1.0 / (photons * delta * delta);

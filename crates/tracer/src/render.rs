@@ -239,28 +239,47 @@ pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Size
     }
 }
 
-/// The size of the pass after `done` samples per pixel (0: stop): double the samples so far,
-/// but no more than [`PASS_SECONDS`] of predicted work, nor past the budget. A time budget stops
-/// when the next pass is predicted to overshoot it.
+/// The size of the pass after `done` samples per pixel (0: stop); see [`next_pass_size`].
 fn next_pass(budget: Budget, done: u32, per_sample: f64, elapsed: f64) -> u32 {
-    let by_time = if per_sample > 0.0 {
-        (PASS_SECONDS / per_sample)
+    let (total, limit) = match budget {
+        Budget::Samples(total) => (Some(u64::from(total.max(1))), None),
+        Budget::Time(limit) => (None, Some(limit.as_secs_f64())),
+    };
+    let pass = next_pass_size(u64::from(done), per_sample, elapsed, total, limit);
+    // A time budget stops before the sample count could overflow.
+    if limit.is_some() && done >= u32::MAX / 2 {
+        return 0;
+    }
+    u32::try_from(pass).unwrap_or(u32::MAX / 2)
+}
+
+/// The schedule of work done in passes, shared by every renderer that takes a budget (the
+/// render loop's samples per pixel, the beam experiment's photon batches): after `done` units,
+/// which took `per_unit` seconds each and `elapsed` seconds in all, the next pass doubles the
+/// work so far, but holds no more than about 2 s of predicted work (so that an interrupt
+/// loses little and checkpoints come regularly) and no more than what is left of a fixed
+/// `total`. Under a time `limit` (seconds) it is 0 — stop — when it is predicted to overshoot.
+/// Always at least 1 unit until the budget is spent. Passes never change a result: every unit
+/// draws from its own random stream.
+pub fn next_pass_size(
+    done: u64,
+    per_unit: f64,
+    elapsed: f64,
+    total: Option<u64>,
+    limit: Option<f64>,
+) -> u64 {
+    let by_time = if per_unit > 0.0 {
+        (PASS_SECONDS / per_unit)
             .floor()
-            .clamp(1.0, f64::from(u32::MAX)) as u32
+            .clamp(1.0, u64::MAX as f64) as u64
     } else {
-        u32::MAX
+        u64::MAX
     };
     let pass = done.min(by_time).max(1);
-    match budget {
-        Budget::Samples(total) => pass.min(total.max(1).saturating_sub(done)),
-        Budget::Time(limit) => {
-            if done >= u32::MAX / 2 || elapsed + per_sample * f64::from(pass) > limit.as_secs_f64()
-            {
-                0
-            } else {
-                pass
-            }
-        }
+    match (total, limit) {
+        (Some(total), _) => pass.min(total.saturating_sub(done)),
+        (None, Some(limit)) if elapsed + per_unit * pass as f64 > limit => 0,
+        _ => pass,
     }
 }
 

@@ -162,6 +162,15 @@ impl Channels {
     }
 }
 
+/// A cosine-distributed direction about the unit normal `n` (pdf `cos/π`, pbrt-v4 §A.5.3 by
+/// the `cos = √u` inversion) and its cosine; `None` at grazing (`cos = 0`), where the pdf
+/// vanishes. The continuation of both a diffuse bounce and a BSSRDF's incident side.
+fn cosine_continuation(n: DVec3, rng: &mut Rng) -> Option<(DVec3, f64)> {
+    let u = rng.uniform2();
+    let cos = u[0].sqrt();
+    (cos > 0.0).then(|| (direction_about(n, cos, std::f64::consts::TAU * u[1]), cos))
+}
+
 /// A shadow ray toward a light sample, measured from the ray's actual origin.
 ///
 /// The origin is the shading point moved off its surface ([`Hit::spawn_origin`]), which on a
@@ -743,12 +752,9 @@ impl<'s> PathIntegrator<'s> {
             st.entered || ld.through_medium,
             self.options.scattering,
         );
-        let u = rng.uniform2();
-        let cos = u[0].sqrt();
-        let wi = direction_about(n, cos, std::f64::consts::TAU * u[1]);
-        if cos <= 0.0 {
+        let Some((wi, cos)) = cosine_continuation(n, rng) else {
             return Step::Stop;
-        }
+        };
         st.beta *= albedo;
         st.prev = Prev::Sampled {
             p: hit.p,
@@ -1016,12 +1022,9 @@ impl<'s> PathIntegrator<'s> {
         if st.beta.is_zero() {
             return Step::Stop;
         }
-        let u = rng.uniform2();
-        let cos = u[0].sqrt();
-        if cos <= 0.0 {
+        let Some((wi, cos)) = cosine_continuation(x_i.ns, rng) else {
             return Step::Stop;
-        }
-        let wi = direction_about(x_i.ns, cos, std::f64::consts::TAU * u[1]);
+        };
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= sw(cos) * std::f64::consts::PI;
         st.prev = Prev::Sampled {
