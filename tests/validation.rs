@@ -72,10 +72,10 @@ fn diffuse_transfer(
     use glam::DVec3;
     use tracer::geometry::Ray;
     use tracer::integrator::PathCounters;
-    use tracer::integrator::path::ChannelView;
     use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
     use tracer::rng::Rng;
     use tracer::scene::Material;
+    use tracer::volume::ChannelView;
     use tracer::volume::direction_about;
     let scene = setup.scene().unwrap();
     let entry = scene

@@ -20,7 +20,7 @@
 
 use std::time::{Duration, Instant};
 
-use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
+use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::Estimator;
 use rayon::prelude::*;
@@ -31,12 +31,12 @@ use tracer::error::SceneError;
 use tracer::field::{Field, MediumField, PlanarProjection};
 use tracer::geometry::{Hit, Ray, primitives};
 use tracer::integrator::PathCounters;
-use tracer::integrator::path::ChannelView;
 use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
 use tracer::light::Light;
 use tracer::render::Counters;
 use tracer::rng::Rng;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+use tracer::volume::ChannelView;
 
 /// Side of the box standing in for the half-space (scene units), and its depth. With
 /// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
@@ -437,11 +437,9 @@ pub fn bssrdf_map(
     let Material::Translucent(t) = &scene.objects()[x_i.object as usize].material else {
         unreachable!("the beam scene's only object is translucent")
     };
-    let family = ProfileFamily::new(profile, setup.scattering, t.g, 1.0)
-        .map_err(|e| bad("profile", e.to_string()))?;
-    let prepared = estimator
-        .prepare(t.g)
-        .map_err(|e| bad("estimator", e.to_string()))?;
+    let (family, prepared) = t
+        .prepare_bssrdf(Some(profile), setup.scattering, estimator)
+        .map_err(|(what, e)| bad(what, e.to_string()))?;
     let surface = scene.object_surface(x_i.object);
     let n = setup.resolution as usize;
     let sub = sub.max(1);

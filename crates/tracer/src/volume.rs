@@ -18,6 +18,7 @@
 
 use glam::DVec3;
 
+use crate::field::MediumField;
 use crate::rng::Rng;
 
 /// Ratio tracking plays Russian roulette once the transmittance estimate drops below this.
@@ -146,6 +147,49 @@ pub fn direction_about(axis: DVec3, cos_theta: f64, phi: f64) -> DVec3 {
 pub fn sample_hg(dir: DVec3, g: f64, rng: &mut Rng) -> DVec3 {
     let cos_theta = bssrdf_core::hg::sample_cos_theta(g, rng.uniform());
     direction_about(dir, cos_theta, std::f64::consts::TAU * rng.uniform())
+}
+
+/// One colour channel of a scene's [`MediumField`] as a [`ChannelMedium`]: what delta and
+/// ratio tracking see (the path tracer's walk, its shadow rays, the beam experiment).
+pub struct ChannelView<'a> {
+    field: &'a MediumField,
+    channel: usize,
+    majorant: f64,
+    constant: Option<(f64, f64)>,
+}
+
+impl<'a> ChannelView<'a> {
+    /// Channel `channel` of `field`.
+    pub fn new(field: &'a MediumField, channel: usize) -> Self {
+        let majorant = field.majorant()[channel];
+        let constant = field.is_constant().then(|| {
+            let c = field.at_point(DVec3::ZERO);
+            (c.sigma_a[channel], c.sigma_s[channel])
+        });
+        Self {
+            field,
+            channel,
+            majorant,
+            constant,
+        }
+    }
+}
+
+impl ChannelMedium for ChannelView<'_> {
+    #[inline]
+    fn coefficients(&self, p: DVec3) -> (f64, f64) {
+        if let Some(c) = self.constant {
+            return c;
+        }
+        let c = self.field.at_point(p);
+        (c.sigma_a[self.channel], c.sigma_s[self.channel])
+    }
+    fn majorant(&self) -> f64 {
+        self.majorant
+    }
+    fn constant(&self) -> Option<(f64, f64)> {
+        self.constant
+    }
 }
 
 #[cfg(test)]

@@ -31,7 +31,6 @@ use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator, PreparedEstimator};
 
-use crate::field::MediumField;
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::counters::PathCounters;
@@ -42,7 +41,7 @@ use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
 use crate::scene::{Material, Scene, Translucent};
-use crate::volume::{ChannelMedium, direction_about, transmittance};
+use crate::volume::{ChannelView, direction_about, transmittance};
 
 /// Russian roulette starts after this many surface interactions.
 const RR_DEPTH: u32 = 3;
@@ -80,48 +79,6 @@ pub struct PathOptions {
     pub scattering: Scattering,
     /// Most surface interactions per path.
     pub max_depth: u32,
-}
-
-/// A channel of a medium field, as the tracking routines see it.
-pub struct ChannelView<'a> {
-    field: &'a MediumField,
-    channel: usize,
-    majorant: f64,
-    constant: Option<(f64, f64)>,
-}
-
-impl<'a> ChannelView<'a> {
-    /// Channel `channel` of `field`.
-    pub fn new(field: &'a MediumField, channel: usize) -> Self {
-        let majorant = field.majorant()[channel];
-        let constant = field.is_constant().then(|| {
-            let c = field.at_point(DVec3::ZERO);
-            (c.sigma_a[channel], c.sigma_s[channel])
-        });
-        Self {
-            field,
-            channel,
-            majorant,
-            constant,
-        }
-    }
-}
-
-impl ChannelMedium for ChannelView<'_> {
-    #[inline]
-    fn coefficients(&self, p: DVec3) -> (f64, f64) {
-        if let Some(c) = self.constant {
-            return c;
-        }
-        let c = self.field.at_point(p);
-        (c.sigma_a[self.channel], c.sigma_s[self.channel])
-    }
-    fn majorant(&self) -> f64 {
-        self.majorant
-    }
-    fn constant(&self) -> Option<(f64, f64)> {
-        self.constant
-    }
 }
 
 /// BSSRDF data of one translucent object, prepared once per render.
@@ -402,12 +359,9 @@ impl<'s> PathIntegrator<'s> {
                     let bssrdf = match method {
                         Method::PathTraced => None,
                         Method::Bssrdf { estimator, profile } => {
-                            let model = profile.or(t.profile).unwrap_or(ProfileModel::Dipole);
-                            let family = ProfileFamily::new(model, options.scattering, t.g, t.eta)
-                                .map_err(|e| RenderError::param(&object.name, "profile", e))?;
-                            let estimator = estimator
-                                .prepare(t.g)
-                                .map_err(|e| RenderError::param(&object.name, "estimator", e))?;
+                            let (family, estimator) = t
+                                .prepare_bssrdf(profile, options.scattering, estimator)
+                                .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
                             let sw_norm =
                                 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / t.eta);
                             Some(Box::new(BssrdfObject {

@@ -50,8 +50,9 @@ use std::path::{Path, PathBuf};
 
 use crate::camera::CameraError;
 
-use bssrdf_core::{ProfileModel, Rgb, Scattering};
+use bssrdf_core::{ParamError, ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
+use het_estimate::{Estimator, PreparedEstimator};
 
 use crate::camera::Camera;
 use crate::error::SceneError;
@@ -115,6 +116,23 @@ pub struct Translucent {
 }
 
 impl Translucent {
+    /// What a BSSRDF render of this material prepares once: the profile family of `model` (or
+    /// the material's own `profile`, or the dipole) counting `scattering`, with the material's
+    /// g and η, and `estimator` prepared for its g. The error names the failing part
+    /// (`"profile"` or `"estimator"`).
+    pub fn prepare_bssrdf(
+        &self,
+        model: Option<ProfileModel>,
+        scattering: Scattering,
+        estimator: Estimator,
+    ) -> Result<(ProfileFamily, PreparedEstimator), (&'static str, ParamError)> {
+        let model = model.or(self.profile).unwrap_or(ProfileModel::Dipole);
+        let family =
+            ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
+        let prepared = estimator.prepare(self.g).map_err(|e| ("estimator", e))?;
+        Ok((family, prepared))
+    }
+
     /// A translucent material with no profile and unit scale 1 (validated when the scene is
     /// built).
     pub fn new(name: impl Into<String>, medium: MediumField, g: f64, eta: f64) -> Self {
