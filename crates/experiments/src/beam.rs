@@ -505,16 +505,18 @@ pub fn write_beam_map(
     extra: serde_json::Value,
 ) -> Result<(), crate::error::WriteError> {
     let n = map.resolution;
-    tracer::output::write_grey_exr(n, n, &map.values, exr)?;
+    // Small files first, images last, renamed into place together or not at all.
+    let mut set = tracer::output::OutputSet::new();
+    let exr_bytes = tracer::output::grey_exr_bytes(n, n, &map.values, exr)?;
     #[cfg(feature = "plot")]
-    {
-        use crate::plot::{MapPlot, MapScale, map_png};
+    let png_bytes = {
+        use crate::plot::{MapPlot, MapScale, map_png_bytes};
         let e = map.extent;
         let title = match &map.profile {
             Some(p) => format!("{} ({p})", map.method),
             None => map.method.clone(),
         };
-        map_png(
+        map_png_bytes(
             &exr.with_extension("png"),
             &MapPlot {
                 values: &map.values,
@@ -525,8 +527,8 @@ pub fn write_beam_map(
                 title: &title,
                 label: "exitance per unit power (1/area)",
             },
-        )?;
-    }
+        )?
+    };
     let mut value = serde_json::json!({
         "setup": setup,
         "map": map,
@@ -543,10 +545,15 @@ pub fn write_beam_map(
     if let (Some(obj), serde_json::Value::Object(more)) = (value.as_object_mut(), extra) {
         obj.extend(more);
     }
-    tracer::output::write_json(
-        &crate::provenance::stamped(value),
-        &exr.with_extension("json"),
-    )?;
+    let json = exr.with_extension("json");
+    set.add(
+        &json,
+        tracer::output::json_bytes(&crate::provenance::stamped(value), &json)?,
+    );
+    #[cfg(feature = "plot")]
+    set.add(&exr.with_extension("png"), png_bytes);
+    set.add(exr, exr_bytes);
+    set.commit()?;
     Ok(())
 }
 
@@ -568,5 +575,46 @@ pub fn run_method(
             estimator,
             profile: p,
         } => bssrdf_map(setup, estimator, p.unwrap_or(profile), sub, seed, progress),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The EXR, PNG and JSON of a beam map are committed together: when one destination cannot
+    /// be written (here the sidecar's path is a directory), none of the three is left behind.
+    #[test]
+    fn a_beam_map_is_written_whole_or_not_at_all() {
+        let mut setup = BeamSetup::paper(BeamTexture::preset("stripe").unwrap());
+        setup.resolution = 8;
+        let method: tracer::integrator::Method = "jensen-out".parse().unwrap();
+        let map = run_method(
+            &setup,
+            method,
+            ProfileModel::Dipole,
+            PhotonBudget::Count(1),
+            1,
+            1,
+            &|_| {},
+        )
+        .unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let exr = dir.path().join("m.exr");
+        std::fs::create_dir(dir.path().join("m.json")).unwrap();
+        assert!(write_beam_map(&map, &setup, &exr, serde_json::json!({})).is_err());
+        let left: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, vec![std::ffi::OsString::from("m.json")], "{left:?}");
+        // With a free destination all three appear.
+        let exr = dir.path().join("ok.exr");
+        write_beam_map(&map, &setup, &exr, serde_json::json!({})).unwrap();
+        for ext in ["exr", "json"] {
+            assert!(exr.with_extension(ext).is_file(), "{ext}");
+        }
+        #[cfg(feature = "plot")]
+        assert!(exr.with_extension("png").is_file());
     }
 }

@@ -154,6 +154,12 @@ fn lerp_stops(stops: &[(f64, [f64; 3])], t: f64) -> RGBColor {
 }
 
 fn encode_png(path: &Path, buf: Vec<u8>, w: u32, h: u32) -> Result<(), PlotError> {
+    write_atomic(path, &png_of(path, buf, w, h)?)?;
+    Ok(())
+}
+
+/// The PNG encoding of an RGB buffer (`path` is named in errors only).
+fn png_of(path: &Path, buf: Vec<u8>, w: u32, h: u32) -> Result<Vec<u8>, PlotError> {
     let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| draw_err(path, "bad buffer"))?;
     let mut bytes = Vec::new();
     img.write_to(
@@ -161,8 +167,7 @@ fn encode_png(path: &Path, buf: Vec<u8>, w: u32, h: u32) -> Result<(), PlotError
         image::ImageFormat::Png,
     )
     .map_err(|e| draw_err(path, e))?;
-    write_atomic(path, &bytes)?;
-    Ok(())
+    Ok(bytes)
 }
 
 /// A false-colour map to plot.
@@ -186,6 +191,12 @@ pub struct MapPlot<'a> {
 
 /// Writes a false-colour PNG of a map with a colour bar.
 pub fn map_png(path: &Path, map: &MapPlot<'_>) -> Result<(), PlotError> {
+    write_atomic(path, &map_png_bytes(path, map)?)?;
+    Ok(())
+}
+
+/// The bytes [`map_png`] writes (`path` is named in errors only).
+pub fn map_png_bytes(path: &Path, map: &MapPlot<'_>) -> Result<Vec<u8>, PlotError> {
     let MapPlot {
         values,
         width,
@@ -237,7 +248,7 @@ pub fn map_png(path: &Path, map: &MapPlot<'_>) -> Result<(), PlotError> {
         colour_bar(&bar, scale, label).map_err(|e| draw_err(path, e))?;
         root.present().map_err(|e| draw_err(path, e))?;
     }
-    encode_png(path, buf, w, h)
+    png_of(path, buf, w, h)
 }
 
 /// Font size (pixels) of tick labels and axis titles: legible at the PNGs' size.

@@ -431,6 +431,16 @@ pub fn write_grey_exr(
     values: &[f64],
     path: &Path,
 ) -> Result<(), OutputError> {
+    write_atomic(path, &grey_exr_bytes(width, height, values, path)?)
+}
+
+/// The bytes [`write_grey_exr`] writes (`path` is named in errors only).
+pub fn grey_exr_bytes(
+    width: u32,
+    height: u32,
+    values: &[f64],
+    path: &Path,
+) -> Result<Vec<u8>, OutputError> {
     #[cfg(feature = "exr")]
     {
         use exr::prelude::*;
@@ -444,10 +454,7 @@ pub fn write_grey_exr(
             fixed_order(),
             channels,
         );
-        write_atomic(
-            path,
-            &encode_exr(path, |bytes| image.write().to_buffered(bytes))?,
-        )
+        encode_exr(path, |bytes| image.write().to_buffered(bytes))
     }
     #[cfg(not(feature = "exr"))]
     {
