@@ -260,6 +260,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .collect();
     let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
     let mut finals = Vec::new();
+    let mut log = RunLog::new(out);
     let runs = scene_study(
         &scene,
         &RenderJob {
@@ -271,10 +272,21 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         &reference,
         |run, outcome| {
             bar.inc(1);
+            bar.suspend(|| log.record(run));
             keep_latest(&mut finals, &run.method, outcome.clone());
         },
     )?;
     bar.finish_and_clear();
+    // Results first (they are small and the point of the run), images last.
+    let summary = summarize(&runs);
+    let title = format!("{} — error against time", scene.display_name());
+    write_outputs(
+        out,
+        &title,
+        &runs,
+        &summary,
+        serde_json::json!({ "scene": file.display().to_string(), "reference_spp": args.reference_spp }),
+    )?;
     for (name, outcome) in &finals {
         let method = *methods
             .iter()
@@ -287,21 +299,36 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         };
         write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
     }
-    let summary = summarize(&runs);
-    let title = format!("{} — error against time", scene.display_name());
-    write_outputs(
-        out,
-        &title,
-        &runs,
-        &summary,
-        serde_json::json!({ "scene": file.display().to_string(), "reference_spp": args.reference_spp }),
-    )?;
     print_summary(&summary);
     eprintln!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()
     );
     Ok(())
+}
+
+/// `convergence.csv` rewritten (atomically) after every finished run, so that a study stopped
+/// early (an interrupt, a later failure) keeps the runs it finished.
+struct RunLog {
+    path: PathBuf,
+    runs: Vec<experiments::converge::Run>,
+}
+
+impl RunLog {
+    fn new(out: &Path) -> Self {
+        Self {
+            path: out.join("convergence.csv"),
+            runs: Vec::new(),
+        }
+    }
+
+    fn record(&mut self, run: &experiments::converge::Run) {
+        self.runs.push(run.clone());
+        let text = experiments::converge::csv(&self.runs);
+        if let Err(e) = tracer::output::write_atomic(&self.path, text.as_bytes()) {
+            eprintln!("warning: {e}: the runs so far are not saved");
+        }
+    }
 }
 
 fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
@@ -358,6 +385,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         .sum();
     let bar = experiments::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
+    let mut log = RunLog::new(out);
     let samples = estimator_samples(args);
     let methods: Vec<Method> = args
         .methods
@@ -374,18 +402,12 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         args.min_radius,
         |run, map| {
             bar.inc(1);
+            bar.suspend(|| log.record(run));
             keep_latest(&mut finals, &run.method, map.clone());
         },
     )?;
     bar.finish_and_clear();
-    for (name, map) in &finals {
-        write_beam_map(
-            map,
-            &setup,
-            &out.join(format!("{name}.exr")),
-            serde_json::json!({"seed": args.seed}),
-        )?;
-    }
+    // Results first (they are small and the point of the run), images last.
     let summary = summarize(&runs);
     let title = format!("beam ({}) — error against time", args.setup.tag());
     write_outputs(
@@ -395,6 +417,14 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         &summary,
         serde_json::json!({ "setup": setup, "min_radius": args.min_radius }),
     )?;
+    for (name, map) in &finals {
+        write_beam_map(
+            map,
+            &setup,
+            &out.join(format!("{name}.exr")),
+            serde_json::json!({"seed": args.seed}),
+        )?;
+    }
     print_summary(&summary);
     eprintln!(
         "wrote {}/convergence.csv, convergence.png, summary.json",

@@ -1,0 +1,94 @@
+//! `converge` keeps every run it finished: `convergence.csv` is rewritten after each run, so a
+//! study interrupted (or failing) later still leaves its finished runs, and results are
+//! written before images.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const SCENE: &str = r#"
+[render]
+width = 16
+height = 16
+spp = 1
+seed = 1
+
+[camera]
+type = "orthographic"
+centre = [0.0, 0.0, 1.0]
+direction = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+width = 2.0
+height = 2.0
+
+[[material]]
+name = "m"
+type = "translucent"
+sigma_a = 0.01
+sigma_s = 1.0
+
+[[light]]
+type = "environment"
+radiance = 1.0
+
+[[shape]]
+type = "half_space"
+material = "m"
+"#;
+
+/// Rows of a convergence CSV after its header.
+fn rows(path: &std::path::Path) -> usize {
+    std::fs::read_to_string(path).map_or(0, |t| t.lines().count().saturating_sub(1))
+}
+
+#[test]
+fn an_interrupted_study_keeps_the_runs_it_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(&scene, SCENE).unwrap();
+    let out = dir.path().join("conv");
+    // A long study: path tracing at doubling budgets up to 2^22 spp (minutes; it is stopped
+    // after its first runs).
+    let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .arg("converge")
+        .arg(&scene)
+        .args([
+            "--methods",
+            "pt",
+            "--reference-spp",
+            "2",
+            "--max-spp",
+            "4194304",
+        ])
+        .arg("--cache-dir")
+        .arg(dir.path().join("cache"))
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let csv = out.join("convergence.csv");
+    let start = Instant::now();
+    while rows(&csv) < 2 {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no finished run was saved within 2 minutes"
+        );
+        assert!(child.try_wait().unwrap().is_none(), "the study ended early");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let kept = rows(&csv);
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert!(
+        !status.success(),
+        "an interrupted study must not report success"
+    );
+    // The finished runs are still there (a rewrite is atomic: never a half-written file).
+    assert!(rows(&csv) >= kept, "{} rows left of {kept}", rows(&csv));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.lines().nth(1).unwrap().starts_with("pt,"), "{text}");
+}
