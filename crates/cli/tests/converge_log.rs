@@ -2,38 +2,10 @@
 //! study interrupted (or failing) later still leaves its finished runs, and results are
 //! written before images.
 
+mod common;
+
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-const SCENE: &str = r#"
-[render]
-width = 16
-height = 16
-spp = 1
-seed = 1
-
-[camera]
-type = "orthographic"
-centre = [0.0, 0.0, 1.0]
-direction = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-width = 2.0
-height = 2.0
-
-[[material]]
-name = "m"
-type = "translucent"
-sigma_a = 0.01
-sigma_s = 1.0
-
-[[light]]
-type = "environment"
-radiance = 1.0
-
-[[shape]]
-type = "half_space"
-material = "m"
-"#;
 
 /// Rows of a convergence CSV after its header.
 fn rows(path: &std::path::Path) -> usize {
@@ -44,10 +16,10 @@ fn rows(path: &std::path::Path) -> usize {
 fn an_interrupted_study_keeps_the_runs_it_finished() {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("s.toml");
-    std::fs::write(&scene, SCENE).unwrap();
+    std::fs::write(&scene, common::MINIMAL).unwrap();
     let out = dir.path().join("conv");
-    // A long study: path tracing at doubling budgets up to 2^22 spp (minutes; it is stopped
-    // after its first runs).
+    // A long study: path tracing at doubling budgets up to 2^22 spp (many minutes; it is
+    // stopped after its first runs).
     let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
         .arg("converge")
         .arg(&scene)
