@@ -70,6 +70,19 @@ pub struct QuadLight {
     pub object: Option<u32>,
 }
 
+impl QuadLight {
+    /// The four corners in order: `corner`, `+ edge_u`, `+ edge_u + edge_v`, `+ edge_v` (wound
+    /// so that `edge_u × edge_v` is the emitting side).
+    pub fn vertices(&self) -> [DVec3; 4] {
+        [
+            self.corner,
+            self.corner + self.edge_u,
+            self.corner + self.edge_u + self.edge_v,
+            self.corner + self.edge_v,
+        ]
+    }
+}
+
 /// Constant environment radiance.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvironmentLight {

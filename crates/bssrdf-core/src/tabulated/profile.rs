@@ -159,7 +159,10 @@ impl TabulatedTerm {
         }
     }
 
-    /// Probability mass of each bin (sums to ≤ 1 before normalisation) and their total.
+    /// Probability mass of each bin (sums to ≤ 1 before normalisation) and their total. A scan
+    /// of every bin (about 1,000 table reads): `sample_r`, `pdf_r` and `radius_for_fraction`
+    /// pay it on each call, which suits per-material use; a renderer samples radii through
+    /// [`crate::ProfileTable`], built once from `eval` and `total`.
     fn masses(&self) -> ([f64; N_BINS], f64) {
         let mut m = [0.0; N_BINS];
         let mut total = 0.0;

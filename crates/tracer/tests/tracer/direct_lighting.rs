@@ -87,6 +87,14 @@ fn quad(size: f64, h: f64, radiance: f64) -> Light {
     .unwrap()
 }
 
+/// The corners of a quad light, for Lambert's formula.
+fn vertices(light: &Light) -> [DVec3; 4] {
+    match light {
+        Light::Quad(q) => q.vertices(),
+        _ => unreachable!("a quad light"),
+    }
+}
+
 /// Mean over `[-half, half]²` of `f`, by the midpoint rule on a 200 × 200 grid (the integrands
 /// are smooth; the rule's error is far below the tests' statistical tolerances).
 fn view_mean(half: f64, f: impl Fn(f64, f64) -> f64) -> f64 {
@@ -149,15 +157,7 @@ fn quad_light_on_a_lambertian_floor_matches_the_form_factor() {
     // event estimation carries nearly all of it), and a large light close by.
     for (size, h, half) in [(4.0, 3.0, 2.0), (1.0, 30.0, 2.0), (10.0, 1.0, 1.0)] {
         let light = quad(size, h, 1.0);
-        let Light::Quad(q) = light else {
-            unreachable!()
-        };
-        let verts = [
-            q.corner,
-            q.corner + q.edge_u,
-            q.corner + q.edge_u + q.edge_v,
-            q.corner + q.edge_v,
-        ];
+        let verts = vertices(&light);
         let want = view_mean(half, |x, y| {
             RHO / PI * lambert_irradiance(DVec3::new(x, y, 0.0), DVec3::Z, &verts)
         });
@@ -210,15 +210,7 @@ fn light_sampling_and_direction_sampling_agree_with_mis_and_the_closed_form() {
     let l_env = 0.2;
     let lights = [light, Light::environment(Rgb::splat(l_env)).unwrap()];
     let half = 2.0;
-    let Light::Quad(q) = light else {
-        unreachable!()
-    };
-    let verts = [
-        q.corner,
-        q.corner + q.edge_u,
-        q.corner + q.edge_u + q.edge_v,
-        q.corner + q.edge_v,
-    ];
+    let verts = vertices(&light);
     // The quad hides part of the environment's sky: E_env = π L_env − L_env · E_quad(L = 1).
     let want = view_mean(half, |x, y| {
         let e_q = lambert_irradiance(DVec3::new(x, y, 0.0), DVec3::Z, &verts);
