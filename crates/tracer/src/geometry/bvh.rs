@@ -59,7 +59,7 @@ fn box_pad(lo: DVec3, hi: DVec3) -> DVec3 {
 }
 
 /// A triangle's padded bounding box, what the BVH is built on.
-struct PaddedBox(Aabb);
+pub(super) struct PaddedBox(pub(super) Aabb);
 
 impl Boundable for PaddedBox {
     fn aabb(&self) -> Aabb {
@@ -172,7 +172,7 @@ struct ScaledRay {
 /// on valid scenes when debug assertions are on (found by the scene fuzzer,
 /// `tests/fuzz_regressions.rs`). The origins' rounding is harmless: children are quantised
 /// conservatively relative to them. The BVH is checked against brute force in the tests.
-fn build_cwbvh(boxes: &[PaddedBox], config: BvhBuildParams) -> CwBvh {
+pub(super) fn build_cwbvh(boxes: &[PaddedBox], config: BvhBuildParams) -> CwBvh {
     let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
         config.ploc_search_distance,
         boxes,

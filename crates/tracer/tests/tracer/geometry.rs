@@ -358,3 +358,81 @@ fn empty_and_tiny_objects() {
             .is_none()
     );
 }
+
+/// Many objects of mixed sizes (600 boxes and spheres from 1e-3 to 1 across, touching and
+/// overlapping, plus one 200-wide floor), optionally far from the origin: the top-level tree
+/// must give the brute-force closest hit and occlusion, for rays starting inside the cluster
+/// and for rays from 1e4 away.
+#[test]
+fn many_objects_match_brute_force() {
+    for offset in [DVec3::ZERO, DVec3::new(1e6, -3e5, 2e5)] {
+        let mut rng = Rng::from_keys(21, &[]);
+        let mut meshes = vec![primitives::cuboid(
+            offset + DVec3::new(-100.0, -100.0, -3.0),
+            offset + DVec3::new(100.0, 100.0, -2.5),
+        )];
+        for k in 0..600 {
+            let c = offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
+            let size = 10f64.powf(-3.0 * rng.uniform());
+            meshes.push(if k % 2 == 0 {
+                primitives::cuboid(c, c + DVec3::splat(size))
+            } else {
+                primitives::icosphere(c, 0.5 * size, 1)
+            });
+        }
+        let g = Geometry::build(meshes);
+        let (mut hits, mut mismatches) = (0, 0);
+        for i in 0..4000 {
+            let target =
+                offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
+            let o = if i % 2 == 0 {
+                offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 5.0 - 2.5
+            } else {
+                target + 1e4 * random_dir(&mut rng)
+            };
+            let ray = Ray::new(o, (target - o).normalize());
+            let fast = g.intersect(&ray).map(|h| (h.object, h.prim, h.t));
+            let slow = brute_closest(&g, None, &ray);
+            if fast.is_some() {
+                hits += 1;
+            }
+            let agree = match (fast, slow) {
+                (Some(a), Some(b)) => (a.0, a.1) == (b.0, b.1) || (a.2 - b.2).abs() < 1e-6 * b.2,
+                (None, None) => true,
+                _ => false,
+            };
+            if !agree {
+                // Grazing rays may differ between the f32 and f64 triangle tests.
+                let grazing = [fast.map(|a| (a.0, a.1)), slow.map(|b| (b.0, b.1))]
+                    .into_iter()
+                    .flatten()
+                    .any(|(o, p)| near_edge(&ray, g.mesh(o).triangle_vertices(p as usize), 1e-5));
+                assert!(
+                    grazing,
+                    "offset {offset}: {fast:?} vs brute {slow:?} for {ray:?}"
+                );
+                mismatches += 1;
+            }
+            let short =
+                Ray::with_range(ray.origin, ray.dir, 0.0, slow.map_or(1e5, |b| 0.999 * b.2));
+            assert!(
+                !g.occluded(&short) || mismatches > 0,
+                "offset {offset}: occluded before the first brute-force hit"
+            );
+            if slow.is_some() {
+                assert!(
+                    g.occluded(&ray) || mismatches > 0,
+                    "offset {offset}: not occluded"
+                );
+            }
+        }
+        assert!(
+            hits > 1500,
+            "offset {offset}: too few hits to be a test: {hits}"
+        );
+        assert!(
+            mismatches < 5,
+            "offset {offset}: {mismatches} grazing mismatches"
+        );
+    }
+}
