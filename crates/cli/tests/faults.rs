@@ -410,3 +410,47 @@ fn huge_tessellations_are_refused_with_the_figure() {
         ],
     );
 }
+
+/// A second SIGINT while the first one's output is being written quits at once: exit 130,
+/// "quitting" on stderr, no temporary file left, and the image on disk is still a whole one
+/// (the last checkpoint's, or the final one if its rename came first). The image is large
+/// (2000²) so that writing it takes far longer than the gap between the two signals.
+#[test]
+fn a_second_interrupt_quits_at_once() {
+    let s = Scratch::new();
+    s.write(
+        "big.toml",
+        edit(
+            MINIMAL,
+            "width = 8\nheight = 8",
+            "width = 2000\nheight = 2000",
+        ),
+    );
+    let child = spawn(
+        s.path(),
+        &[
+            "render",
+            "big.toml",
+            "--method",
+            "pt",
+            "--spp",
+            "100000000",
+            "--out",
+            "out.exr",
+            "--checkpoint",
+            "0.1",
+        ],
+    );
+    let json = s.join("out.json");
+    wait_for("a checkpoint", || json.is_file());
+    signal(&child, "INT");
+    std::thread::sleep(Duration::from_millis(20));
+    signal(&child, "INT");
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("quitting"), "{stderr}");
+    assert_no_temporaries(s.path());
+    let film = tracer::output::read_exr(&s.join("out.exr")).expect("a whole image");
+    assert_eq!((film.width, film.height), (2000, 2000));
+}
