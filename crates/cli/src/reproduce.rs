@@ -32,6 +32,11 @@ pub struct Args {
     /// Seed of the runs (references use a different one).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
+    /// Skip the steps that an earlier run into the same --out (same scale and seed) finished,
+    /// reusing their files and numbers (kept in `reproduce-state.json`); the report is the same
+    /// as an uninterrupted run's.
+    #[arg(long)]
+    resume: bool,
 }
 
 /// Runs the subcommand.
@@ -66,7 +71,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         eprintln!("[{:>5.0} s] {msg}", start.elapsed().as_secs_f64());
     };
-    let report = reproduce(&args.out, &scale, args.seed, &mut step)
+    let report = reproduce(&args.out, &scale, args.seed, args.resume, &mut step)
         .with_context(|| format!("reproduce into `{}` failed", args.out.display()))?;
     bar.finish_and_clear();
     eprintln!(

@@ -267,3 +267,72 @@ fn existing_file_as_out_fails_cleanly() {
         &["--out", "`r/sub`"],
     );
 }
+
+/// `--resume` reruns only the steps whose results are missing, leaves the finished ones'
+/// files alone, and gives the same numbers as the uninterrupted run; a ledger of another seed
+/// is refused, naming the file and the seed to use.
+#[test]
+fn resume_reruns_only_what_is_missing() {
+    let s = Scratch::new();
+    let r = s.run(&["reproduce", "--scale", "tiny", "--out", "r"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    let root = s.join("r");
+    let first = read_csv(&root.join("errors.csv"));
+    let removed = ["slab/sone.exr", "beam/check/segment-pbd.exr"];
+    for rel in removed {
+        std::fs::remove_file(root.join(rel)).unwrap();
+    }
+    let kept = [
+        "beam/stripe/pt.exr",
+        "beam/check/sone-dipole.exr",
+        "slab/reference-pt.exr",
+        "slab/jensen-out.exr",
+        "converge-slab/convergence.csv",
+    ];
+    let mtime = |rel: &str| {
+        std::fs::metadata(root.join(rel))
+            .unwrap()
+            .modified()
+            .unwrap()
+    };
+    let before: Vec<_> = kept.iter().map(|rel| mtime(rel)).collect();
+
+    let r = s.run(&["reproduce", "--scale", "tiny", "--out", "r", "--resume"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    for rel in removed {
+        assert_file(&root, rel);
+    }
+    for (rel, t) in kept.iter().zip(&before) {
+        assert_eq!(mtime(rel), *t, "{rel} was rewritten");
+    }
+    let report = std::fs::read_to_string(root.join("report.md")).unwrap();
+    assert!(report.contains("resumed: "), "no resume note in report.md");
+    let second = read_csv(&root.join("errors.csv"));
+    assert_eq!(first.rows.len(), second.rows.len());
+    for (a, b) in first.rows.iter().zip(&second.rows) {
+        assert_eq!(
+            (&a["experiment"], &a["method"]),
+            (&b["experiment"], &b["method"])
+        );
+        for m in ["rel_l2", "rmse", "mean_abs_log10"] {
+            assert_eq!(a[m], b[m], "{m} of {} {}", a["experiment"], a["method"]);
+        }
+    }
+
+    let r = s.run(&[
+        "reproduce",
+        "--scale",
+        "tiny",
+        "--out",
+        "r",
+        "--resume",
+        "--seed",
+        "2",
+    ]);
+    assert_ne!(r.code, Some(0));
+    assert!(
+        r.stderr.contains("reproduce-state.json") && r.stderr.contains("--seed 1"),
+        "{}",
+        r.stderr
+    );
+}

@@ -14,7 +14,7 @@
 
 use std::path::Path;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::WriteError;
 use crate::metrics::Metrics;
@@ -40,16 +40,19 @@ pub struct Run {
 }
 
 /// The summary of one BSSRDF method against path tracing.
-#[derive(Debug, Clone, Serialize, PartialEq)]
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[non_exhaustive]
 pub struct MethodSummary {
     /// The method.
     pub method: String,
     /// Relative L2 error at the largest budget.
+    #[serde(deserialize_with = "crate::metrics::null_as_nan")]
     pub converged_error: f64,
     /// Mean |log10(T/R)| at the largest budget (less dominated by the brightest pixels).
+    #[serde(deserialize_with = "crate::metrics::null_as_nan")]
     pub converged_mean_abs_log10: f64,
     /// Seconds of the first run within `CONVERGED_TOLERANCE` of the converged error.
+    #[serde(deserialize_with = "crate::metrics::null_as_nan")]
     pub time_to_converge: f64,
     /// Seconds path tracing needs to reach the same error (None without path-tracing runs).
     pub pt_time_to_same_error: Option<f64>,

@@ -5,6 +5,7 @@
 pub mod beam;
 pub mod converge;
 pub mod error;
+pub mod ledger;
 pub mod metrics;
 #[cfg(feature = "plot")]
 pub mod plot;

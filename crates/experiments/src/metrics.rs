@@ -1,18 +1,27 @@
 //! Image error metrics used by `compare` and `converge`: relative L2 error, RMSE and mean
 //! absolute log10 ratio. RGB images count each channel of each pixel as one value.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+/// Reads a number that may have been NaN or infinite when written: JSON has no such numbers,
+/// so serde_json writes them as `null`, which reads back as NaN.
+pub(crate) fn null_as_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Option::<f64>::deserialize(d).map(|v| v.unwrap_or(f64::NAN))
+}
 
 /// Errors of a test image against a reference.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub struct Metrics {
     /// ‖T − R‖₂ / ‖R‖₂ over the compared values (infinite if the reference is all zero and
     /// the test is not).
+    #[serde(deserialize_with = "null_as_nan")]
     pub rel_l2: f64,
     /// √(mean (T − R)²) over the compared values.
+    #[serde(deserialize_with = "null_as_nan")]
     pub rmse: f64,
     /// mean |log10(T / R)| over the compared values where both are positive (NaN if none).
+    #[serde(deserialize_with = "null_as_nan")]
     pub mean_abs_log10: f64,
     /// Values compared (pixels × channels).
     pub values: usize,

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use bssrdf_core::{ProfileModel, Scattering};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-use crate::beam::{BeamMap, BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map};
+use crate::beam::{BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map};
 use crate::converge::{MethodSummary, summarize, write_outputs};
 use crate::error::WriteError;
+use crate::ledger::{Ledger, LedgerError};
 use crate::metrics::{Metrics, compare, compare_films};
 use crate::run::{RenderJob, render_scene, write_render};
 use crate::scenes::CHECKER_SLAB;
@@ -113,6 +114,9 @@ pub enum ReproduceError {
     /// Writing results.
     #[error(transparent)]
     Write(#[from] WriteError),
+    /// `--resume` cannot use the earlier run's ledger.
+    #[error(transparent)]
+    Ledger(#[from] LedgerError),
     /// Creating a directory.
     #[error("cannot create the directory `{path}`")]
     Dir {
@@ -136,7 +140,7 @@ impl From<tracer::error::SceneError> for ReproduceError {
 }
 
 /// One row of an error table.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ErrorRow {
     /// Experiment (`beam stripe`, `checker slab`).
     pub experiment: String,
@@ -159,16 +163,30 @@ fn method(name: &str) -> Method {
     name.parse().expect("built-in method names")
 }
 
+/// Every value rounded to `f32`, as an EXR holds it (see [`crate::ledger`]: references are
+/// compared as written, so that a resumed run's numbers equal an uninterrupted one's).
+fn as_written(values: &mut [f64]) {
+    for v in values {
+        *v = f64::from(*v as f32);
+    }
+}
+
 /// Runs everything into `out` and writes `report.md`; `step(message)` is called before each
 /// step (for progress display). Returns the report's path.
+///
+/// With `resume`, steps that an earlier run into `out` with the same scale and seed finished
+/// are not run again: their numbers come from its ledger and their references from their
+/// EXR files ([`crate::ledger`]).
 pub fn reproduce(
     out: &Path,
     scale: &Scale,
     seed: u64,
+    resume: bool,
     step: &mut dyn FnMut(&str),
 ) -> Result<PathBuf, ReproduceError> {
     let start = Instant::now();
     mkdir(out)?;
+    let mut ledger = Ledger::open(out, scale.name, seed, resume)?;
     let mut rows: Vec<ErrorRow> = Vec::new();
     let mut report = String::new();
     let _ = writeln!(
@@ -180,7 +198,7 @@ pub fn reproduce(
     );
 
     // 1. The beam maps (Figure 4).
-    let mut stripe_reference: Option<(BeamSetup, BeamMap)> = None;
+    let mut stripe_reference: Option<(BeamSetup, Vec<f64>)> = None;
     let _ = writeln!(
         report,
         "## Figure 4: a pencil beam in a textured half-space\n\nσs = 1, isotropic, η = 1, multiple \
@@ -197,26 +215,36 @@ pub fn reproduce(
         mkdir(&dir)?;
         let mut setup = BeamSetup::paper(BeamTexture::preset(preset).expect("built-in preset"));
         setup.resolution = scale.beam_resolution;
-        step(&format!(
-            "beam {preset}: light tracing {} photons",
-            scale.beam_photons
-        ));
         let ref_seed = seed.wrapping_add(REFERENCE_SEED_OFFSET);
-        let pt = run_method(
-            &setup,
-            Method::PathTraced,
-            ProfileModel::Dipole,
-            PhotonBudget::Count(scale.beam_photons),
-            1,
-            ref_seed,
-            &|_| {},
-        )?;
-        write_beam_map(
-            &pt,
-            &setup,
-            &dir.join("pt.exr"),
-            serde_json::json!({"seed": ref_seed}),
-        )?;
+        let pt_path = dir.join("pt.exr");
+        let key = format!("beam/{preset}/pt");
+        let pt_values = if ledger.reuse::<bool>(&key, &[&pt_path])?.is_some() {
+            step(&format!("beam {preset}: light tracing (done earlier)"));
+            tracer::output::read_exr(&pt_path)?
+                .pixels
+                .iter()
+                .map(|p| p.0[0])
+                .collect()
+        } else {
+            step(&format!(
+                "beam {preset}: light tracing {} photons",
+                scale.beam_photons
+            ));
+            let pt = run_method(
+                &setup,
+                Method::PathTraced,
+                ProfileModel::Dipole,
+                PhotonBudget::Count(scale.beam_photons),
+                1,
+                ref_seed,
+                &|_| {},
+            )?;
+            write_beam_map(&pt, &setup, &pt_path, serde_json::json!({"seed": ref_seed}))?;
+            ledger.record(&key, &true)?;
+            let mut values = pt.values;
+            as_written(&mut values);
+            values
+        };
         let n = setup.resolution as usize;
         let keep = |i: usize| {
             let (x, y) = (i % n, i / n);
@@ -228,6 +256,17 @@ pub fn reproduce(
         let mut images = vec![format!("![pt](beam/{preset}/pt.png)")];
         for profile in [ProfileModel::Dipole, ProfileModel::Pbd] {
             for est in BEAM_ESTIMATORS {
+                let name = format!("{est}-{profile}");
+                let path = dir.join(format!("{name}.exr"));
+                let key = format!("beam/{preset}/{name}");
+                images.push(format!("![{name}](beam/{preset}/{name}.png)"));
+                if let Some(row) = ledger.reuse::<ErrorRow>(&key, &[&path])? {
+                    step(&format!(
+                        "beam {preset}: {est} with {profile} (done earlier)"
+                    ));
+                    rows.push(row);
+                    continue;
+                }
                 step(&format!("beam {preset}: {est} with {profile}"));
                 let map = run_method(
                     &setup,
@@ -238,27 +277,22 @@ pub fn reproduce(
                     seed,
                     &|_| {},
                 )?;
-                let name = format!("{est}-{profile}");
-                write_beam_map(
-                    &map,
-                    &setup,
-                    &dir.join(format!("{name}.exr")),
-                    serde_json::json!({"seed": seed}),
-                )?;
+                write_beam_map(&map, &setup, &path, serde_json::json!({"seed": seed}))?;
                 let metrics =
-                    compare(&map.values, &pt.values, 1, keep).map_err(StudyError::from)?;
-                rows.push(ErrorRow {
+                    compare(&map.values, &pt_values, 1, keep).map_err(StudyError::from)?;
+                let row = ErrorRow {
                     experiment: format!("beam {preset}"),
-                    method: name.clone(),
+                    method: name,
                     seconds: map.seconds,
                     metrics,
-                });
-                images.push(format!("![{name}](beam/{preset}/{name}.png)"));
+                };
+                ledger.record(&key, &row)?;
+                rows.push(row);
             }
         }
         let _ = writeln!(report, "### {preset}\n\n{}\n", images.join(" "));
         if preset == "stripe" {
-            stripe_reference = Some((setup, pt));
+            stripe_reference = Some((setup, pt_values));
         }
     }
     let _ = writeln!(
@@ -278,23 +312,47 @@ pub fn reproduce(
         seed,
         ..RenderJob::from_scene(&scene, Method::PathTraced)
     };
-    step(&format!(
-        "checker slab: path-traced reference at {} spp",
-        scale.slab_reference_spp
-    ));
-    let reference = render_scene(
-        &scene,
-        &RenderJob {
-            budget: Budget::Samples(scale.slab_reference_spp),
-            seed: seed.wrapping_add(REFERENCE_SEED_OFFSET),
-            ..base.clone()
-        },
-    )
-    .map_err(StudyError::from)?;
-    write_exr(&reference.film, &slab_dir.join("reference-pt.exr"))?;
-    tracer::output::write_png(&reference.film, &slab_dir.join("reference-pt.png"), 0.0)?;
+    let reference_path = slab_dir.join("reference-pt.exr");
+    let reference_png = slab_dir.join("reference-pt.png");
+    let reference_film = if ledger
+        .reuse::<bool>("slab/reference", &[&reference_path, &reference_png])?
+        .is_some()
+    {
+        step("checker slab: path-traced reference (done earlier)");
+        tracer::output::read_exr(&reference_path)?
+    } else {
+        step(&format!(
+            "checker slab: path-traced reference at {} spp",
+            scale.slab_reference_spp
+        ));
+        let reference = render_scene(
+            &scene,
+            &RenderJob {
+                budget: Budget::Samples(scale.slab_reference_spp),
+                seed: seed.wrapping_add(REFERENCE_SEED_OFFSET),
+                ..base.clone()
+            },
+        )
+        .map_err(StudyError::from)?;
+        write_exr(&reference.film, &reference_path)?;
+        tracer::output::write_png(&reference.film, &reference_png, 0.0)?;
+        ledger.record("slab/reference", &true)?;
+        let mut film = reference.film;
+        for p in &mut film.pixels {
+            as_written(&mut p.0);
+        }
+        film
+    };
     let mut slab_images = vec!["![reference](slab/reference-pt.png)".to_string()];
     for name in SLAB_METHODS {
+        let path = slab_dir.join(format!("{name}.exr"));
+        let key = format!("slab/{name}");
+        slab_images.push(format!("![{name}](slab/{name}.png)"));
+        if let Some(row) = ledger.reuse::<ErrorRow>(&key, &[&path])? {
+            step(&format!("checker slab: {name} (done earlier)"));
+            rows.push(row);
+            continue;
+        }
         step(&format!("checker slab: {name} at {} spp", scale.slab_spp));
         let job = RenderJob {
             method: method(name),
@@ -302,22 +360,17 @@ pub fn reproduce(
             ..base.clone()
         };
         let outcome = render_scene(&scene, &job).map_err(StudyError::from)?;
-        write_render(
-            &outcome,
-            &scene,
-            &job,
-            &slab_dir.join(format!("{name}.exr")),
-            0.0,
-        )?;
+        write_render(&outcome, &scene, &job, &path, 0.0)?;
         let metrics =
-            compare_films(&outcome.film, &reference.film, None).map_err(StudyError::from)?;
-        rows.push(ErrorRow {
+            compare_films(&outcome.film, &reference_film, None).map_err(StudyError::from)?;
+        let row = ErrorRow {
             experiment: "checker slab".into(),
             method: name.into(),
             seconds: outcome.seconds,
             metrics,
-        });
-        slab_images.push(format!("![{name}](slab/{name}.png)"));
+        };
+        ledger.record(&key, &row)?;
+        rows.push(row);
     }
     let _ = writeln!(
         report,
@@ -334,49 +387,69 @@ pub fn reproduce(
     let methods: Vec<Method> = CONVERGE_METHODS.iter().map(|m| method(m)).collect();
     let dir = out.join("converge-slab");
     mkdir(&dir)?;
-    step("convergence study: checker slab");
-    let spp: Vec<u32> = std::iter::successors(Some(1u32), |s| Some(s * 2))
-        .take_while(|&s| s <= scale.converge_max_spp)
-        .collect();
-    let slab_runs = scene_study(&scene, &base, &methods, &spp, &reference.film, |_, _| {})?;
-    let slab_summary = summarize(&slab_runs);
-    write_outputs(
-        &dir,
-        "checker slab — error against time",
-        &slab_runs,
-        &slab_summary,
-        serde_json::json!({"reference_spp": scale.slab_reference_spp}),
-    )?;
-    let (setup, pt) = stripe_reference.expect("the stripe preset ran");
+    let key = "converge-slab";
+    let slab_summary = if let Some(s) =
+        ledger.reuse::<Vec<MethodSummary>>(key, &[&dir.join("convergence.csv")])?
+    {
+        step("convergence study: checker slab (done earlier)");
+        s
+    } else {
+        step("convergence study: checker slab");
+        let spp: Vec<u32> = std::iter::successors(Some(1u32), |s| Some(s * 2))
+            .take_while(|&s| s <= scale.converge_max_spp)
+            .collect();
+        let slab_runs = scene_study(&scene, &base, &methods, &spp, &reference_film, |_, _| {})?;
+        let slab_summary = summarize(&slab_runs);
+        write_outputs(
+            &dir,
+            "checker slab — error against time",
+            &slab_runs,
+            &slab_summary,
+            serde_json::json!({"reference_spp": scale.slab_reference_spp}),
+        )?;
+        ledger.record(key, &slab_summary)?;
+        slab_summary
+    };
+    let (setup, pt_values) = stripe_reference.expect("the stripe preset ran");
     let dir = out.join("converge-beam-stripe");
     mkdir(&dir)?;
-    step("convergence study: beam, stripe preset");
-    let budgets = BeamBudgets {
-        photons: std::iter::successors(Some(1u64 << 16), |p| Some(p * 2))
-            .take_while(|&p| p <= scale.converge_max_photons.max(1 << 16))
-            .collect(),
-        subsamples: std::iter::successors(Some(1u32), |k| Some(k * 2))
-            .take_while(|&k| k <= scale.converge_max_subsamples)
-            .collect(),
+    let key = "converge-beam-stripe";
+    let beam_summary = if let Some(s) =
+        ledger.reuse::<Vec<MethodSummary>>(key, &[&dir.join("convergence.csv")])?
+    {
+        step("convergence study: beam, stripe preset (done earlier)");
+        s
+    } else {
+        step("convergence study: beam, stripe preset");
+        let budgets = BeamBudgets {
+            photons: std::iter::successors(Some(1u64 << 16), |p| Some(p * 2))
+                .take_while(|&p| p <= scale.converge_max_photons.max(1 << 16))
+                .collect(),
+            subsamples: std::iter::successors(Some(1u32), |k| Some(k * 2))
+                .take_while(|&k| k <= scale.converge_max_subsamples)
+                .collect(),
+        };
+        let beam_runs = beam_study(
+            &setup,
+            &methods,
+            ProfileModel::Dipole,
+            &budgets,
+            seed,
+            &pt_values,
+            1.0,
+            |_, _| {},
+        )?;
+        let beam_summary = summarize(&beam_runs);
+        write_outputs(
+            &dir,
+            "beam (stripe) — error against time",
+            &beam_runs,
+            &beam_summary,
+            serde_json::json!({"setup": setup, "min_radius": 1.0}),
+        )?;
+        ledger.record(key, &beam_summary)?;
+        beam_summary
     };
-    let beam_runs = beam_study(
-        &setup,
-        &methods,
-        ProfileModel::Dipole,
-        &budgets,
-        seed,
-        &pt.values,
-        1.0,
-        |_, _| {},
-    )?;
-    let beam_summary = summarize(&beam_runs);
-    write_outputs(
-        &dir,
-        "beam (stripe) — error against time",
-        &beam_runs,
-        &beam_summary,
-        serde_json::json!({"setup": setup, "min_radius": 1.0}),
-    )?;
     let _ = writeln!(
         report,
         "## Error against time\n\nEach method at doubling budgets against the references above \
@@ -388,9 +461,15 @@ pub fn reproduce(
         summary_table(&slab_summary),
         summary_table(&beam_summary)
     );
+    let (reused, steps) = ledger.reused();
+    let resumed = if reused > 0 {
+        format!(" (resumed: {reused} of its {steps} steps were finished by an earlier run)")
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         report,
-        "## Notes\n\n* Every figure above was produced by `het-bssrdf reproduce --scale {}` in {:.0} s.\n\
+        "## Notes\n\n* Every figure above was produced by `het-bssrdf reproduce --scale {}` in {:.0} s{resumed}.\n\
          * Scattering orders: multiple only ({}), as in the paper.\n\
          * Error tables as CSV: `errors.csv`.\n",
         scale.name,
