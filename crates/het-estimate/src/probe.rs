@@ -160,6 +160,7 @@ impl ProbeSampler {
     /// scatters).
     pub fn probe_radius(&self, c: Coefficients) -> f64 {
         self.channels(c)
+            .radial
             .iter()
             .flatten()
             .map(|(_, r)| *r)
@@ -167,38 +168,75 @@ impl ProbeSampler {
     }
 
     /// The radial densities and probe radii of the three channels at coefficients `c` (x_o's).
-    fn channels(&self, c: Coefficients) -> [Option<(Radial<'_>, f64)>; 3] {
+    fn channels(&self, c: Coefficients) -> Channels<'_> {
         let c = if c.sigma_s.max_component() > 0.0 {
             c
         } else {
             self.bounds.max
         };
-        std::array::from_fn(|ch| {
-            let own = self
-                .table
-                .sampler(c.sigma_a[ch], c.sigma_s[ch])
-                .ok()
-                .map(|s| {
-                    let r = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
-                    (s, if r.is_finite() { r } else { 0.0 })
-                })
-                .filter(|(_, r)| *r > 0.0);
-            let wide = self.widest[ch].filter(|((a, s), _)| {
-                (*a, *s) != (c.sigma_a[ch], c.sigma_s[ch]) && !self.bounds.is_constant()
-            });
-            match (own, wide) {
-                (Some((s, r)), None) => Some((Radial::One(s), r)),
-                (own, Some(((a, sg), r_wide))) => {
-                    let wide = self.table.sampler(a, sg).ok()?;
-                    match own {
-                        Some((s, r)) => Some((Radial::Mixture(s, wide), r.max(r_wide))),
-                        None => Some((Radial::One(wide), r_wide)),
-                    }
-                }
-                (None, None) => None,
+        // A channel with the same coefficients as an earlier one has the same density: it is
+        // built once and counted twice (grey materials cost one channel, not three).
+        let same = |a: usize, b: usize| {
+            (c.sigma_a[a], c.sigma_s[a]) == (c.sigma_a[b], c.sigma_s[b])
+                && self.widest[a] == self.widest[b]
+        };
+        let first = [0, if same(1, 0) { 0 } else { 1 }, {
+            if same(2, 0) {
+                0
+            } else if same(2, 1) {
+                1
+            } else {
+                2
             }
-        })
+        }];
+        let mut count = [0u8; 3];
+        for f in first {
+            count[f] += 1;
+        }
+        let mut radial: [Option<(Radial<'_>, f64)>; 3] = [None; 3];
+        for (ch, &f) in first.iter().enumerate() {
+            radial[ch] = if f < ch {
+                radial[f]
+            } else {
+                self.channel(c, ch)
+            };
+        }
+        Channels { radial, count }
     }
+
+    /// Channel `ch`'s radial density and probe radius at coefficients `c`.
+    fn channel(&self, c: Coefficients, ch: usize) -> Option<(Radial<'_>, f64)> {
+        let own = self
+            .table
+            .sampler(c.sigma_a[ch], c.sigma_s[ch])
+            .ok()
+            .map(|s| {
+                let r = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
+                (s, if r.is_finite() { r } else { 0.0 })
+            })
+            .filter(|(_, r)| *r > 0.0);
+        let wide = self.widest[ch].filter(|((a, s), _)| {
+            (*a, *s) != (c.sigma_a[ch], c.sigma_s[ch]) && !self.bounds.is_constant()
+        });
+        match (own, wide) {
+            (Some((s, r)), None) => Some((Radial::One(s), r)),
+            (own, Some(((a, sg), r_wide))) => {
+                let wide = self.table.sampler(a, sg).ok()?;
+                match own {
+                    Some((s, r)) => Some((Radial::Mixture(s, wide), r.max(r_wide))),
+                    None => Some((Radial::One(wide), r_wide)),
+                }
+            }
+            (None, None) => None,
+        }
+    }
+}
+
+/// The three channels' radial densities and probe radii; `count[k]` is how many channels share
+/// channel `k`'s density (0 for a channel that repeats an earlier one).
+struct Channels<'a> {
+    radial: [Option<(Radial<'a>, f64)>; 3],
+    count: [u8; 3],
 }
 
 /// A channel's radial sampling density: x_o's profile, or an equal mixture of it and the
@@ -283,7 +321,7 @@ pub fn probe<C: ProbeChords, U: UniformSource>(
     for axis in 0..3 {
         let ch = ((rng.next_f64() * 3.0) as usize).min(2);
         let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
-        let Some((prof, r_max)) = channels[ch].as_ref() else {
+        let Some((prof, r_max)) = channels.radial[ch].as_ref() else {
             continue;
         };
         let Some(r) = prof.sample_r(u_r) else {
@@ -347,7 +385,7 @@ fn axis_densities_in(
     x_o: DVec3,
     frame: &Frame,
     x_i: &impl SurfacePoint,
-    channels: &[Option<(Radial<'_>, f64)>; 3],
+    channels: &Channels<'_>,
 ) -> [f64; 3] {
     let d = x_i.position() - x_o;
     let dist = d.length();
@@ -360,14 +398,18 @@ fn axis_densities_in(
         (dl.x * dl.x + dl.y * dl.y).sqrt(),
     ];
     let mut pdf = [0.0; 3];
-    for (prof, r_max) in channels.iter().flatten() {
-        if dist >= *r_max {
+    for (channel, &count) in channels.radial.iter().zip(&channels.count) {
+        let Some((prof, r_max)) = channel else {
+            continue;
+        };
+        if count == 0 || dist >= *r_max {
             continue;
         }
+        let share = f64::from(count) / (3.0 * std::f64::consts::TAU);
         for axis in 0..3 {
             let r = r_proj[axis];
             if r > 0.0 {
-                pdf[axis] += prof.pdf_r(r) / (3.0 * std::f64::consts::TAU * r) * nl[axis].abs();
+                pdf[axis] += share * prof.pdf_r(r) / r * nl[axis].abs();
             }
         }
     }
