@@ -88,12 +88,19 @@ impl Estimator {
             Estimator::Sone(p) => {
                 p.disk.validate()?;
                 p.ellipse.validate()?;
-                theta2_of(p.mean_square_angle)?
+                theta2_of(Default::default())?;
+                let (g_theta, _) = p.width_scattering.resolve(g);
+                p.mean_square_angle.evaluate(g_theta)?
             }
+        };
+        let sigma_s_scale = match self {
+            Estimator::Sone(p) => p.width_scattering.resolve(g).1,
+            _ => 1.0,
         };
         Ok(PreparedEstimator {
             estimator: self,
             theta2,
+            sigma_s_scale,
         })
     }
 }
@@ -104,6 +111,8 @@ impl Estimator {
 pub struct PreparedEstimator {
     estimator: Estimator,
     theta2: f64,
+    /// Factor on σs in Eq. (2) (Sone; see `WidthScattering`).
+    sigma_s_scale: f64,
 }
 
 impl PreparedEstimator {
@@ -160,7 +169,9 @@ impl PreparedEstimator {
             Estimator::JensenOut => point_lookup::single_point(&mut probe, false),
             Estimator::Endpoints => point_lookup::endpoints(&mut probe),
             Estimator::Segment(p) => segment::estimate(p, &mut probe, &known, rng),
-            Estimator::Sone(p) => sone::estimate(p, self.theta2, &mut probe, &known, rng),
+            Estimator::Sone(p) => {
+                sone::estimate(p, self.theta2, self.sigma_s_scale, &mut probe, &known, rng)
+            }
         };
         Estimate {
             coefficients: known.finish(raw),

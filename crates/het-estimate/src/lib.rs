@@ -76,5 +76,5 @@ pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use sampler::SplitMix64;
 pub use sampler::UniformSource;
 pub use segment::SegmentParams;
-pub use sone::SoneParams;
+pub use sone::{SoneParams, WidthScattering};
 pub use surface::{SurfacePoint, SurfaceQuery};

@@ -59,12 +59,58 @@ pub struct SoneParams {
     pub mean_square_angle: MeanSquareAngle,
     /// Semi-minor axis from w: w/2 (default, the literal reading) or w.
     pub semi_minor: SemiMinorAxis,
+    /// Which scattering coefficient (and ⟨θ²⟩) Eq. (2) uses for an anisotropic medium.
+    pub width_scattering: WidthScattering,
     /// Projection misses: hits only (default) or endpoint mean.
     pub misses: MissPolicy,
     /// Ask [`CoefficientField::ellipse_average`] first and sample only when it returns `None`
     /// (default true; it returns `None` unless the field implements it, at no cost).
     pub use_field_average: bool,
 }
+
+/// Which scattering coefficient Eq. (2) uses when g ≠ 0. The paper calls its σs, σa and g
+/// "the reduced scattering and absorption coefficients, and the average cosine", which reads
+/// either way; the three readings differ only for g ≠ 0 (measured against the beam path
+/// tracer at g = 0.8 in `docs/physics.md#path-width`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum WidthScattering {
+    /// σs and the phase function's own ⟨θ²⟩ (PAT04's path model of the real medium). Default.
+    #[default]
+    Unreduced,
+    /// The reduced σs' = (1 − g)σs with the phase function's own ⟨θ²⟩.
+    Reduced,
+    /// The similar isotropic medium: σs' = (1 − g)σs and the isotropic ⟨θ²⟩.
+    SimilarIsotropic,
+}
+
+impl WidthScattering {
+    /// `(g at which ⟨θ²⟩ is evaluated, factor on σs)` for a medium with HG parameter `g`.
+    pub fn resolve(self, g: f64) -> (f64, f64) {
+        match self {
+            WidthScattering::Unreduced => (g, 1.0),
+            WidthScattering::Reduced => (g, 1.0 - g),
+            WidthScattering::SimilarIsotropic => (0.0, 1.0 - g),
+        }
+    }
+}
+
+impl crate::names::Named for WidthScattering {
+    const WHAT: &'static str = "width scattering";
+    const ALL: &'static [Self] = &[
+        WidthScattering::Unreduced,
+        WidthScattering::Reduced,
+        WidthScattering::SimilarIsotropic,
+    ];
+    fn name(self) -> &'static str {
+        match self {
+            WidthScattering::Unreduced => "unreduced",
+            WidthScattering::Reduced => "reduced",
+            WidthScattering::SimilarIsotropic => "similar-isotropic",
+        }
+    }
+}
+
+named_display_fromstr!(WidthScattering);
 
 impl SoneParams {
     /// The paper's reading: exact ⟨θ²⟩, b = w/2, hits only, 16 disk + 32 ellipse samples
@@ -75,6 +121,7 @@ impl SoneParams {
             ellipse: SampleBudget::fixed(32),
             mean_square_angle: MeanSquareAngle::Exact,
             semi_minor: SemiMinorAxis::HalfWidth,
+            width_scattering: WidthScattering::Unreduced,
             misses: MissPolicy::HitsOnly,
             use_field_average: true,
         }
@@ -134,10 +181,12 @@ impl Ellipses {
     }
 }
 
-/// Estimates σ̄a, σ̄s for one pair (see the module docs). `theta2` is ⟨θ²⟩ (prepared once).
+/// Estimates σ̄a, σ̄s for one pair (see the module docs). `theta2` is ⟨θ²⟩ and
+/// `sigma_s_scale` the factor on σs in Eq. (2) (both prepared once, see [`WidthScattering`]).
 pub(crate) fn estimate<S, F, U>(
     params: &SoneParams,
     theta2: f64,
+    sigma_s_scale: f64,
     probe: &mut Probe<'_, S, F>,
     known: &Known,
     rng: &mut U,
@@ -188,7 +237,12 @@ where
     // Step 2: the width of Eq. (2) per channel, and the semi-minor axis.
     let d = chord.length();
     let w = Rgb(std::array::from_fn(|c| {
-        width_unchecked(theta2, disk_mean.sigma_s[c], disk_mean.sigma_a[c], d)
+        width_unchecked(
+            theta2,
+            sigma_s_scale * disk_mean.sigma_s[c],
+            disk_mean.sigma_a[c],
+            d,
+        )
     }));
     let b = w.map(|w| params.semi_minor.from_width(w));
 

@@ -13,6 +13,7 @@ use het_estimate::pattern::{Check, Ramp, Stripe};
 use het_estimate::{
     CoefficientField, Coefficients, Estimate, Estimator, MissPolicy, Named, Region, Rgb,
     SampleBudget, SegmentParams, SemiMinorAxis, SoneParams, SplitMix64, SurfacePoint, SurfaceQuery,
+    WidthScattering,
 };
 use proptest::prelude::*;
 
@@ -525,6 +526,57 @@ fn sone_stripe_matches_brute_force_quadrature() {
         );
         assert_eq!(ests[0].diagnostics.region, Region::Ellipse);
         assert!(ests.iter().all(|e| e.coefficients.sigma_s == Rgb::ONE));
+    }
+}
+
+/// Henyey–Greenstein ⟨θ²⟩ = ∫ θ² p(θ) dω by the midpoint rule in θ (independent of the crate).
+fn hg_theta2(g: f64) -> f64 {
+    let n = 200_000;
+    let h = PI / n as f64;
+    (0..n)
+        .map(|k| {
+            let t = (k as f64 + 0.5) * h;
+            let p = (1.0 - g * g) / (4.0 * PI * (1.0 + g * g - 2.0 * g * t.cos()).powf(1.5));
+            t * t * p * 2.0 * PI * t.sin() * h
+        })
+        .sum()
+}
+
+/// Eq. (2)'s three readings for g ≠ 0: the width Sone reports is Eq. (2) with σs or
+/// (1 − g)σs, and the phase function's ⟨θ²⟩ or the isotropic one; at g = 0 all three agree.
+#[test]
+fn width_scattering_readings_of_eq2() {
+    let f = stripe_preset();
+    let sa = |x: f64, y: f64| f.values[stripe_index(x, y, 4.0, FRAC_PI_4)].sigma_a[0];
+    let xo = (6.0, 1.0);
+    let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(xo.0, xo.1));
+    let d = (xo.0 * xo.0 + xo.1 * xo.1).sqrt();
+    let m = [xo.0 / 2.0, xo.1 / 2.0];
+    let xh = [xo.0 / d, xo.1 / d];
+    let disk_sa = ellipse_quadrature(m, xh, d / 2.0, d / 2.0, 2000, sa);
+    for g in [0.0, 0.8] {
+        for (reading, theta2, ss) in [
+            (WidthScattering::Unreduced, hg_theta2(g), 1.0),
+            (WidthScattering::Reduced, hg_theta2(g), 1.0 - g),
+            (WidthScattering::SimilarIsotropic, ISO_THETA2, 1.0 - g),
+        ] {
+            let mut p = sone(512, 512);
+            p.width_scattering = reading;
+            let ws: Vec<f64> = (0..16)
+                .map(|s| {
+                    run(Estimator::Sone(p), g, &Plane, &f, &x_i, &x_o, s)
+                        .diagnostics
+                        .width
+                        .unwrap()[0]
+                })
+                .collect();
+            let want = eq2(theta2, ss, disk_sa, d);
+            let got = mean_sd(&ws).0;
+            assert!(
+                (got - want).abs() < 2e-3 * want,
+                "g {g}, {reading}: width {got} vs {want}"
+            );
+        }
     }
 }
 
