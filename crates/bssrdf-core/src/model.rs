@@ -28,6 +28,19 @@ impl ProfileModel {
         ProfileModel::Tabulated,
     ];
 
+    /// The model used when none is asked for: the exact [`ProfileModel::Tabulated`] profile
+    /// wherever its table reaches (η ≤ 1.6), otherwise photon beam diffusion, the least biased
+    /// of the diffusion models on a half-space (`docs/tabulated-profile.md`). `eta` is the
+    /// material's relative refractive index; a NaN gives the tabulated model, whose
+    /// construction then reports the invalid η.
+    pub fn default_for(eta: f64) -> ProfileModel {
+        if eta > crate::tabulated::profile::ETA_MAX {
+            ProfileModel::Pbd
+        } else {
+            ProfileModel::Tabulated
+        }
+    }
+
     /// The name used on the command line and in scene files.
     pub const fn name(self) -> &'static str {
         match self {
@@ -100,6 +113,19 @@ impl Scattering {
     /// Every variant.
     pub const ALL: &'static [Scattering] =
         &[Scattering::Multiple, Scattering::Single, Scattering::All];
+
+    /// The model used when none is asked for: the exact [`ProfileModel::Tabulated`] profile
+    /// wherever its table reaches (η ≤ 1.6), otherwise photon beam diffusion, the least biased
+    /// of the diffusion models on a half-space (`docs/tabulated-profile.md`). `eta` is the
+    /// material's relative refractive index; a NaN gives the tabulated model, whose
+    /// construction then reports the invalid η.
+    pub fn default_for(eta: f64) -> ProfileModel {
+        if eta > crate::tabulated::profile::ETA_MAX {
+            ProfileModel::Pbd
+        } else {
+            ProfileModel::Tabulated
+        }
+    }
 
     /// The name used on the command line and in scene files.
     pub const fn name(self) -> &'static str {

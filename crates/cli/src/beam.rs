@@ -159,7 +159,7 @@ pub struct Args {
     /// endpoints, segment, sone.
     #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
-    /// Profile model for BSSRDF methods (default: dipole).
+    /// Profile model for BSSRDF methods (default: tabulated, the exact profile).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
@@ -245,7 +245,8 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.estimator_samples.is_some(),
     )?;
     let setup = args.setup.setup()?;
-    let profile = args.profile.unwrap_or(ProfileModel::Dipole);
+    // The beam's half-space is index-matched (η = 1).
+    let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
     let name = match args.method {
         Method::PathTraced => "pt".to_string(),
         m => format!("{}-{}", m.name(), profile),

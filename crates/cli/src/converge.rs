@@ -56,7 +56,8 @@ pub struct Args {
     /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
     #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
-    /// Profile model of the BSSRDF methods (scene: default each material's).
+    /// Profile model of the BSSRDF methods (scene: default each material's, else tabulated
+    /// where η ≤ 1.6 and pbd above; beam: tabulated).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment and Sone estimators.
@@ -333,7 +334,8 @@ impl RunLog {
 
 fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     let setup = args.setup.setup()?;
-    let profile = args.profile.unwrap_or(ProfileModel::Dipole);
+    // The beam's half-space is index-matched (η = 1).
+    let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
     let given = args.reference.as_deref().map(read_exr).transpose()?;
     prepare_out(out)?;
     let reference: Vec<f64> = match given {

@@ -99,8 +99,10 @@ impl Scale {
 
 /// The BSSRDF estimators compared in the beam experiment.
 pub const BEAM_ESTIMATORS: [&str; 4] = ["jensen-out", "segment", "endpoints", "sone"];
-/// Methods of the checker-slab renders.
-pub const SLAB_METHODS: [&str; 3] = ["pt", "jensen-out", "sone"];
+/// Methods of the checker-slab renders. The paper's Figure 5 shows Jensen's lookup at the
+/// incident point (`jensen-in`); `jensen-out`, the exitant point as in its Figure 4, is kept
+/// beside it.
+pub const SLAB_METHODS: [&str; 4] = ["pt", "jensen-in", "jensen-out", "sone"];
 /// Methods of the convergence studies.
 pub const CONVERGE_METHODS: [&str; 4] = ["pt", "jensen-out", "endpoints", "sone"];
 

@@ -1,7 +1,12 @@
 //! The grid of the tabulated half-space profile: refractive indices, albedos and radii.
 
-/// Relative refractive indices η = n_medium / n_outside of the table's planes.
-pub const ETAS: [f64; 5] = [1.0, 1.15, 1.3, 1.45, 1.6];
+/// Relative refractive indices η = n_medium / n_outside of the table's planes: 1 to 1.6 in
+/// steps of 0.05, dense enough that cubic interpolation between planes is well below the
+/// table's noise (the leave-one-out check in `tests/tabulated.rs` at twice this spacing is
+/// within it; `docs/tabulated-profile.md`).
+pub const ETAS: [f64; 13] = [
+    1.0, 1.05, 1.1, 1.15, 1.2, 1.25, 1.3, 1.35, 1.4, 1.45, 1.5, 1.55, 1.6,
+];
 
 /// Number of albedo rows.
 pub const N_ALBEDO: usize = 40;

@@ -16,7 +16,7 @@
 //!   used by some shape refers to it.
 //! * `[[material]]`: `type = "translucent"` with `name`, `sigma_a`, `sigma_s` (fields, see
 //!   below), `g` (default 0, |g| < 1), `eta` (default 1, ≥ 1), optional `profile`
-//!   (`dipole | pbd | better-dipole`), `unit_scale` (default 1: file coefficients × unit_scale =
+//!   (`dipole | pbd | better-dipole | tabulated`; default tabulated where η ≤ 1.6, else pbd), `unit_scale` (default 1: file coefficients × unit_scale =
 //!   1/scene-unit); or `type = "diffuse"` with `name`, `albedo`. Unused materials are validated
 //!   but their textures are not decoded.
 //! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
@@ -117,7 +117,7 @@ pub struct Translucent {
 
 impl Translucent {
     /// What a BSSRDF render of this material prepares once: the profile family of `model` (or
-    /// the material's own `profile`, or the dipole) counting `scattering`, with the material's
+    /// the material's own `profile`, or [`ProfileModel::default_for`] its η) counting `scattering`, with the material's
     /// g and η, and `estimator` prepared for its g. The error names the failing part
     /// (`"profile"` or `"estimator"`).
     pub fn prepare_bssrdf(
@@ -126,7 +126,9 @@ impl Translucent {
         scattering: Scattering,
         estimator: Estimator,
     ) -> Result<(ProfileFamily, PreparedEstimator), (&'static str, ParamError)> {
-        let model = model.or(self.profile).unwrap_or(ProfileModel::Dipole);
+        let model = model
+            .or(self.profile)
+            .unwrap_or(ProfileModel::default_for(self.eta));
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
         let prepared = estimator.prepare(self.g).map_err(|e| ("estimator", e))?;

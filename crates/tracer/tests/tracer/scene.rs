@@ -578,3 +578,43 @@ fn uv_field_is_refused_only_when_used_volumetrically() {
     let e = load_err(&text.replace("mapping = \"uv\"", "mapping = \"uv\", size = [1.0, 1.0]"));
     check(&e, "material[0].sigma_s.size", &["does not apply"]);
 }
+
+/// Without a profile asked for, a material uses the tabulated exact profile where the table
+/// reaches (η ≤ 1.6) and photon beam diffusion above; a material's own profile and an explicit
+/// model override it, in that order.
+#[test]
+fn the_default_profile_is_tabulated_where_it_applies() {
+    use tracer::field::MediumField;
+    use tracer::scene::Translucent;
+    let medium = MediumField::new(
+        Field::constant(Rgb::splat(0.01)).unwrap(),
+        Field::constant(Rgb::splat(1.0)).unwrap(),
+    );
+    let model = |m: &Translucent, asked: Option<ProfileModel>| {
+        let (family, _) = m
+            .prepare_bssrdf(asked, Scattering::Multiple, "sone".parse().unwrap())
+            .expect("valid material");
+        family.model()
+    };
+    for (eta, want) in [
+        (1.0, ProfileModel::Tabulated),
+        (1.3, ProfileModel::Tabulated),
+        (1.6, ProfileModel::Tabulated),
+        (1.61, ProfileModel::Pbd),
+        (2.5, ProfileModel::Pbd),
+    ] {
+        let mut m = Translucent::new("m", medium.clone(), 0.0, eta);
+        assert_eq!(model(&m, None), want, "η {eta}");
+        m.profile = Some(ProfileModel::Dipole);
+        assert_eq!(
+            model(&m, None),
+            ProfileModel::Dipole,
+            "η {eta}: own profile"
+        );
+        assert_eq!(
+            model(&m, Some(ProfileModel::BetterDipole)),
+            ProfileModel::BetterDipole,
+            "η {eta}: asked"
+        );
+    }
+}
