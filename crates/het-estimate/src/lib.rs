@@ -53,6 +53,7 @@ mod known;
 pub mod path_integral;
 pub mod pattern;
 mod point_lookup;
+pub mod prefilter;
 pub mod probe;
 mod region_average;
 pub mod sampler;
@@ -72,6 +73,7 @@ pub use field::{CoefficientField, Coefficients, FieldBounds};
 pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
+pub use prefilter::{Averaging, Flatness};
 #[cfg(feature = "fixtures")]
 pub use sampler::SplitMix64;
 pub use sampler::UniformSource;
