@@ -64,6 +64,13 @@ impl Named for Averaging {
 
 named_display_fromstr!(Averaging);
 
+impl Averaging {
+    /// The name used on the command line and in sidecars.
+    pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
+}
+
 /// When a flat footprint stands for the projected region: the fallback criterion of
 /// prefiltered averaging.
 ///
