@@ -261,7 +261,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .map(|m| {
             m.with_profile(args.profile)
                 .with_estimator_samples(estimator_samples(args))
-                .with_averaging(args.averaging)
+                .with_averaging(args.averaging.or(scene.settings().averaging))
         })
         .collect();
     let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");

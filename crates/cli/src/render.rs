@@ -101,7 +101,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.estimator_samples
                 .map(|n| n.min(u32::MAX as u64) as u32),
         )
-        .with_averaging(args.averaging);
+        .with_averaging(args.averaging.or(scene.settings().averaging));
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);

@@ -183,9 +183,10 @@ pub fn stripe_fraction(stripe: &Stripe, fp: &PlaneFootprint) -> Option<f64> {
     if !fp.is_finite() || !(stripe.width > 0.0 && stripe.width.is_finite()) {
         return None;
     }
-    let g = DVec2::new(stripe.angle.cos(), stripe.angle.sin());
+    let (sin, cos) = stripe.angle.sin_cos();
+    let g = DVec2::new(cos, sin);
     let w = stripe.width;
-    let u_c = stripe.u(fp.centre.x, fp.centre.y);
+    let u_c = g.dot(fp.centre);
     let h = fp.half_extent(g);
     let band = |u: f64| (u / w + 0.5).floor();
     let (k0, k1) = (band(u_c - h), band(u_c + h));
@@ -238,6 +239,7 @@ pub fn check_fraction(check: &Check, fp: &PlaneFootprint) -> Option<f64> {
         let d = p - fp.centre;
         DVec2::new(d.perp_dot(fp.axis_v), fp.axis_u.perp_dot(d)) / det
     };
+    let cell_area = w * w / det.abs();
     let mut ones = 0.0;
     let mut i = i0;
     while i <= i1 {
@@ -256,7 +258,14 @@ pub fn check_fraction(check: &Check, fp: &PlaneFootprint) -> Option<f64> {
                 inv(DVec2::new(x1, y1)),
                 inv(DVec2::new(x0, y1)),
             ];
-            ones += disk_polygon_area(&quad).abs();
+            let (lo, hi) = quad[1..]
+                .iter()
+                .fold((quad[0], quad[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+            if quad.iter().all(|q| q.length_squared() <= 1.0) {
+                ones += cell_area; // inside the disk: the whole cell
+            } else if lo.x < 1.0 && lo.y < 1.0 && hi.x > -1.0 && hi.y > -1.0 {
+                ones += disk_polygon_area(&quad).abs();
+            } // else: the cell's bounding box misses the disk
             j += 2.0;
         }
         i += 1.0;
