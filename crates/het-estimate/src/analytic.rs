@@ -99,11 +99,9 @@ pub type CheckField = PatternField<Check>;
 /// The projection of a vector along `n` onto the plane z = 0, as (x, y); `None` when `n` is
 /// parallel to the plane.
 fn along_onto_plane(n: DVec3) -> Option<impl Fn(DVec3) -> DVec2> {
-    (n.z.abs() >= 1e-12 && n.is_finite()).then(move || {
-        move |v: DVec3| {
-            let p = v - n * (v.z / n.z);
-            DVec2::new(p.x, p.y)
-        }
+    (n.z.abs() >= 1e-12 && n.is_finite()).then_some(move |v: DVec3| {
+        let p = v - n * (v.z / n.z);
+        DVec2::new(p.x, p.y)
     })
 }
 

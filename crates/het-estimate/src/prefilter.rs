@@ -180,7 +180,7 @@ impl PlaneFootprint {
 /// The weighted fraction of `fp` where `stripe` selects value 1 (in [0, 1]); `None` for a
 /// non-finite footprint or one that spans more than [`MAX_CELLS`] bands.
 pub fn stripe_fraction(stripe: &Stripe, fp: &PlaneFootprint) -> Option<f64> {
-    if !fp.is_finite() || !(stripe.width > 0.0 && stripe.width.is_finite()) {
+    if !(fp.is_finite() && stripe.width > 0.0 && stripe.width.is_finite()) {
         return None;
     }
     let (sin, cos) = stripe.angle.sin_cos();
@@ -220,7 +220,9 @@ pub fn check_fraction(check: &Check, fp: &PlaneFootprint) -> Option<f64> {
     }
     let det = fp.axis_u.perp_dot(fp.axis_v);
     let scale = fp.axis_u.length() * fp.axis_v.length();
-    if !(det.abs() > 1e-12 * scale) || scale == 0.0 {
+    // Zero area (or NaN): declined.
+    if det.abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) || scale == 0.0
+    {
         return None;
     }
     let w = check.width;
