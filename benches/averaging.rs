@@ -3,7 +3,11 @@
 //! so that a user can pick N).
 //!
 //! Run: `cargo bench --bench averaging` (add `-- sone` to filter). Benchmark ids are
-//! `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. Compare the
+//! `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. `sone samples=<N>`
+//! is Monte Carlo averaging; `sone prefiltered` is the default (closed-form averages where
+//! the field has them and the pair is flat, the paper's 16 + 32 samples elsewhere): run
+//! `cargo bench --bench averaging -- 'prefiltered|field-lookup|jensen-out'` to compare it
+//! with a point lookup. Compare the
 //! estimators with the point-lookup estimator `jensen-out` of the same scene (and with
 //! `field-lookup`, one bare `CoefficientField::coefficients` call): absolute times depend on
 //! the machine. Each iteration estimates one pair and keeps only the coefficients, as a
@@ -13,6 +17,7 @@
 //! * `plane-stripe`: the analytic plane with the Figure 4 stripe preset (width 4, 45°,
 //!   σa 0.005 / 0.1, σs 1), x_i at the origin and x_o uniform in the paper's plot region
 //!   [−15, 15]² (the beam experiment);
+//! * `plane-check`: the same pairs over the Figure 4 check preset (cells of width 4);
 //! * `plane-constant`: the same pairs over a constant field (the short-circuit: every estimator
 //!   should cost about the same as a point lookup, or less);
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
@@ -28,11 +33,13 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
 use het_bssrdf::bssrdf_core::Rgb;
-use het_bssrdf::het_estimate::analytic::{ConstantField, Plane, PlanePoint, StripeField};
-use het_bssrdf::het_estimate::pattern::Stripe;
+use het_bssrdf::het_estimate::analytic::{
+    CheckField, ConstantField, Plane, PlanePoint, StripeField,
+};
+use het_bssrdf::het_estimate::pattern::{Check, Stripe};
 use het_bssrdf::het_estimate::{
-    CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams, SplitMix64,
-    SurfaceQuery, UniformSource,
+    Averaging, CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams,
+    SplitMix64, SurfaceQuery, UniformSource,
 };
 use het_bssrdf::tracer::field::{Field, MediumField, PlanarProjection};
 use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives};
@@ -61,9 +68,19 @@ fn estimators() -> Vec<(String, Estimator)> {
         let budget = SampleBudget::fixed(n);
         v.push((
             format!("sone samples={n}"),
-            Estimator::Sone(SoneParams::paper().with_samples(budget)),
+            Estimator::Sone(
+                SoneParams::paper()
+                    .with_averaging(Averaging::MonteCarlo)
+                    .with_samples(budget),
+            ),
         ));
     }
+    // The default: closed forms where the field has them and the pair is flat, sampling (at
+    // the paper's 16 + 32) where it is not.
+    v.push((
+        "sone prefiltered".to_string(),
+        Estimator::Sone(SoneParams::paper()),
+    ));
     v
 }
 
@@ -255,6 +272,11 @@ fn averaging(c: &mut Criterion) {
     let stripe = stripe_preset();
     print_std_table("plane-stripe", &Plane, &stripe, &pairs[..64], 64);
     bench_scene(c, "plane-stripe", &Plane, &stripe, &pairs);
+    let check = CheckField {
+        pattern: Check { width: 4.0 },
+        values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+    };
+    bench_scene(c, "plane-check", &Plane, &check, &pairs);
     let constant = ConstantField(Coefficients::grey(0.05, 1.0));
     bench_scene(c, "plane-constant", &Plane, &constant, &pairs);
     let (geometry, field, mesh_pairs) = mesh_scene();

@@ -186,7 +186,7 @@ fn eta_interpolation_is_within_the_noise() {
     };
     let mut worst: f64 = 0.0;
     let mut checked = 0;
-    for k in 1..n - 1 {
+    for (k, plane) in planes.iter().enumerate().take(n - 1).skip(1) {
         // (offset, weight) of the stencil predicting offset 0.
         let stencil: &[(isize, f64)] = if k >= 3 && k + 3 < n {
             &[
@@ -214,7 +214,7 @@ fn eta_interpolation_is_within_the_noise() {
             assert!(
                 z.abs() < 4.0,
                 "η {} α {}: predicted {got} from twice the spacing, stored {want} (z = {z:.2})",
-                planes[k].eta,
+                plane.eta,
                 albedo_of_row(row)
             );
         }

@@ -37,8 +37,8 @@ use het_estimate::analytic::{Plane, PlanePoint, StripeField};
 use het_estimate::path_integral::{self, MeanSquareAngle};
 use het_estimate::pattern::{Check, Stripe};
 use het_estimate::{
-    CoefficientField, Coefficients, Estimator, FieldBounds, MissPolicy, Named, SampleBudget,
-    SemiMinorAxis, SoneParams, SplitMix64, SurfacePoint, SurfaceQuery,
+    Averaging, CoefficientField, Coefficients, Estimator, FieldBounds, MissPolicy, Named,
+    SampleBudget, SemiMinorAxis, SoneParams, SplitMix64, SurfacePoint, SurfaceQuery,
 };
 
 /// Coefficient values (1/length) for σa and σs.
@@ -593,7 +593,7 @@ pub fn estimator_cases() -> Vec<(String, Estimator)> {
     alt.semi_minor = SemiMinorAxis::Width;
     alt.mean_square_angle = MeanSquareAngle::SmallAngle;
     alt.misses = MissPolicy::Endpoints;
-    alt.use_field_average = false;
+    alt.averaging = Averaging::MonteCarlo;
     v.push((
         "sone (b=w, 2(1−g), miss→endpoints)".into(),
         Estimator::Sone(alt),

@@ -14,7 +14,7 @@ use tracer::integrator::Method;
 use crate::common::{
     check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{Given, check_method_flags};
+use crate::flags::{Given, check_averaging_flag, check_method_flags};
 use crate::interrupt;
 
 /// Texture kinds.
@@ -166,6 +166,10 @@ pub struct Args {
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
+    /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field
+    /// has them and the surface is flat, sampling elsewhere) or `monte-carlo` (always sample).
+    #[arg(long, value_parser = crate::choices::averaging())]
+    averaging: Option<het_estimate::Averaging>,
     /// Photons for `pt` (rounded up to batches of 8192).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     photons: Option<u64>,
@@ -244,6 +248,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         given.has("profile"),
         args.estimator_samples.is_some(),
     )?;
+    check_averaging_flag(&[args.method], args.averaging.is_some())?;
     let setup = args.setup.setup()?;
     // The beam's half-space is index-matched (η = 1).
     let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
@@ -271,10 +276,12 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     interrupt::install()?;
     let map = run_method(
         &setup,
-        args.method.with_estimator_samples(
-            args.estimator_samples
-                .map(|n| n.min(u32::MAX as u64) as u32),
-        ),
+        args.method
+            .with_estimator_samples(
+                args.estimator_samples
+                    .map(|n| n.min(u32::MAX as u64) as u32),
+            )
+            .with_averaging(args.averaging),
         profile,
         photons,
         sub,
@@ -293,6 +300,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         &out,
         serde_json::json!({
             "seed": args.seed,
+            "averaging": args.method.with_averaging(args.averaging).averaging().map(|a| a.name()),
             "interrupted": interrupted.is_some(),
             "max_collisions": tracer::integrator::walk::collision_cap(),
         }),

@@ -53,6 +53,16 @@ pub fn method() -> Choice<Method> {
     by_name(names)
 }
 
+/// An averaging mode of the Sone estimator (`prefiltered`, `monte-carlo`).
+pub fn averaging() -> Choice<het_estimate::Averaging> {
+    by_name(
+        het_estimate::Averaging::ALL
+            .iter()
+            .map(|a| a.name())
+            .collect(),
+    )
+}
+
 /// A profile model name.
 pub fn profile() -> Choice<ProfileModel> {
     by_name(ProfileModel::ALL.iter().map(|m| m.name()).collect())

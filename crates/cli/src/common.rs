@@ -85,6 +85,13 @@ pub fn warn_counters(c: &PathCounters) {
             c.estimator_fallbacks
         );
     }
+    if c.prefiltered + c.prefilter_fallbacks > 0 {
+        eprintln!(
+            "averaging: {} of {} estimates prefiltered, {} sampled where the surface was too curved \
+             for a flat footprint",
+            c.prefiltered, c.estimates, c.prefilter_fallbacks
+        );
+    }
 }
 
 /// Refuses, before anything is allocated, a render of the scene's `width × height` that would

@@ -20,7 +20,7 @@ use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
 use crate::common::parse_positive;
-use crate::flags::{Given, check_method_flags};
+use crate::flags::{Given, check_averaging_flag, check_method_flags};
 
 /// Flags that set up the beam experiment: they do not apply to a scene.
 const BEAM_ONLY: &[&str] = &[
@@ -63,6 +63,10 @@ pub struct Args {
     /// Averaging samples per region of the segment and Sone estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
+    /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field
+    /// has them and the surface is flat, sampling elsewhere) or `monte-carlo` (always sample).
+    #[arg(long, value_parser = crate::choices::averaging())]
+    averaging: Option<het_estimate::Averaging>,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
     /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
     /// (beam, in --out).
@@ -153,6 +157,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.profile.is_some(),
         args.estimator_samples.is_some(),
     )?;
+    check_averaging_flag(&args.methods, args.averaging.is_some())?;
     if args.beam {
         given.refuse(SCENE_ONLY, "with --beam (it applies to a scene study)")?;
     } else {
@@ -257,6 +262,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .map(|m| {
             m.with_profile(args.profile)
                 .with_estimator_samples(estimator_samples(args))
+                .with_averaging(args.averaging.or(scene.settings().averaging))
         })
         .collect();
     let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
@@ -392,7 +398,10 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     let methods: Vec<Method> = args
         .methods
         .iter()
-        .map(|m| m.with_estimator_samples(samples))
+        .map(|m| {
+            m.with_estimator_samples(samples)
+                .with_averaging(args.averaging)
+        })
         .collect();
     let runs = beam_study(
         &setup,

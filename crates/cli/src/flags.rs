@@ -76,3 +76,25 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
     }
     Ok(())
 }
+
+/// Errors when `--averaging` was given but none of `methods` is the Sone estimator, the only
+/// one that averages over an ellipse.
+pub fn check_averaging_flag(methods: &[Method], given: bool) -> anyhow::Result<()> {
+    let sone = |m: &Method| {
+        matches!(
+            m,
+            Method::Bssrdf {
+                estimator: Estimator::Sone(_),
+                ..
+            }
+        )
+    };
+    if given && !methods.iter().any(sone) {
+        let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
+        bail!(
+            "--averaging does not apply to `{}`: only the sone estimator averages over an ellipse",
+            names.join(", ")
+        );
+    }
+    Ok(())
+}

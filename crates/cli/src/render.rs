@@ -20,7 +20,7 @@ use crate::common::{
     check_image_memory, check_writable, note_triangles, parse_exr_out, parse_positive,
     parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::check_method_flags;
+use crate::flags::{check_averaging_flag, check_method_flags};
 use crate::interrupt;
 
 /// Arguments of `het-bssrdf render`.
@@ -39,6 +39,10 @@ pub struct Args {
     /// segment; 16 in the disk and 32 in the ellipse for Sone).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
+    /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field
+    /// has them and the surface is flat, sampling elsewhere) or `monte-carlo` (always sample).
+    #[arg(long, value_parser = crate::choices::averaging())]
+    averaging: Option<het_estimate::Averaging>,
     /// Samples per pixel (default: the scene's `render.spp`).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     spp: Option<u64>,
@@ -90,10 +94,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         args.profile.is_some(),
         args.estimator_samples.is_some(),
     )?;
-    let method = method.with_profile(args.profile).with_estimator_samples(
-        args.estimator_samples
-            .map(|n| n.min(u32::MAX as u64) as u32),
-    );
+    check_averaging_flag(&[method], args.averaging.is_some())?;
+    let method = method
+        .with_profile(args.profile)
+        .with_estimator_samples(
+            args.estimator_samples
+                .map(|n| n.min(u32::MAX as u64) as u32),
+        )
+        .with_averaging(args.averaging.or(scene.settings().averaging));
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);

@@ -1,4 +1,4 @@
-//! Method overrides (`--profile`, `--estimator-samples`) reach the runs and their sidecars, for
+//! Method overrides (`--profile`, `--estimator-samples`, `--averaging`) reach the runs and their sidecars, for
 //! `converge` (on a tiny scene) and `beam`.
 
 use std::process::Command;
@@ -64,6 +64,8 @@ fn beam_uses_the_requested_estimator_samples() {
             "sone",
             "--estimator-samples",
             "3",
+            "--averaging",
+            "monte-carlo",
         ])
         .args([
             "--resolution",
@@ -91,4 +93,38 @@ fn beam_uses_the_requested_estimator_samples() {
         6 * estimates,
         "{samples} samples for {estimates} estimates"
     );
+    assert_eq!(v["averaging"], "monte-carlo");
+    assert_eq!(c["prefiltered"], 0);
+}
+
+/// The default averaging is prefiltered: on the beam's flat half-space with its stripe
+/// texture every estimate is answered by the closed form (no samples, no fallback), and the
+/// sidecar says so. `--averaging` with an estimator that does not average over an ellipse is
+/// refused.
+#[test]
+fn beam_prefilters_by_default_and_records_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("map.exr");
+    let beam = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(["beam", "--preset", "check", "--resolution", "6"])
+            .args(["--subsamples", "1", "--out", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    assert!(beam(&["--method", "sone"]).status.success());
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+            .unwrap();
+    let c = &v["map"]["counters"];
+    assert_eq!(v["averaging"], "prefiltered");
+    assert!(c["estimates"].as_u64().unwrap() > 0);
+    assert_eq!(c["prefiltered"], c["estimates"]);
+    assert_eq!(c["estimator_samples"], 0);
+    assert_eq!(c["prefilter_fallbacks"], 0);
+    let refused = beam(&["--method", "jensen-out", "--averaging", "monte-carlo"]);
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("--averaging does not apply"), "{err}");
 }

@@ -251,6 +251,7 @@ pub fn write_render(
         "method": outcome.method,
         "profile": profile,
         "estimator_parameters": estimator,
+        "averaging": job.method.averaging().map(|a| a.name()),
         "scattering": job.scattering.name(),
         "spp": outcome.spp,
         "seed": job.seed,

@@ -4,11 +4,12 @@
 //! The plane's outward normal is +z (the medium fills z < 0). Fields are functions of the
 //! point's (x, y), using the shared definitions of [`crate::pattern`].
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use crate::ellipse::PlanarEllipse;
 use crate::field::{CoefficientField, Coefficients, FieldBounds};
 use crate::pattern::{BinaryPattern, Check, Ramp, Stripe};
+use crate::prefilter::{PlaneFootprint, check_fraction, stripe_fraction};
 use crate::surface::{SurfacePoint, SurfaceQuery};
 
 /// The infinite plane z = 0 with outward normal +z.
@@ -75,6 +76,9 @@ impl CoefficientField<PlanePoint> for ConstantField {
     fn ellipse_average(&self, _: &PlanarEllipse) -> Option<Coefficients> {
         Some(self.0)
     }
+    fn has_ellipse_average(&self) -> bool {
+        true
+    }
 }
 
 /// Two coefficient values arranged by a binary pattern (stripes, checks) of
@@ -92,10 +96,54 @@ pub type StripeField = PatternField<Stripe>;
 /// A checkerboard of two coefficient values.
 pub type CheckField = PatternField<Check>;
 
-impl<P: BinaryPattern> CoefficientField<PlanePoint> for PatternField<P> {
+/// The projection of a vector along `n` onto the plane z = 0, as (x, y); `None` when `n` is
+/// parallel to the plane.
+fn along_onto_plane(n: DVec3) -> Option<impl Fn(DVec3) -> DVec2> {
+    (n.z.abs() >= 1e-12 && n.is_finite()).then_some(move |v: DVec3| {
+        let p = v - n * (v.z / n.z);
+        DVec2::new(p.x, p.y)
+    })
+}
+
+/// A pattern with a closed-form average over a footprint in its plane (fraction of value 1).
+pub trait FootprintPattern: BinaryPattern {
+    /// The weighted fraction of `fp` where the pattern selects value 1, if it has a closed
+    /// form ([`crate::prefilter`]).
+    fn fraction(&self, fp: &PlaneFootprint) -> Option<f64>;
+}
+
+impl FootprintPattern for Stripe {
+    fn fraction(&self, fp: &PlaneFootprint) -> Option<f64> {
+        stripe_fraction(self, fp)
+    }
+}
+
+impl FootprintPattern for Check {
+    fn fraction(&self, fp: &PlaneFootprint) -> Option<f64> {
+        check_fraction(self, fp)
+    }
+}
+
+impl<P: FootprintPattern> CoefficientField<PlanePoint> for PatternField<P> {
     #[inline]
     fn coefficients(&self, p: &PlanePoint) -> Coefficients {
         self.values[self.pattern.select(p.x, p.y)]
+    }
+
+    /// Exact: the plane is flat, so projecting the ellipse along its normal onto z = 0 is
+    /// affine and the closed forms of [`crate::prefilter`] apply.
+    fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
+        let fp = PlaneFootprint::of_ellipse(e, along_onto_plane(e.normal)?);
+        let f = self.pattern.fraction(&fp)?;
+        let [v0, v1] = self.values;
+        Some(Coefficients {
+            sigma_a: v0.sigma_a * (1.0 - f) + v1.sigma_a * f,
+            sigma_s: v0.sigma_s * (1.0 - f) + v1.sigma_s * f,
+        })
+    }
+
+    fn has_ellipse_average(&self) -> bool {
+        true
     }
     #[inline]
     fn bounds(&self) -> Option<FieldBounds> {
@@ -199,6 +247,10 @@ impl CoefficientField<PlanePoint> for RampField {
             q.value(c.x, c.y) - gu.hypot(gv) >= 0.0
         });
         ok.then(|| self.linear(c.x, c.y))
+    }
+
+    fn has_ellipse_average(&self) -> bool {
+        true
     }
 }
 

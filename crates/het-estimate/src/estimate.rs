@@ -62,6 +62,9 @@ pub struct Diagnostics {
     /// Ellipse averages answered by [`crate::CoefficientField::ellipse_average`] instead of
     /// sampling (Sone: up to 1 for the disk + 3 for the ellipses).
     pub field_averages: u8,
+    /// Prefiltered averaging was asked for and the field offers it, but the surface was too
+    /// curved for a flat footprint ([`crate::Flatness`]): the regions were sampled instead.
+    pub prefilter_fallback: bool,
     /// Sone: the step-1 disk means ⟨σa⟩, ⟨σs⟩ that entered Eq. (2).
     pub disk_mean: Option<Coefficients>,
     /// Sone: the width w of Eq. (2) per channel (scene units); the ellipse's semi-minor axis

@@ -19,8 +19,9 @@ use crate::surface::SurfaceQuery;
 /// Names (`Display`/`FromStr`, used by the CLI and scene files): `jensen-in`, `jensen-out`,
 /// `endpoints`, `segment`, `sone`. Parsing a name gives the variant with default parameters.
 ///
-/// New methods (a diffusion-theory averaging kernel, prefiltered constant-time averaging, …)
-/// are one more variant each, with their parameters in their own module.
+/// New methods (a diffusion-theory averaging kernel, …) are one more variant each, with their
+/// parameters in their own module. Prefiltered constant-time averaging is an option of
+/// `sone` ([`SoneParams::averaging`], on by default), not a separate estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Estimator {
@@ -88,6 +89,10 @@ impl Estimator {
             Estimator::Sone(p) => {
                 p.disk.validate()?;
                 p.ellipse.validate()?;
+                crate::names::check_non_negative(
+                    "flatness.max_normal_angle",
+                    p.flatness.max_normal_angle,
+                )?;
                 theta2_of(Default::default())?;
                 let (g_theta, _) = p.width_scattering.resolve(g);
                 p.mean_square_angle.evaluate(g_theta)?

@@ -90,12 +90,22 @@ pub trait CoefficientField<P> {
     /// over `region`, i.e. the mean of the coefficients at the projections of the ellipse's
     /// points onto the surface along `±region.normal`, uniformly weighted by area in the
     /// ellipse's plane. Fields that can answer in constant time (summed-area tables, EWA over
-    /// a texture, closed forms) override this; the Sone estimator then asks it before sampling
-    /// (see `SoneParams::use_field_average`). The default, `None`, means "not supported:
-    /// sample it", and costs nothing.
+    /// a texture, closed forms: see [`crate::prefilter`]) override this together with
+    /// [`CoefficientField::has_ellipse_average`]; the Sone estimator then asks it before
+    /// sampling wherever the surface is flat enough for a flat footprint (see
+    /// `SoneParams::averaging` and [`crate::Flatness`]). An implementation may answer for the
+    /// ellipse as it lies in its plane (the flat-surface reading). `None` means "not for this
+    /// region: sample it"; the default always returns `None` and costs nothing.
     fn ellipse_average(&self, region: &PlanarEllipse) -> Option<Coefficients> {
         let _ = region;
         None
+    }
+
+    /// True when [`CoefficientField::ellipse_average`] can answer (for some regions). The
+    /// estimator asks for field averages, checks the surface's flatness and counts fallbacks
+    /// only for such fields. Default: false.
+    fn has_ellipse_average(&self) -> bool {
+        false
     }
 }
 
@@ -108,5 +118,8 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn ellipse_average(&self, region: &PlanarEllipse) -> Option<Coefficients> {
         (**self).ellipse_average(region)
+    }
+    fn has_ellipse_average(&self) -> bool {
+        (**self).has_ellipse_average()
     }
 }

@@ -12,8 +12,9 @@
 //!   [`SurfaceQuery`] projects a point of the averaging plane onto the object being shaded by
 //!   two rays along ± the plane normal (the paper's Figure 3); [`CoefficientField`] looks up
 //!   σa, σs per colour channel at a surface point and may report bounds (so constant fields
-//!   cost nothing) or an exact/prefiltered ellipse average (so summed-area tables or EWA can
-//!   replace sampling). Geometry and texturing are separate because they vary separately
+//!   cost nothing) or an exact/prefiltered ellipse average (so closed forms, summed-area
+//!   tables or EWA can replace sampling; [`prefilter`] has the closed forms for stripes and
+//!   checks, and the fallback criterion on curved surfaces). Geometry and texturing are separate because they vary separately
 //!   (one mesh, many textures; one procedural field, many shapes), and because tests and
 //!   benchmarks substitute analytic versions of each (module `analytic`, behind the
 //!   `fixtures` feature). The point type is the
@@ -53,6 +54,7 @@ mod known;
 pub mod path_integral;
 pub mod pattern;
 mod point_lookup;
+pub mod prefilter;
 pub mod probe;
 mod region_average;
 pub mod sampler;
@@ -72,6 +74,7 @@ pub use field::{CoefficientField, Coefficients, FieldBounds};
 pub use glam;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
+pub use prefilter::{Averaging, Flatness};
 #[cfg(feature = "fixtures")]
 pub use sampler::SplitMix64;
 pub use sampler::UniformSource;

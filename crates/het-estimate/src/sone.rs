@@ -15,6 +15,13 @@
 //!
 //! σs and σa are averaged separately (not the albedo, not σt), as in Eq. (3).
 //!
+//! # Prefiltered averaging
+//! With [`Averaging::Prefiltered`] (the default), steps 1 and 3 first ask the field's
+//! constant-time [`CoefficientField::ellipse_average`] (closed forms for stripes and checks,
+//! see [`crate::prefilter`]), if the field has one and the pair is flat by
+//! [`SoneParams::flatness`]; a curved pair is sampled and flagged
+//! ([`crate::Diagnostics::prefilter_fallback`]). [`Averaging::MonteCarlo`] always samples.
+//!
 //! # Colour
 //! Eq. (2) gives one width per channel, so each channel has its own ellipse. One unit-disk
 //! sample u is mapped to every channel's ellipse (`m + (d/2)u.x x̂ + b_c u.y (n_i*×x̂)`), so the
@@ -41,10 +48,11 @@ use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
+use crate::prefilter::{Averaging, Flatness};
 use crate::region_average::{Accumulator, Channels, Probe, average};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
-use crate::surface::SurfaceQuery;
+use crate::surface::{SurfacePoint, SurfaceQuery};
 
 /// Parameters of the `sone` estimator. Defaults follow the paper's reading
 /// ([`SoneParams::paper`]).
@@ -63,9 +71,13 @@ pub struct SoneParams {
     pub width_scattering: WidthScattering,
     /// Projection misses: hits only (default) or endpoint mean.
     pub misses: MissPolicy,
-    /// Ask [`CoefficientField::ellipse_average`] first and sample only when it returns `None`
-    /// (default true; it returns `None` unless the field implements it, at no cost).
-    pub use_field_average: bool,
+    /// Prefiltered (default) or Monte Carlo averaging. Prefiltered asks
+    /// [`CoefficientField::ellipse_average`] first, for fields that have it
+    /// ([`CoefficientField::has_ellipse_average`]) and pairs that pass `flatness`, and samples
+    /// otherwise; Monte Carlo always samples.
+    pub averaging: Averaging,
+    /// The fallback criterion of prefiltered averaging (default: normals within 2°).
+    pub flatness: Flatness,
 }
 
 /// Which scattering coefficient Eq. (2) uses when g ≠ 0. The paper calls its σs, σa and g
@@ -123,7 +135,8 @@ impl SoneParams {
             semi_minor: SemiMinorAxis::HalfWidth,
             width_scattering: WidthScattering::Unreduced,
             misses: MissPolicy::HitsOnly,
-            use_field_average: true,
+            averaging: Averaging::Prefiltered,
+            flatness: Flatness::DEFAULT,
         }
     }
 
@@ -135,6 +148,12 @@ impl SoneParams {
             rel_se: 0.01,
             max: NonZeroU32::new(4096).unwrap(),
         })
+    }
+
+    /// The same parameters with `averaging`.
+    pub const fn with_averaging(mut self, averaging: Averaging) -> Self {
+        self.averaging = averaging;
+        self
     }
 
     /// The same parameters with `samples` for both the disk and the ellipse.
@@ -209,9 +228,21 @@ where
         }
     };
 
+    // Prefiltered averages only where a flat footprint stands for the projected region.
+    let use_field_average =
+        params.averaging == Averaging::Prefiltered && probe.field.has_ellipse_average() && {
+            let flat = params.flatness.is_flat(
+                probe.x_i.normal().normalize(),
+                probe.x_o.normal().normalize(),
+                chord.x_hat,
+            );
+            probe.diag.prefilter_fallback = !flat;
+            flat
+        };
+
     // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
     let disk = chord.ellipse(chord.half_len);
-    let field_disk = if params.use_field_average {
+    let field_disk = if use_field_average {
         probe.field.ellipse_average(&disk)
     } else {
         None
@@ -252,7 +283,7 @@ where
     let mut sampled = [false; 3];
     for (g, is_sampled) in sampled.iter_mut().enumerate().take(groups.len) {
         let e = chord.ellipse(groups.semi_minor[g]);
-        let field_avg = if params.use_field_average {
+        let field_avg = if use_field_average {
             probe.field.ellipse_average(&e)
         } else {
             None

@@ -11,7 +11,7 @@ use het_estimate::analytic::{
 };
 use het_estimate::pattern::{Check, Ramp, Stripe};
 use het_estimate::{
-    CoefficientField, Coefficients, Estimate, Estimator, MissPolicy, Named, Region, Rgb,
+    Averaging, CoefficientField, Coefficients, Estimate, Estimator, MissPolicy, Named, Region, Rgb,
     SampleBudget, SegmentParams, SemiMinorAxis, SoneParams, SplitMix64, SurfacePoint, SurfaceQuery,
     WidthScattering,
 };
@@ -80,8 +80,10 @@ fn fixed(n: u32) -> SampleBudget {
     SampleBudget::Fixed(NonZeroU32::new(n).unwrap())
 }
 
+/// Sone with fixed budgets and Monte Carlo averaging (the sampling under test; the
+/// prefiltered default is tested explicitly).
 fn sone(disk: u32, ellipse: u32) -> SoneParams {
-    let mut p = SoneParams::paper();
+    let mut p = SoneParams::paper().with_averaging(Averaging::MonteCarlo);
     p.disk = fixed(disk);
     p.ellipse = fixed(ellipse);
     p
@@ -445,7 +447,7 @@ fn linear_ramp_gives_the_centroid_value() {
         for semi_minor in SemiMinorAxis::ALL {
             let mut p = sone(n, n);
             p.semi_minor = *semi_minor;
-            p.use_field_average = false;
+            p.averaging = Averaging::MonteCarlo;
             let est = run(Estimator::Sone(p), 0.2, &Plane, &field, &x_i, &x_o, 7);
             assert!(
                 close(est.coefficients),
@@ -460,7 +462,7 @@ fn linear_ramp_gives_the_centroid_value() {
             // 3 ellipses × n points, plus n disk points.
             assert_eq!(est.diagnostics.projections, 4 * n);
             // The field's own exact ellipse average gives the same, without sampling.
-            p.use_field_average = true;
+            p.averaging = Averaging::Prefiltered;
             let fa = run(Estimator::Sone(p), 0.2, &Plane, &field, &x_i, &x_o, 7);
             assert!(close(fa.coefficients));
             assert_eq!(fa.diagnostics.field_averages, 4);
@@ -470,7 +472,7 @@ fn linear_ramp_gives_the_centroid_value() {
     // The presets too (the reference preset stops early: a linear field has no variance).
     for p in [SoneParams::paper(), SoneParams::reference()] {
         let mut p = p;
-        p.use_field_average = false;
+        p.averaging = Averaging::MonteCarlo;
         let est = run(Estimator::Sone(p), 0.0, &Plane, &field, &x_i, &x_o, 3);
         assert!(close(est.coefficients), "{p:?}: {:?}", est.coefficients);
     }
@@ -479,53 +481,61 @@ fn linear_ramp_gives_the_centroid_value() {
 /// The Sone estimate on the Figure 4 stripe preset against an independent computation:
 /// disk quadrature → ⟨σa⟩ → Eq. (2) as printed → ellipse quadrature. Compared at 4 standard
 /// errors (measured over 64 seeds) plus the quadrature's own error. The two semi-minor
-/// readings give answers ~7 standard errors apart here, so a wrong b fails.
+/// readings give answers ~7 standard errors apart here, so a wrong b fails. The prefiltered
+/// default (closed form, no variance) must match within the quadrature's error alone.
 #[test]
 fn sone_stripe_matches_brute_force_quadrature() {
     let f = stripe_preset();
-    let sa = |x: f64, y: f64| f.values[stripe_index(x, y, 4.0, FRAC_PI_4)].sigma_a[0];
-    for (xo, semi) in [
-        ((6.0, 1.0), SemiMinorAxis::HalfWidth),
-        ((-3.0, 9.0), SemiMinorAxis::Width),
-    ] {
-        let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(xo.0, xo.1));
-        let d = (xo.0 * xo.0 + xo.1 * xo.1).sqrt();
-        let m = [xo.0 / 2.0, xo.1 / 2.0];
-        let xh = [xo.0 / d, xo.1 / d];
-        let g = 2000;
-        let disk_sa = ellipse_quadrature(m, xh, d / 2.0, d / 2.0, g, sa);
-        let w = eq2(ISO_THETA2, 1.0, disk_sa, d);
-        let b = if semi == SemiMinorAxis::HalfWidth {
-            w / 2.0
-        } else {
-            w
-        };
-        let want = ellipse_quadrature(m, xh, d / 2.0, b, g, sa);
+    for averaging in Averaging::ALL {
+        let sa = |x: f64, y: f64| f.values[stripe_index(x, y, 4.0, FRAC_PI_4)].sigma_a[0];
+        for (xo, semi) in [
+            ((6.0, 1.0), SemiMinorAxis::HalfWidth),
+            ((-3.0, 9.0), SemiMinorAxis::Width),
+        ] {
+            let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(xo.0, xo.1));
+            let d = (xo.0 * xo.0 + xo.1 * xo.1).sqrt();
+            let m = [xo.0 / 2.0, xo.1 / 2.0];
+            let xh = [xo.0 / d, xo.1 / d];
+            let g = 2000;
+            let disk_sa = ellipse_quadrature(m, xh, d / 2.0, d / 2.0, g, sa);
+            let w = eq2(ISO_THETA2, 1.0, disk_sa, d);
+            let b = if semi == SemiMinorAxis::HalfWidth {
+                w / 2.0
+            } else {
+                w
+            };
+            let want = ellipse_quadrature(m, xh, d / 2.0, b, g, sa);
 
-        let mut p = sone(512, 512);
-        p.semi_minor = semi;
-        let ests: Vec<Estimate> = (0..64)
-            .map(|s| run(Estimator::Sone(p), 0.0, &Plane, &f, &x_i, &x_o, s))
-            .collect();
-        let vals: Vec<f64> = ests.iter().map(|e| e.coefficients.sigma_a[0]).collect();
-        let (mean, sd) = mean_sd(&vals);
-        let se = sd / 8.0;
-        assert!(
-            (mean - want).abs() < 4.0 * se + 1e-4 * want,
-            "{mean} vs {want} (se {se})"
-        );
-        // The reported width and step-1 mean agree with the independent ones.
-        let ws: Vec<f64> = ests
-            .iter()
-            .map(|e| e.diagnostics.width.unwrap()[0])
-            .collect();
-        assert!(
-            (mean_sd(&ws).0 - w).abs() < 2e-3 * w,
-            "width {} vs {w}",
-            mean_sd(&ws).0
-        );
-        assert_eq!(ests[0].diagnostics.region, Region::Ellipse);
-        assert!(ests.iter().all(|e| e.coefficients.sigma_s == Rgb::ONE));
+            let mut p = sone(512, 512).with_averaging(*averaging);
+            p.semi_minor = semi;
+            let ests: Vec<Estimate> = (0..64)
+                .map(|s| run(Estimator::Sone(p), 0.0, &Plane, &f, &x_i, &x_o, s))
+                .collect();
+            let vals: Vec<f64> = ests.iter().map(|e| e.coefficients.sigma_a[0]).collect();
+            let (mean, sd) = mean_sd(&vals);
+            let se = sd / 8.0;
+            assert!(
+                (mean - want).abs() < 4.0 * se + 1e-4 * want,
+                "{mean} vs {want} (se {se})"
+            );
+            // The reported width and step-1 mean agree with the independent ones.
+            let ws: Vec<f64> = ests
+                .iter()
+                .map(|e| e.diagnostics.width.unwrap()[0])
+                .collect();
+            assert!(
+                (mean_sd(&ws).0 - w).abs() < 2e-3 * w,
+                "width {} vs {w}",
+                mean_sd(&ws).0
+            );
+            assert_eq!(ests[0].diagnostics.region, Region::Ellipse);
+            assert!(ests.iter().all(|e| e.coefficients.sigma_s == Rgb::ONE));
+            let answered = ests[0].diagnostics.field_averages;
+            match averaging {
+                Averaging::Prefiltered => assert!(answered == 2 && se <= 1e-12 * mean),
+                Averaging::MonteCarlo => assert!(answered == 0 && se > 0.0),
+            }
+        }
     }
 }
 
@@ -739,7 +749,7 @@ fn target_relative_error_budget() {
         rel_se: 0.01,
         max: NonZeroU32::new(4096).unwrap(),
     });
-    p.use_field_average = false;
+    p.averaging = Averaging::MonteCarlo;
     let est = run(Estimator::Sone(p), 0.0, &Plane, &f, &x_i, &x_o, 11);
     let err = est.diagnostics.rel_std_error.unwrap();
     assert!(err <= 0.01, "{err}");

@@ -26,7 +26,8 @@ use std::sync::Arc;
 use bssrdf_core::Rgb;
 use glam::{DVec2, DVec3};
 use het_estimate::pattern::{BinaryPattern, Check, Stripe};
-use het_estimate::{CoefficientField, Coefficients, FieldBounds};
+use het_estimate::prefilter::{PlaneFootprint, check_fraction, stripe_fraction};
+use het_estimate::{CoefficientField, Coefficients, FieldBounds, PlanarEllipse};
 
 use crate::error::FieldError;
 use crate::geometry::Hit;
@@ -47,6 +48,16 @@ impl Pattern {
         match self {
             Pattern::Stripe(p) => p.select(s, t),
             Pattern::Check(p) => p.select(s, t),
+        }
+    }
+
+    /// The weighted fraction of `fp` where the pattern selects 1, in closed form
+    /// ([`het_estimate::prefilter`]); `None` where the closed form declines.
+    #[inline]
+    pub fn fraction(&self, fp: &PlaneFootprint) -> Option<f64> {
+        match self {
+            Pattern::Stripe(p) => stripe_fraction(p, fp),
+            Pattern::Check(p) => check_fraction(p, fp),
         }
     }
 }
@@ -259,6 +270,30 @@ impl Field {
         }
     }
 
+    /// The uniform area average over the ellipse `e` as it lies in its plane (the
+    /// flat-footprint reading of Eq. (3)), in constant time: the constant itself, or the
+    /// pattern's closed form through the planar projection ([`het_estimate::prefilter`]).
+    /// `None` for image fields (sampled) and where a closed form declines.
+    pub fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Rgb> {
+        match self {
+            Field::Constant(v) => Some(*v),
+            Field::Pattern {
+                pattern,
+                values,
+                projection,
+            } => {
+                let f = pattern.fraction(&projection.footprint(e))?;
+                Some(values[0] * (1.0 - f) + values[1] * f)
+            }
+            Field::Image(_) => None,
+        }
+    }
+
+    /// True when [`Field::ellipse_average`] can answer (constant and procedural fields).
+    pub fn has_ellipse_average(&self) -> bool {
+        !matches!(self, Field::Image(_))
+    }
+
     /// False only for UV-mapped images (defined on the surface only).
     pub fn is_volumetric(&self) -> bool {
         !matches!(
@@ -421,6 +456,19 @@ impl CoefficientField<Hit> for MediumField {
     fn bounds(&self) -> Option<FieldBounds> {
         Some(self.bounds)
     }
+
+    /// Both fields' [`Field::ellipse_average`]; `None` if either declines.
+    fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
+        Some(Coefficients {
+            sigma_a: self.sigma_a.ellipse_average(e)?,
+            sigma_s: self.sigma_s.ellipse_average(e)?,
+        })
+    }
+
+    /// True when neither field is an image.
+    fn has_ellipse_average(&self) -> bool {
+        self.sigma_a.has_ellipse_average() && self.sigma_s.has_ellipse_average()
+    }
 }
 
 #[cfg(test)]
@@ -452,6 +500,59 @@ mod tests {
         let m = MediumField::new(fs, Field::constant(Rgb::ONE).unwrap());
         assert!(!m.is_grey() && m.is_volumetric() && !m.is_constant());
         assert_eq!(m.majorant(), Rgb::new(2.0, 3.0, 4.0));
+    }
+
+    /// The closed-form ellipse average of a projected pattern against the mean over 40,000
+    /// uniform points of the same ellipse (tilted to the projection axis, fixed seed), at 5
+    /// standard errors of the Bernoulli mean; image fields decline (they are sampled).
+    #[test]
+    fn pattern_ellipse_average_matches_monte_carlo() {
+        let (a, b) = (Rgb::new(0.1, 0.2, 0.3), Rgb::new(1.0, 2.0, 4.0));
+        let proj = PlanarProjection::new(Axis::X, DVec3::new(0.0, 0.5, -0.25));
+        let normal = DVec3::new(0.8, 0.36, 0.48);
+        let major = normal.any_orthonormal_vector();
+        let minor = normal.cross(major);
+        let e = PlanarEllipse {
+            center: DVec3::new(3.0, 1.0, -2.0),
+            semi_major: 5.0 * major,
+            semi_minor: 2.0 * minor,
+            normal,
+        };
+        for field in [
+            Field::stripe(1.5, 0.3, [a, b], proj).unwrap(),
+            Field::check(1.2, [a, b], proj).unwrap(),
+        ] {
+            let exact = field.ellipse_average(&e).unwrap();
+            let f = (exact[0] - a[0]) / (b[0] - a[0]);
+            let mut rng = crate::rng::Rng::from_keys(77, &[]);
+            let n = 40_000;
+            let mut ones = 0usize;
+            for _ in 0..n {
+                let u = loop {
+                    let u = DVec2::new(2.0 * rng.uniform() - 1.0, 2.0 * rng.uniform() - 1.0);
+                    if u.length_squared() <= 1.0 {
+                        break u;
+                    }
+                };
+                let v = field.at_point(e.center + u.x * e.semi_major + u.y * e.semi_minor);
+                ones += (v == b) as usize;
+            }
+            let mc = ones as f64 / n as f64;
+            let se = (mc * (1.0 - mc) / n as f64).sqrt();
+            assert!(mc > 0.05 && mc < 0.95, "a footprint over both values: {mc}");
+            assert!((f - mc).abs() <= 5.0 * se, "{f} vs {mc} ± {se}");
+            // Every channel gets the same fraction.
+            assert!(((exact[2] - a[2]) / (b[2] - a[2]) - f).abs() < 1e-12);
+        }
+        let tex = Arc::new(Texture::from_texels("t", 1, 1, vec![[1.0; 3]]).unwrap());
+        let img = Field::image(
+            tex,
+            ImageMapping::Uv,
+            Wrap::Clamp,
+            Filter::Nearest,
+            Rgb::ONE,
+        );
+        assert!(img.unwrap().ellipse_average(&e).is_none());
     }
 
     #[test]

@@ -2,7 +2,8 @@
 //! a planar-mapped image. The field is then constant along the projection axis (the paper's
 //! assumption that coefficients vary only along tangent directions, §3.1).
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
+use het_estimate::prefilter::PlaneFootprint;
 
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -51,12 +52,29 @@ impl PlanarProjection {
     /// `(s, t)` of `p`.
     #[inline]
     pub fn st(&self, p: DVec3) -> (f64, f64) {
-        let d = p - self.origin;
+        self.st_vector(p - self.origin)
+    }
+
+    /// The linear part of [`PlanarProjection::st`]: `(s, t)` components of a displacement.
+    #[inline]
+    pub fn st_vector(&self, d: DVec3) -> (f64, f64) {
         match self.axis {
             Axis::Z => (d.x, d.y),
             Axis::X => (d.y, d.z),
             Axis::Y => (d.z, d.x),
         }
+    }
+
+    /// The footprint of the ellipse `e` in the `(s, t)` plane (the field is constant along
+    /// the axis, so the ellipse's points are read at their `(s, t)`): uniformly weighted.
+    pub fn footprint(&self, e: &het_estimate::PlanarEllipse) -> PlaneFootprint {
+        let mut fp = PlaneFootprint::of_ellipse(e, |v| {
+            let (s, t) = self.st_vector(v);
+            DVec2::new(s, t)
+        });
+        let (s, t) = self.st(e.center);
+        fp.centre = DVec2::new(s, t);
+        fp
     }
 }
 

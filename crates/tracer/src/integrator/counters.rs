@@ -39,6 +39,12 @@ pub struct PathCounters {
     pub short_circuits: u64,
     /// Estimates where a channel fell back to the endpoint average (no hits at all).
     pub estimator_fallbacks: u64,
+    /// Estimates with at least one region average answered by the field's prefiltered
+    /// (constant-time) average instead of sampling.
+    pub prefiltered: u64,
+    /// Estimates where prefiltered averaging applied to the field but the surface was too
+    /// curved for a flat footprint (`het_estimate::Flatness`), so the regions were sampled.
+    pub prefilter_fallbacks: u64,
     /// Profile evaluations whose estimated coefficients the profile rejected; those channels
     /// contribute 0, so a non-zero count means a bias (never expected: scenes are validated
     /// with the profiles' own bounds at load).
@@ -53,6 +59,8 @@ impl PathCounters {
         self.projection_misses += d.misses as u64;
         self.short_circuits += d.short_circuit as u64;
         self.estimator_fallbacks += d.fallback as u64;
+        self.prefiltered += (d.field_averages > 0) as u64;
+        self.prefilter_fallbacks += d.prefilter_fallback as u64;
     }
 
     /// The diffuse reflectance profile `R(r)` (1/length², the paper's Eq. 1 kernel) of the
@@ -111,6 +119,8 @@ impl Counters for PathCounters {
         self.projection_misses += o.projection_misses;
         self.short_circuits += o.short_circuits;
         self.estimator_fallbacks += o.estimator_fallbacks;
+        self.prefiltered += o.prefiltered;
+        self.prefilter_fallbacks += o.prefilter_fallbacks;
         self.profile_failures += o.profile_failures;
     }
 }

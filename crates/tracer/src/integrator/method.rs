@@ -50,6 +50,35 @@ impl Method {
         }
     }
 
+    /// The method with Sone's averaging set to `averaging` (prefiltered or Monte Carlo); other
+    /// methods are unchanged.
+    pub fn with_averaging(self, averaging: Option<het_estimate::Averaging>) -> Self {
+        match (self, averaging) {
+            (
+                Method::Bssrdf {
+                    estimator: Estimator::Sone(p),
+                    profile,
+                },
+                Some(a),
+            ) => Method::Bssrdf {
+                estimator: Estimator::Sone(p.with_averaging(a)),
+                profile,
+            },
+            (m, _) => m,
+        }
+    }
+
+    /// Sone's averaging (`None` for other methods).
+    pub fn averaging(&self) -> Option<het_estimate::Averaging> {
+        match self {
+            Method::Bssrdf {
+                estimator: Estimator::Sone(p),
+                ..
+            } => Some(p.averaging),
+            _ => None,
+        }
+    }
+
     /// The method with its profile model overridden (BSSRDF methods only).
     pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
         match self {

@@ -219,6 +219,8 @@ pub struct RenderDesc {
     pub max_depth: Option<u32>,
     /// BSSRDF estimator name.
     pub estimator: Option<String>,
+    /// Sone's averaging: `"prefiltered" | "monte-carlo"`.
+    pub averaging: Option<String>,
     /// `"multiple" | "single" | "all"`.
     pub scattering: Option<String>,
 }

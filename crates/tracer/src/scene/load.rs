@@ -310,7 +310,15 @@ impl Cx {
                 )
             })?),
         };
+        let averaging = match &r.averaging {
+            None => None,
+            Some(name) => Some(
+                name.parse::<het_estimate::Averaging>()
+                    .map_err(|e| self.invalid("render.averaging", e.to_string()))?,
+            ),
+        };
         let s = RenderSettings {
+            averaging,
             width: r.width,
             height: r.height,
             spp: r.spp,

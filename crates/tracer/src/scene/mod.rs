@@ -7,7 +7,8 @@
 //! errors; every error names the file, the key path (`material[1].sigma_a.width`) and the line.
 //!
 //! * `[render]`: `width`, `height`, `spp` (all ≥ 1), `seed` (default 0), optional `max_depth`,
-//!   `estimator` (a name the renderer parses), `scattering` (`multiple | single | all`).
+//!   `estimator` (a name the renderer parses), `averaging` (`prefiltered | monte-carlo`),
+//!   `scattering` (`multiple | single | all`).
 //! * `[camera]`: `type = "perspective"` with `eye`, `target`, `up`, `fov_y` (degrees, full
 //!   vertical), or `type = "orthographic"` with `centre`, `direction` (view direction; rays start
 //!   on the plane through `centre`), `up`, `width`, `height` (of the view rectangle).
@@ -75,6 +76,9 @@ pub struct RenderSettings {
     pub max_depth: Option<u32>,
     /// The BSSRDF estimator, if given (`render.estimator`, parsed at load).
     pub estimator: Option<het_estimate::Estimator>,
+    /// Sone's averaging, if given (`render.averaging`: `prefiltered` or `monte-carlo`; the
+    /// command line's `--averaging` overrides it).
+    pub averaging: Option<het_estimate::Averaging>,
     /// Scattering orders, if given.
     pub scattering: Option<Scattering>,
 }
@@ -89,6 +93,7 @@ impl RenderSettings {
             seed: 0,
             max_depth: None,
             estimator: None,
+            averaging: None,
             scattering: None,
         }
     }

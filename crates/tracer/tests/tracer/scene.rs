@@ -45,6 +45,7 @@ spp = 16
 seed = 7
 max_depth = 256
 estimator = "sone"
+averaging = "monte-carlo"
 scattering = "multiple"
 
 [camera]
@@ -200,6 +201,7 @@ fn full_scene_loads() {
         (64, 48, 16, 7, Some(256))
     );
     assert_eq!(r.estimator.map(|e| e.name()), Some("sone"));
+    assert_eq!(r.averaging, Some(het_estimate::Averaging::MonteCarlo));
     assert_eq!(r.scattering, Some(Scattering::Multiple));
     assert!(matches!(s.camera(), Camera::Perspective(_)));
     assert_eq!(s.camera().resolution(), (64, 48));

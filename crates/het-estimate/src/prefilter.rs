@@ -1,0 +1,392 @@
+//! Constant-time (prefiltered) averages over the averaging region of Eq. (3) of the paper,
+//! for fields that vary in a plane: closed forms for the procedural [`Stripe`] and [`Check`]
+//! patterns, and the choice between them and Monte Carlo sampling ([`Averaging`],
+//! [`Flatness`]).
+//!
+//! # Footprint
+//! A field defined in a plane (the analytic plane z = 0, or a planar projection along an axis)
+//! sees the averaging ellipse `centre + x·semi_major + y·semi_minor`, `|(x, y)| ≤ 1`, through
+//! a linear map into its own plane. The image is again an ellipse, given by conjugate
+//! semi-axes ([`PlaneFootprint`]); the map is affine, so a uniform area weight on the ellipse
+//! stays uniform on its image. The average is therefore the mean of the pattern over the
+//! image of the unit disk, weighted by the footprint's [`FootprintWeight`] in unit-disk
+//! coordinates. This is exact when the projected points of the Monte Carlo estimator are the
+//! ellipse's own points, i.e. on a flat surface, where the ellipse lies in the surface
+//! (the averaging plane contains x_i and x_o and is normal to the surface there). On curved
+//! surfaces the estimator falls back to sampling ([`Flatness`]).
+//!
+//! # Closed forms (derivations: `docs/physics.md#prefiltered-averages`)
+//! * Stripe: the stripe coordinate `u` is linear, so over the footprint it is `u_c + h·z`
+//!   with `h = |Mᵀĝ|` and `z` distributed as the weight's 1-D marginal. The fraction of the
+//!   weight in value 1 is a sum of marginal-CDF differences over the bands that `[u_c − h,
+//!   u_c + h]` meets: O(1 + h/w).
+//! * Check: the area of the footprint in each odd cell is the area of the unit disk inside the
+//!   cell's parallelogram image, exact by the polygon–circle formula (signed areas of the disk
+//!   inside the triangles spanned by the centre and each edge): O((1 + extent/w)²).
+//!
+//! Both are exact to rounding. Footprints that would need more than [`MAX_CELLS`] bands or
+//! cells (an ellipse thousands of pattern periods wide) return `None`, and the estimator
+//! samples instead.
+
+use glam::{DVec2, DVec3};
+
+use crate::ellipse::PlanarEllipse;
+use crate::names::Named;
+use crate::pattern::{BinaryPattern, Check, Stripe};
+
+/// Most stripe bands or check cells a closed form visits before it declines (`None`).
+pub const MAX_CELLS: usize = 4096;
+
+/// How the Sone estimator averages the coefficients over its disk and ellipse.
+///
+/// Names (CLI `--averaging`): `prefiltered` (default), `monte-carlo`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Averaging {
+    /// Ask the field's constant-time average ([`crate::CoefficientField::ellipse_average`])
+    /// wherever the surface is flat enough ([`Flatness`]), and sample where it is not or where
+    /// the field has none.
+    #[default]
+    Prefiltered,
+    /// Always sample (the paper's Monte Carlo estimator).
+    MonteCarlo,
+}
+
+impl Named for Averaging {
+    const WHAT: &'static str = "averaging";
+    const ALL: &'static [Self] = &[Averaging::Prefiltered, Averaging::MonteCarlo];
+    fn name(self) -> &'static str {
+        match self {
+            Averaging::Prefiltered => "prefiltered",
+            Averaging::MonteCarlo => "monte-carlo",
+        }
+    }
+}
+
+named_display_fromstr!(Averaging);
+
+impl Averaging {
+    /// The name used on the command line and in sidecars.
+    pub fn name(self) -> &'static str {
+        Named::name(self)
+    }
+}
+
+/// When a flat footprint stands for the projected region: the fallback criterion of
+/// prefiltered averaging.
+///
+/// A pair (x_i, x_o) is *flat* when the normals at x_i and x_o differ by at most
+/// `max_normal_angle`, and the chord leaves each tangent plane by at most that angle
+/// (|n·x̂| ≤ sin θ, which on a sphere of radius R is θ = d/(2R)). Otherwise the region is
+/// sampled and the estimate is counted in [`crate::Diagnostics::prefilter_fallback`], so that
+/// accuracy never drops silently.
+///
+/// What the bound means: on a surface of curvature radius R, a chord of length d ≤ θR sags by
+/// about d²/(8R) ≤ θd/8 below its midpoint; a flat footprint shifts the projected points by
+/// at most that, i.e. ≤ 0.44 % of the chord at the default θ = 2°. The criterion sees only
+/// the two end normals: a bump between x_i and x_o, or curvature across the chord beyond the
+/// endpoints' reach (a minor axis b ≫ d/2), is not detected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Flatness {
+    /// θ, radians (default 2° = 0.0349).
+    pub max_normal_angle: f64,
+}
+
+impl Flatness {
+    /// θ = 2°.
+    pub const DEFAULT: Flatness = Flatness {
+        max_normal_angle: 2.0 * std::f64::consts::PI / 180.0,
+    };
+
+    /// True when the pair with unit normals `n_i`, `n_o` and unit chord direction `x_hat`
+    /// is flat by the criterion above. Non-finite input is not flat.
+    pub fn is_flat(&self, n_i: DVec3, n_o: DVec3, x_hat: DVec3) -> bool {
+        let (sin, cos) = self.max_normal_angle.sin_cos();
+        n_i.dot(n_o) >= cos && n_i.dot(x_hat).abs() <= sin && n_o.dot(x_hat).abs() <= sin
+    }
+}
+
+impl Default for Flatness {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// The weight of a footprint over the unit disk (in the ellipse's own coordinates).
+///
+/// Only the uniform weight of Eq. (3) exists today. A radially symmetric kernel (a Gaussian
+/// weight of a kernel estimator) fits the same closed form for stripes through its 1-D
+/// marginal ([`FootprintWeight::marginal_cdf`]); the check's closed form is for the uniform
+/// weight only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[non_exhaustive]
+pub enum FootprintWeight {
+    /// Uniform over the unit disk (area measure; Eq. (3)).
+    #[default]
+    Uniform,
+}
+
+impl FootprintWeight {
+    /// The weight's marginal distribution along any direction, as a CDF on z ∈ [−1, 1]
+    /// (0 below, 1 above). Uniform disk: the semicircle law,
+    /// F(z) = ½ + (z√(1 − z²) + asin z)/π.
+    #[inline]
+    pub fn marginal_cdf(self, z: f64) -> f64 {
+        match self {
+            FootprintWeight::Uniform => {
+                let z = z.clamp(-1.0, 1.0);
+                0.5 + (z * (1.0 - z * z).sqrt() + z.asin()) / std::f64::consts::PI
+            }
+        }
+    }
+}
+
+/// The image of the unit disk in a pattern's plane: `centre + x·axis_u + y·axis_v` for
+/// `x² + y² ≤ 1` (conjugate semi-axes; not necessarily orthogonal), with a weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneFootprint {
+    /// Centre (pattern coordinates, scene units).
+    pub centre: DVec2,
+    /// Image of the unit disk's x axis (the ellipse's semi-major axis).
+    pub axis_u: DVec2,
+    /// Image of the unit disk's y axis (the ellipse's semi-minor axis).
+    pub axis_v: DVec2,
+    /// Weight over the unit disk.
+    pub weight: FootprintWeight,
+}
+
+impl PlaneFootprint {
+    /// The footprint of `e` in a plane whose coordinates are the *linear* map `to_plane`
+    /// (applied to the centre and to both semi-axis vectors), uniformly weighted.
+    pub fn of_ellipse(e: &PlanarEllipse, to_plane: impl Fn(DVec3) -> DVec2) -> Self {
+        Self {
+            centre: to_plane(e.center),
+            axis_u: to_plane(e.semi_major),
+            axis_v: to_plane(e.semi_minor),
+            weight: FootprintWeight::Uniform,
+        }
+    }
+
+    /// Half the extent of the footprint along unit direction `g`: `|Mᵀg|`.
+    #[inline]
+    fn half_extent(&self, g: DVec2) -> f64 {
+        g.dot(self.axis_u).hypot(g.dot(self.axis_v))
+    }
+
+    fn is_finite(&self) -> bool {
+        self.centre.is_finite() && self.axis_u.is_finite() && self.axis_v.is_finite()
+    }
+}
+
+/// The weighted fraction of `fp` where `stripe` selects value 1 (in [0, 1]); `None` for a
+/// non-finite footprint or one that spans more than [`MAX_CELLS`] bands.
+pub fn stripe_fraction(stripe: &Stripe, fp: &PlaneFootprint) -> Option<f64> {
+    if !(fp.is_finite() && stripe.width > 0.0 && stripe.width.is_finite()) {
+        return None;
+    }
+    let (sin, cos) = stripe.angle.sin_cos();
+    let g = DVec2::new(cos, sin);
+    let w = stripe.width;
+    let u_c = g.dot(fp.centre);
+    let h = fp.half_extent(g);
+    let band = |u: f64| (u / w + 0.5).floor();
+    let (k0, k1) = (band(u_c - h), band(u_c + h));
+    if k1 - k0 >= MAX_CELLS as f64 {
+        return None;
+    }
+    if k0 == k1 || h == 0.0 {
+        return Some(stripe.select(fp.centre.x, fp.centre.y) as f64);
+    }
+    let cdf = |u: f64| fp.weight.marginal_cdf((u - u_c) / h);
+    let mut ones = 0.0;
+    let mut k = k0;
+    while k <= k1 {
+        if k.rem_euclid(2.0) == 1.0 {
+            ones += cdf((k + 0.5) * w) - cdf((k - 0.5) * w);
+        }
+        k += 1.0;
+    }
+    Some(ones.clamp(0.0, 1.0))
+}
+
+/// The area fraction of `fp` where `check` selects value 1 (in [0, 1]); uniform weight only.
+/// `None` for another weight, a non-finite or degenerate (zero-area) footprint, or one that
+/// spans more than [`MAX_CELLS`] cells.
+pub fn check_fraction(check: &Check, fp: &PlaneFootprint) -> Option<f64> {
+    if fp.weight != FootprintWeight::Uniform
+        || !fp.is_finite()
+        || !(check.width > 0.0 && check.width.is_finite())
+    {
+        return None;
+    }
+    let det = fp.axis_u.perp_dot(fp.axis_v);
+    let scale = fp.axis_u.length() * fp.axis_v.length();
+    // Zero area (or NaN): declined.
+    if det.abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) || scale == 0.0
+    {
+        return None;
+    }
+    let w = check.width;
+    let (hx, hy) = (fp.half_extent(DVec2::X), fp.half_extent(DVec2::Y));
+    let cell = |v: f64| (v / w + 0.5).floor();
+    let (i0, i1) = (cell(fp.centre.x - hx), cell(fp.centre.x + hx));
+    let (j0, j1) = (cell(fp.centre.y - hy), cell(fp.centre.y + hy));
+    if (i1 - i0 + 1.0) * (j1 - j0 + 1.0) > MAX_CELLS as f64 {
+        return None;
+    }
+    if i0 == i1 && j0 == j1 {
+        return Some(check.select(fp.centre.x, fp.centre.y) as f64);
+    }
+    // Unit-disk coordinates of a pattern point: M⁻¹ (p − c).
+    let inv = |p: DVec2| {
+        let d = p - fp.centre;
+        DVec2::new(d.perp_dot(fp.axis_v), fp.axis_u.perp_dot(d)) / det
+    };
+    let cell_area = w * w / det.abs();
+    let mut ones = 0.0;
+    let mut i = i0;
+    while i <= i1 {
+        let (x0, x1) = ((i - 0.5) * w, (i + 0.5) * w);
+        // Every other cell of the column, starting with the first odd one.
+        let mut j = if (i + j0).rem_euclid(2.0) == 1.0 {
+            j0
+        } else {
+            j0 + 1.0
+        };
+        while j <= j1 {
+            let (y0, y1) = ((j - 0.5) * w, (j + 0.5) * w);
+            let quad = [
+                inv(DVec2::new(x0, y0)),
+                inv(DVec2::new(x1, y0)),
+                inv(DVec2::new(x1, y1)),
+                inv(DVec2::new(x0, y1)),
+            ];
+            let (lo, hi) = quad[1..]
+                .iter()
+                .fold((quad[0], quad[0]), |(lo, hi), &q| (lo.min(q), hi.max(q)));
+            if quad.iter().all(|q| q.length_squared() <= 1.0) {
+                ones += cell_area; // inside the disk: the whole cell
+            } else if lo.x < 1.0 && lo.y < 1.0 && hi.x > -1.0 && hi.y > -1.0 {
+                ones += disk_polygon_area(&quad).abs();
+            } // else: the cell's bounding box misses the disk
+            j += 2.0;
+        }
+        i += 1.0;
+    }
+    Some((ones / std::f64::consts::PI).clamp(0.0, 1.0))
+}
+
+/// Signed area of the unit disk (centre 0) inside the convex polygon `poly` (positive when
+/// counter-clockwise): the sum over edges of the signed area of the disk inside the triangle
+/// (0, a, b).
+pub fn disk_polygon_area(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|k| disk_triangle_area(poly[k], poly[(k + 1) % n]))
+        .sum()
+}
+
+/// Signed area of the unit disk inside the triangle (0, a, b).
+fn disk_triangle_area(a: DVec2, b: DVec2) -> f64 {
+    // Signed area of the circular sector between directions u and v (radius 1).
+    let sector = |u: DVec2, v: DVec2| 0.5 * u.perp_dot(v).atan2(u.dot(v));
+    let (la, lb) = (a.length_squared(), b.length_squared());
+    if la <= 1.0 && lb <= 1.0 {
+        return 0.5 * a.perp_dot(b);
+    }
+    let d = b - a;
+    let qa = d.length_squared();
+    if qa == 0.0 {
+        return 0.0;
+    }
+    // |a + t d|² = 1.
+    let qb = a.dot(d);
+    let disc = qb * qb - qa * (la - 1.0);
+    if disc <= 0.0 {
+        return sector(a, b);
+    }
+    let s = disc.sqrt();
+    let (t1, t2) = ((-qb - s) / qa, (-qb + s) / qa);
+    if t2 <= 0.0 || t1 >= 1.0 {
+        return sector(a, b);
+    }
+    let p1 = a + t1.max(0.0) * d;
+    let p2 = a + t2.min(1.0) * d;
+    sector(a, p1) + 0.5 * p1.perp_dot(p2) + sector(p2, b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn disk_polygon_areas() {
+        let square = |h: f64| {
+            [
+                DVec2::new(-h, -h),
+                DVec2::new(h, -h),
+                DVec2::new(h, h),
+                DVec2::new(-h, h),
+            ]
+        };
+        // Inside: the square's own area; containing the disk: π.
+        assert!((disk_polygon_area(&square(0.5)) - 1.0).abs() < 1e-14);
+        assert!((disk_polygon_area(&square(3.0)) - PI).abs() < 1e-13);
+        // Clockwise gives the negative.
+        let mut cw = square(3.0);
+        cw.reverse();
+        assert!((disk_polygon_area(&cw) + PI).abs() < 1e-13);
+        // Half-plane x ≥ 0 (a large box): π/2; the strip 0 ≤ x ≤ 0.5: the segment formula.
+        let right = [
+            DVec2::new(0.0, -5.0),
+            DVec2::new(5.0, -5.0),
+            DVec2::new(5.0, 5.0),
+            DVec2::new(0.0, 5.0),
+        ];
+        assert!((disk_polygon_area(&right) - PI / 2.0).abs() < 1e-13);
+        let strip = [
+            DVec2::new(0.0, -5.0),
+            DVec2::new(0.5, -5.0),
+            DVec2::new(0.5, 5.0),
+            DVec2::new(0.0, 5.0),
+        ];
+        let f = |z: f64| z * (1.0 - z * z).sqrt() + z.asin();
+        assert!((disk_polygon_area(&strip) - (f(0.5) - f(0.0))).abs() < 1e-13);
+        // A square of side 2 centred at (1, 1): the quarter disk.
+        let corner = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(2.0, 0.0),
+            DVec2::new(2.0, 2.0),
+            DVec2::new(0.0, 2.0),
+        ];
+        assert!((disk_polygon_area(&corner) - PI / 4.0).abs() < 1e-13);
+        // Entirely outside.
+        let far = square(0.1).map(|p| p + DVec2::new(3.0, 0.0));
+        assert!(disk_polygon_area(&far).abs() < 1e-15);
+    }
+
+    #[test]
+    fn semicircle_cdf() {
+        let w = FootprintWeight::Uniform;
+        assert_eq!(w.marginal_cdf(-2.0), 0.0);
+        assert!((w.marginal_cdf(0.0) - 0.5).abs() < 1e-15);
+        assert!((w.marginal_cdf(1.0) - 1.0).abs() < 1e-15);
+        // Symmetric.
+        assert!((w.marginal_cdf(0.3) + w.marginal_cdf(-0.3) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn flatness_criterion() {
+        let f = Flatness::DEFAULT;
+        assert!(f.is_flat(DVec3::Z, DVec3::Z, DVec3::X));
+        // Sphere of radius 10, chord 0.5 apart (θ = 2.9°): not flat; 0.2 apart (1.1°): flat.
+        let on = |a: f64| DVec3::new(a.sin(), 0.0, a.cos());
+        for (d, flat) in [(0.5, false), (0.2, true)] {
+            let a = d / 10.0 / 2.0;
+            let (n_i, n_o) = (on(-a), on(a));
+            let x_hat = (10.0 * (n_o - n_i)).normalize();
+            assert_eq!(f.is_flat(n_i, n_o, x_hat), flat, "d = {d}");
+        }
+        assert!(!f.is_flat(DVec3::NAN, DVec3::Z, DVec3::X));
+    }
+}

@@ -1,0 +1,275 @@
+//! Prefiltered averaging: the closed forms for stripes and checks against Monte Carlo averages
+//! over the same footprints, the Sone estimator's prefiltered default against its Monte Carlo
+//! path, and the flatness fallback on a curved surface.
+//!
+//! Monte Carlo comparisons use independent uniform points (rejection from the square, this
+//! file's own generator) and a fixed seed; the tolerance is 5 standard errors of a Bernoulli
+//! mean, sqrt(p(1 − p)/N), plus 1e-12.
+
+use glam::{DVec2, DVec3};
+use het_estimate::analytic::{CheckField, Plane, PlanePoint, StripeField};
+use het_estimate::pattern::{BinaryPattern, Check, Stripe};
+use het_estimate::prefilter::{FootprintWeight, PlaneFootprint, check_fraction, stripe_fraction};
+use het_estimate::{
+    Averaging, CoefficientField, Coefficients, Estimator, PlanarEllipse, SampleBudget, SoneParams,
+    SplitMix64, SurfacePoint, SurfaceQuery, UniformSource,
+};
+
+const N_MC: usize = 40_000;
+const K_SE: f64 = 5.0;
+
+/// Uniform points of the unit disk (rejection).
+fn disk_point(rng: &mut SplitMix64) -> DVec2 {
+    loop {
+        let p = DVec2::new(2.0 * rng.next_f64() - 1.0, 2.0 * rng.next_f64() - 1.0);
+        if p.length_squared() <= 1.0 {
+            return p;
+        }
+    }
+}
+
+/// The Monte Carlo fraction of `fp` where `pattern` selects 1, and its standard error.
+fn mc_fraction(pattern: &impl BinaryPattern, fp: &PlaneFootprint, seed: u64) -> (f64, f64) {
+    let mut rng = SplitMix64::new(seed);
+    let ones = (0..N_MC)
+        .filter(|_| {
+            let u = disk_point(&mut rng);
+            let p = fp.centre + u.x * fp.axis_u + u.y * fp.axis_v;
+            pattern.select(p.x, p.y) == 1
+        })
+        .count();
+    let p = ones as f64 / N_MC as f64;
+    (p, (p * (1.0 - p) / N_MC as f64).sqrt())
+}
+
+/// Footprints of assorted sizes, shears and orientations, with a fixed seed.
+fn footprints() -> Vec<PlaneFootprint> {
+    let mut rng = SplitMix64::new(2024);
+    let mut r = move || rng.next_f64();
+    (0..24)
+        .map(|k| {
+            let size = [0.3, 2.0, 7.0, 15.0][k % 4];
+            let angle = 6.3 * r();
+            let a = size * (0.2 + r());
+            let b = a * (0.05 + 1.5 * r());
+            let shear = r() - 0.5;
+            let (s, c) = angle.sin_cos();
+            PlaneFootprint {
+                centre: DVec2::new(20.0 * r() - 10.0, 20.0 * r() - 10.0),
+                axis_u: DVec2::new(c, s) * a,
+                axis_v: (DVec2::new(-s, c) + shear * DVec2::new(c, s)) * b,
+                weight: FootprintWeight::Uniform,
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn stripe_closed_form_matches_monte_carlo() {
+    for (k, fp) in footprints().iter().enumerate() {
+        let stripe = Stripe {
+            width: [4.0, 1.3][k % 2],
+            angle: 0.4 * k as f64,
+        };
+        let exact = stripe_fraction(&stripe, fp).unwrap();
+        let (mc, se) = mc_fraction(&stripe, fp, 100 + k as u64);
+        assert!(
+            (exact - mc).abs() <= K_SE * se + 1e-12,
+            "footprint {k}: closed form {exact}, Monte Carlo {mc} ± {se}"
+        );
+    }
+}
+
+#[test]
+fn check_closed_form_matches_monte_carlo() {
+    for (k, fp) in footprints().iter().enumerate() {
+        let check = Check {
+            width: [4.0, 1.3][k % 2],
+        };
+        let exact = check_fraction(&check, fp).unwrap();
+        let (mc, se) = mc_fraction(&check, fp, 200 + k as u64);
+        assert!(
+            (exact - mc).abs() <= K_SE * se + 1e-12,
+            "footprint {k}: closed form {exact}, Monte Carlo {mc} ± {se}"
+        );
+    }
+}
+
+/// Independent exact cases: a footprint inside one cell, and a disk centred on a check corner
+/// (four quarter disks: half of it is value 1), and a disk centred on a stripe edge.
+#[test]
+fn closed_forms_in_symmetric_cases() {
+    let disk = |c: DVec2, r: f64| PlaneFootprint {
+        centre: c,
+        axis_u: DVec2::X * r,
+        axis_v: DVec2::Y * r,
+        weight: FootprintWeight::Uniform,
+    };
+    let check = Check { width: 4.0 };
+    assert_eq!(check_fraction(&check, &disk(DVec2::ZERO, 1.0)), Some(0.0));
+    assert_eq!(
+        check_fraction(&check, &disk(DVec2::new(4.0, 0.0), 1.0)),
+        Some(1.0)
+    );
+    let f = check_fraction(&check, &disk(DVec2::new(2.0, 2.0), 1.5)).unwrap();
+    assert!((f - 0.5).abs() < 1e-14, "{f}");
+    let stripe = Stripe {
+        width: 4.0,
+        angle: 0.0,
+    };
+    let f = stripe_fraction(&stripe, &disk(DVec2::new(2.0, 5.0), 1.5)).unwrap();
+    assert!((f - 0.5).abs() < 1e-14, "{f}");
+    // A footprint much wider than the period sees half of each value (to ~ (w/h)^{3/2}).
+    let f = stripe_fraction(&stripe, &disk(DVec2::ZERO, 400.0)).unwrap();
+    assert!((f - 0.5).abs() < 1e-3, "{f}");
+    // Too many cells: declined, so that the estimator samples.
+    assert!(check_fraction(&check, &disk(DVec2::ZERO, 1e4)).is_none());
+    // Degenerate (zero-area) footprints are declined by the check.
+    let mut line = disk(DVec2::ZERO, 3.0);
+    line.axis_v = DVec2::ZERO;
+    assert!(check_fraction(&check, &line).is_none());
+}
+
+fn check_preset() -> CheckField {
+    CheckField {
+        pattern: Check { width: 4.0 },
+        values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+    }
+}
+
+/// The whole Sone estimate, prefiltered (default) against Monte Carlo with 4096 samples per
+/// stage, over 32 seeds, on the check preset: within 5 standard errors of the Monte Carlo mean
+/// (plus 1e-9). Both stages enter (the disk mean sets the ellipse's width).
+#[test]
+fn sone_prefiltered_matches_monte_carlo_on_the_check() {
+    let f = check_preset();
+    let pre = Estimator::Sone(SoneParams::paper()).prepare(0.0).unwrap();
+    let mc = Estimator::Sone(
+        SoneParams::paper()
+            .with_averaging(Averaging::MonteCarlo)
+            .with_samples(SampleBudget::fixed(4096)),
+    )
+    .prepare(0.0)
+    .unwrap();
+    let x_i = PlanePoint::new(0.3, -0.2);
+    for x_o in [
+        PlanePoint::new(5.0, 1.0),
+        PlanePoint::new(-3.0, 9.0),
+        PlanePoint::new(11.0, -6.5),
+    ] {
+        let p = pre.estimate(&Plane, &f, &x_i, &x_o, &mut SplitMix64::new(1));
+        assert_eq!(p.diagnostics.field_averages, 2);
+        assert_eq!(p.diagnostics.projections, 0);
+        let v: Vec<f64> = (0..32)
+            .map(|s| {
+                mc.estimate(&Plane, &f, &x_i, &x_o, &mut SplitMix64::new(s))
+                    .coefficients
+                    .sigma_a[0]
+            })
+            .collect();
+        let mean = v.iter().sum::<f64>() / 32.0;
+        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / 31.0).sqrt();
+        let se = sd / 32f64.sqrt();
+        let got = p.coefficients.sigma_a[0];
+        assert!(
+            (got - mean).abs() <= K_SE * se + 1e-9,
+            "{x_o:?}: prefiltered {got}, Monte Carlo {mean} ± {se}"
+        );
+    }
+}
+
+/// A sphere of radius `R` at the origin with a stripe field projected along z; its closed-form
+/// average reads the ellipse as it lies in its plane (the flat-footprint reading).
+const R: f64 = 3.0;
+
+#[derive(Debug, Clone, Copy)]
+struct SpherePoint(DVec3);
+impl SurfacePoint for SpherePoint {
+    fn position(&self) -> DVec3 {
+        self.0
+    }
+    fn normal(&self) -> DVec3 {
+        self.0.normalize()
+    }
+}
+struct Sphere;
+impl SurfaceQuery for Sphere {
+    type Point = SpherePoint;
+    fn project(&self, o: DVec3, d: DVec3) -> Option<SpherePoint> {
+        let (b, c) = (o.dot(d), o.length_squared() - R * R);
+        let disc = b * b - c;
+        (disc >= 0.0).then(|| {
+            let t = [-b - disc.sqrt(), -b + disc.sqrt()]
+                .into_iter()
+                .min_by(|x, y| x.abs().total_cmp(&y.abs()))
+                .unwrap();
+            SpherePoint(o + t * d)
+        })
+    }
+}
+struct ProjectedStripe(StripeField);
+impl CoefficientField<SpherePoint> for ProjectedStripe {
+    fn coefficients(&self, p: &SpherePoint) -> Coefficients {
+        self.0.coefficients(&PlanePoint::new(p.0.x, p.0.y))
+    }
+    fn bounds(&self) -> Option<het_estimate::FieldBounds> {
+        CoefficientField::<PlanePoint>::bounds(&self.0)
+    }
+    fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
+        let fp = PlaneFootprint::of_ellipse(e, |v| DVec2::new(v.x, v.y));
+        let f = stripe_fraction(&self.0.pattern, &fp)?;
+        let [v0, v1] = self.0.values;
+        Some(Coefficients {
+            sigma_a: v0.sigma_a * (1.0 - f) + v1.sigma_a * f,
+            sigma_s: v0.sigma_s * (1.0 - f) + v1.sigma_s * f,
+        })
+    }
+    fn has_ellipse_average(&self) -> bool {
+        true
+    }
+}
+
+/// On a small sphere, pairs far apart fail the flatness criterion: they are sampled (as the
+/// Monte Carlo path would, to the bit) and flagged; a close pair is answered by the field.
+#[test]
+fn fallback_triggers_on_a_small_sphere_and_is_counted() {
+    let field = ProjectedStripe(StripeField {
+        pattern: Stripe {
+            width: 0.5,
+            angle: 0.7,
+        },
+        values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+    });
+    let pre = Estimator::Sone(SoneParams::paper()).prepare(0.0).unwrap();
+    let mc = Estimator::Sone(SoneParams::paper().with_averaging(Averaging::MonteCarlo))
+        .prepare(0.0)
+        .unwrap();
+    let on = |theta: f64, phi: f64| {
+        SpherePoint(
+            R * DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ),
+        )
+    };
+    let mut fallbacks = 0;
+    for k in 0..20 {
+        let (x_i, x_o) = (on(0.3, 0.1 * k as f64), on(0.9, 0.2 + 0.1 * k as f64));
+        let p = pre.estimate(&Sphere, &field, &x_i, &x_o, &mut SplitMix64::new(k));
+        let m = mc.estimate(&Sphere, &field, &x_i, &x_o, &mut SplitMix64::new(k));
+        assert!(p.diagnostics.prefilter_fallback, "pair {k} not flagged");
+        assert_eq!(p.diagnostics.field_averages, 0);
+        assert_eq!(p.coefficients, m.coefficients);
+        fallbacks += p.diagnostics.prefilter_fallback as u32;
+    }
+    assert_eq!(fallbacks, 20);
+    // 0.02 apart on a radius-3 sphere: normals 0.38° apart, flat.
+    let (x_i, x_o) = (on(0.5, 0.0), on(0.5 + 0.02 / R, 0.0));
+    let p = pre.estimate(&Sphere, &field, &x_i, &x_o, &mut SplitMix64::new(1));
+    assert!(!p.diagnostics.prefilter_fallback);
+    assert_eq!(p.diagnostics.field_averages, 2);
+    // Monte Carlo averaging never asks and never flags.
+    let m = mc.estimate(&Sphere, &field, &x_i, &x_o, &mut SplitMix64::new(1));
+    assert!(!m.diagnostics.prefilter_fallback && m.diagnostics.field_averages == 0);
+}
