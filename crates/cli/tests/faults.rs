@@ -411,8 +411,8 @@ fn huge_tessellations_are_refused_with_the_figure() {
     );
 }
 
-/// A second SIGINT while the first one's output is being written quits at once: exit 130,
-/// "quitting" on stderr, no temporary file left, and the image on disk is still a whole one
+/// A second signal while the first one's output is being written quits at once: exit 128 +
+/// the signal, "quitting" on stderr, no temporary file left, and the image on disk is still a whole one
 /// (the last checkpoint's, or the final one if its rename came first). The image is large
 /// (2000²) so that writing it takes far longer than the gap between the two signals.
 #[test]
@@ -443,12 +443,18 @@ fn a_second_interrupt_quits_at_once() {
     );
     let json = s.join("out.json");
     wait_for("a checkpoint", || json.is_file());
+    // Two different signals back to back: a second SIGINT sent at once could be merged with
+    // the first by the kernel (pending signals of one kind do not queue), and a pause between
+    // them lets a loaded machine finish the write first.
     signal(&child, "INT");
-    std::thread::sleep(Duration::from_millis(20));
-    signal(&child, "INT");
+    signal(&child, "TERM");
     let out = child.wait_with_output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(
+        matches!(out.status.code(), Some(130 | 143)),
+        "{:?}: {stderr}",
+        out.status
+    );
     assert!(stderr.contains("quitting"), "{stderr}");
     assert_no_temporaries(s.path());
     let film = tracer::output::read_exr(&s.join("out.exr")).expect("a whole image");
