@@ -430,6 +430,13 @@ pub fn merge(
         .as_str()
         .ok_or_else(|| shard_err(&first.path, "its sidecar has no valid `method`"))?;
     let mut attributes = render_attributes(lo, seed, method, first.sidecar["profile"].as_str());
+    // The shards' writer, not this one, generated the pixels (all shards share a version).
+    if let (Some(version), Some(generator)) = (
+        first.sidecar["tool"]["version"].as_str(),
+        attributes.iter_mut().find(|(k, _)| *k == "generator"),
+    ) {
+        generator.1 = ExrAttribute::Text(format!("het-bssrdf {version}"));
+    }
     if time_budget {
         attributes.push((
             "samplesPerPixelPerShard",

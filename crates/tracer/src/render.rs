@@ -488,10 +488,10 @@ mod tests {
             );
             let rows = (0..7).filter(|&y| shard.holds_row(y)).count() as u32;
             assert_eq!(shard.rows(7), rows);
-            for y in 0..7usize {
+            for (y, covers) in covered.iter_mut().enumerate() {
                 let (a, b) = (&part.pixels[y * 5..][..5], &full.pixels[y * 5..][..5]);
                 if shard.holds_row(y as u32) {
-                    covered[y] += 1;
+                    *covers += 1;
                     assert_eq!(a, b, "row {y} of shard {shard}");
                 } else {
                     assert!(a.iter().all(|p| *p == Rgb::ZERO), "row {y} of {shard}");
