@@ -12,7 +12,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use het_bssrdf::bssrdf_core::Scattering;
 use het_bssrdf::experiments::scenes::CHECKER_SLAB;
 use het_bssrdf::tracer::integrator::{Method, PathIntegrator, PathOptions};
-use het_bssrdf::tracer::render::{Budget, RenderOptions, render};
+use het_bssrdf::tracer::render::{Budget, RenderOptions, Shard, render};
 use het_bssrdf::tracer::scene::Scene;
 
 fn renders(c: &mut Criterion) {
@@ -53,6 +53,7 @@ fn renders(c: &mut Criterion) {
                         &RenderOptions {
                             budget: Budget::Samples(1),
                             seed,
+                            shard: Shard::WHOLE,
                         },
                     )
                 })

@@ -10,7 +10,7 @@ use tracer::camera::Camera;
 use tracer::field::{Field, MediumField, PlanarProjection};
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
-use tracer::render::{Budget, RenderOptions, render};
+use tracer::render::{Budget, RenderOptions, Shard, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
@@ -118,6 +118,7 @@ fn renders_are_identical_whatever_the_thread_count() {
                 &RenderOptions {
                     budget: Budget::Samples(2),
                     seed: 9,
+                    shard: Shard::WHOLE,
                 },
             )
         })

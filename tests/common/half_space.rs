@@ -9,7 +9,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, render};
+use tracer::render::{Budget, RenderOptions, Shard, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// A huge half-space (top z = 0, η = `eta`, isotropic) seen from above over a 0.5 × 0.5 patch
@@ -72,6 +72,7 @@ pub fn mean_and_se(
                 &RenderOptions {
                     budget: Budget::Samples(spp),
                     seed: 1000 + seed,
+                    shard: Shard::WHOLE,
                 },
             );
             assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);

@@ -17,7 +17,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, render};
+use tracer::render::{Budget, RenderOptions, Shard, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// Environment radiance.
@@ -194,6 +194,7 @@ pub fn measure(case: &Case) -> Measurement {
         &RenderOptions {
             budget: Budget::Samples(case.spp),
             seed: case.seed,
+            shard: Shard::WHOLE,
         },
     );
     let seconds = start.elapsed().as_secs_f64();

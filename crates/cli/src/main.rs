@@ -16,6 +16,7 @@ mod compare;
 mod converge;
 mod flags;
 mod interrupt;
+mod merge;
 mod profile;
 mod render;
 mod reproduce;
@@ -45,6 +46,8 @@ enum Command {
     Profile(profile::Args),
     /// Render a scene file with the path-traced reference or a BSSRDF method.
     Render(render::Args),
+    /// Assemble the shards of a render (`render --tile I/N`) into the whole image.
+    Merge(merge::Args),
     /// The paper's Figure 4: exitance map of a pencil beam in a textured half-space.
     Beam(beam::Args),
     /// Error metrics of a test image against a reference, and a difference image.
@@ -73,6 +76,7 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
     match cli.command {
         Command::Profile(args) => profile::run(args),
         Command::Render(args) => render::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Beam(args) => beam::run(args, &given),
         Command::Compare(args) => compare::run(args),
         Command::Converge(args) => converge::run(args, &given),

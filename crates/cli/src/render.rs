@@ -70,6 +70,11 @@ pub struct Args {
     /// time a path can take in an optically huge medium (default 100,000,000).
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     max_collisions: Option<u64>,
+    /// Render only shard I of N of the image (0 ≤ I < N): the rows y with y mod N = I, with the
+    /// same per-pixel seeds as the whole render; the others are left black. `het-bssrdf
+    /// merge` assembles the N shards (see deploy/ for Slurm and Kubernetes examples).
+    #[arg(long, value_name = "I/N")]
+    tile: Option<tracer::render::Shard>,
     /// Write the image so far (EXR, PNG and JSON, the sidecar marked as a checkpoint) after
     /// each pass that ends at least this many seconds after the previous checkpoint.
     #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
@@ -119,14 +124,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         job.max_depth = u32::try_from(d).context("--max-depth is too large")?;
     }
     job.progress = true;
+    if let Some(shard) = args.tile {
+        job.shard = Some(
+            experiments::shard::ShardJob::new(shard, &scene)
+                .with_context(|| format!("cannot hash the scene `{}`", args.scene.display()))?,
+        );
+    }
     let stem = args
         .scene
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
+    let tile = args
+        .tile
+        .map(|t| format!("-tile-{}-of-{}", t.index(), t.count()))
+        .unwrap_or_default();
     let out = args
         .out
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}.exr", method.name())));
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}{tile}.exr", method.name())));
     check_writable(&out)?;
     let (width, height) = scene.camera().resolution();
     check_image_memory(width, height, &args.scene)?;
@@ -149,7 +164,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Ok(())
     };
     let observer = Checkpoints::new(
-        experiments::progress::RenderBar::new(method.name(), width, height, job.progress),
+        experiments::progress::RenderBar::new(
+            method.name(),
+            width,
+            args.tile.map_or(height, |t| t.rows(height)),
+            job.progress,
+        ),
         args.checkpoint,
         &write_checkpoint,
     );
@@ -182,12 +202,29 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         png.display(),
         json.display()
     );
-    let px = outcome.film.pixels.len().max(1) as f64;
-    let mean: [f64; 3] =
-        std::array::from_fn(|c| outcome.film.pixels.iter().map(|p| p[c]).sum::<f64>() / px);
+    // The mean over the rendered pixels (a shard's rows only).
+    let shard = job.options().shard;
+    let w = outcome.film.width.max(1) as usize;
+    let rendered: Vec<_> = outcome
+        .film
+        .pixels
+        .chunks(w)
+        .enumerate()
+        .filter(|(y, _)| shard.holds_row(*y as u32))
+        .flat_map(|(_, row)| row)
+        .collect();
+    let px = rendered.len().max(1) as f64;
+    let mean: [f64; 3] = std::array::from_fn(|c| rendered.iter().map(|p| p[c]).sum::<f64>() / px);
     eprintln!(
-        "mean pixel value (R, G, B): {:.6}, {:.6}, {:.6}",
-        mean[0], mean[1], mean[2]
+        "mean pixel value (R, G, B){}: {:.6}, {:.6}, {:.6}",
+        if shard.is_whole() {
+            ""
+        } else {
+            " of the shard's rows"
+        },
+        mean[0],
+        mean[1],
+        mean[2]
     );
     for w in &outcome.warnings {
         eprintln!("warning: {w}");

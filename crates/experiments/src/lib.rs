@@ -14,4 +14,5 @@ pub mod provenance;
 pub mod reproduce;
 pub mod run;
 pub mod scenes;
+pub mod shard;
 pub mod study;

@@ -13,7 +13,7 @@ use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions, Rend
 use tracer::output::{
     ExrAttribute, OutputSet, exr_bytes, json_bytes, parent_dir, png_bytes, resolve_output,
 };
-use tracer::render::{Budget, RenderObserver, RenderOptions, Rendered, render_observed};
+use tracer::render::{Budget, RenderObserver, RenderOptions, Rendered, Shard, render_observed};
 use tracer::scene::Scene;
 
 /// Default most surface interactions per camera path.
@@ -34,6 +34,9 @@ pub struct RenderJob {
     pub max_depth: u32,
     /// Show a progress bar.
     pub progress: bool,
+    /// Render one shard of the image (`render --tile I/N`), recorded in the files written;
+    /// `None`: the whole image, as an ordinary render.
+    pub shard: Option<crate::shard::ShardJob>,
 }
 
 impl RenderJob {
@@ -46,6 +49,7 @@ impl RenderJob {
             scattering: scene.settings().scattering.unwrap_or_default(),
             max_depth: scene.settings().max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             progress: false,
+            shard: None,
         }
     }
 
@@ -54,6 +58,7 @@ impl RenderJob {
         RenderOptions {
             budget: self.budget,
             seed: self.seed,
+            shard: self.shard.as_ref().map_or(Shard::WHOLE, |s| s.shard),
         }
     }
 }
@@ -206,7 +211,41 @@ pub fn check_dir_accepts_files(dir: &Path, path: &Path) -> Result<(), OutputErro
     Ok(())
 }
 
+/// The metadata every render's EXR header holds (pbrt-v4 style): the generator, the samples
+/// per pixel, the seed, the method and the profile (`None`: `"none"`, the path tracer). No
+/// render time: a duration makes every file unique, and the bytes of an EXR must be
+/// reproducible for a given seed (its hash is a render's fingerprint; a merge of shards
+/// rebuilds the same header from the shards' sidecars). The time is the sidecar's
+/// `wall_seconds`.
+pub fn render_attributes(
+    spp: u32,
+    seed: u64,
+    method: &str,
+    profile: Option<&str>,
+) -> Vec<(&'static str, ExrAttribute)> {
+    vec![
+        (
+            "generator",
+            ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
+        ),
+        (
+            "samplesPerPixel",
+            ExrAttribute::Int(i32::try_from(spp).unwrap_or(i32::MAX)),
+        ),
+        ("seed", ExrAttribute::Text(seed.to_string())),
+        ("method", ExrAttribute::Text(method.to_string())),
+        (
+            "profile",
+            ExrAttribute::Text(profile.unwrap_or("none").to_string()),
+        ),
+    ]
+}
+
 /// Writes the EXR, the PNG preview (exposure in stops) and the JSON sidecar of a render.
+/// The preview and the sidecar's `mean_rgb` are made from the values the EXR holds (`f32`,
+/// [`Film::as_stored`]), so that an image assembled from files (a merge of shards) writes the
+/// same ones. A shard (`job.shard`) also records which rows it holds and the scene's hash, in
+/// the EXR header and in the sidecar's `shard`.
 pub fn write_render(
     outcome: &RenderOutcome,
     scene: &Scene,
@@ -214,7 +253,6 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    let (png, json_path) = sidecar_paths(exr);
     let profile = match job.method {
         Method::Bssrdf { profile, .. } => Some(
             profile
@@ -227,25 +265,12 @@ pub fn write_render(
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
     };
-    let attributes = [
-        (
-            "generator",
-            ExrAttribute::Text(format!("het-bssrdf {}", env!("CARGO_PKG_VERSION"))),
-        ),
-        (
-            "samplesPerPixel",
-            ExrAttribute::Int(i32::try_from(outcome.spp).unwrap_or(i32::MAX)),
-        ),
-        ("seed", ExrAttribute::Text(job.seed.to_string())),
-        ("method", ExrAttribute::Text(outcome.method.clone())),
-        (
-            "profile",
-            ExrAttribute::Text(profile.clone().unwrap_or_else(|| "none".into())),
-        ),
-        // No render time here: a duration makes every file unique, and the bytes of an EXR
-        // must be reproducible for a given seed (its hash is a render's fingerprint). The
-        // time is the sidecar's `wall_seconds`.
-    ];
+    let film = outcome.film.as_stored();
+    let mut attributes =
+        render_attributes(outcome.spp, job.seed, &outcome.method, profile.as_deref());
+    if let Some(shard) = &job.shard {
+        attributes.extend(shard.attributes());
+    }
     let value = json!({
         "scene": scene.source_path().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name().to_string()),
         "method": outcome.method,
@@ -254,27 +279,49 @@ pub fn write_render(
         "averaging": job.method.averaging().map(|a| a.name()),
         "scattering": job.scattering.name(),
         "spp": outcome.spp,
+        "time_budget_seconds": match job.budget {
+            Budget::Time(t) => Some(t.as_secs_f64()),
+            Budget::Samples(_) => None,
+        },
         "seed": job.seed,
         "max_depth": job.max_depth,
-        "width": outcome.film.width,
-        "height": outcome.film.height,
+        "width": film.width,
+        "height": film.height,
         "wall_seconds": outcome.seconds,
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,
         "warnings": outcome.warnings,
-        "mean_rgb": outcome.film.mean().0,
+        "mean_rgb": film.mean().0,
         "interrupted": outcome.interrupted,
         "checkpoint": outcome.checkpoint,
         "max_collisions": tracer::integrator::walk::collision_cap(),
+        "preview_exposure": exposure,
+        "shard": job.shard.as_ref().map(crate::shard::ShardJob::to_json),
     });
-    // Small files first, images last, renamed into place together or not at all.
+    write_image_set(
+        &film,
+        &attributes,
+        &crate::provenance::stamped(value),
+        exr,
+        exposure,
+    )
+}
+
+/// Writes `film` as an EXR with `attributes` in its header, its PNG preview (exposure in
+/// stops) and the sidecar `sidecar` beside it ([`sidecar_paths`]): small files first, images
+/// last, renamed into place together or not at all ([`OutputSet`]).
+pub fn write_image_set(
+    film: &Film,
+    attributes: &[(&str, ExrAttribute)],
+    sidecar: &serde_json::Value,
+    exr: &Path,
+    exposure: f64,
+) -> Result<(), OutputError> {
+    let (png, json_path) = sidecar_paths(exr);
     let mut set = OutputSet::new();
-    set.add(
-        &json_path,
-        json_bytes(&crate::provenance::stamped(value), &json_path)?,
-    );
-    set.add(&png, png_bytes(&outcome.film, &png, exposure)?);
-    set.add(exr, exr_bytes(&outcome.film, exr, &attributes)?);
+    set.add(&json_path, json_bytes(sidecar, &json_path)?);
+    set.add(&png, png_bytes(film, &png, exposure)?);
+    set.add(exr, exr_bytes(film, exr, attributes)?);
     set.commit()
 }

@@ -59,6 +59,22 @@ impl Film {
         }
     }
 
+    /// The film as an EXR written by [`crate::output::write_exr`] holds it: every value
+    /// rounded to `f32`. Previews and statistics made from this film equal those made from
+    /// the file, so that an image assembled from files (a merge of shards) reproduces them.
+    pub fn as_stored(&self) -> Film {
+        let round = |v: f64| f64::from(v as f32);
+        Film {
+            width: self.width,
+            height: self.height,
+            pixels: self
+                .pixels
+                .iter()
+                .map(|p| Rgb::new(round(p[0]), round(p[1]), round(p[2])))
+                .collect(),
+        }
+    }
+
     /// Mean over all pixels.
     pub fn mean(&self) -> Rgb {
         if self.pixels.is_empty() {

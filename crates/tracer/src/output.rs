@@ -528,6 +528,45 @@ pub fn read_exr(path: &Path) -> Result<Film, OutputError> {
     })
 }
 
+/// The metadata pairs (`name`, `value`) that [`write_exr_with_attributes`] recorded in the
+/// header of the EXR at `path`, in their order; empty when it has none. Only the header is
+/// read.
+pub fn read_exr_metadata(path: &Path) -> Result<Vec<(String, String)>, OutputError> {
+    #[cfg(feature = "exr")]
+    {
+        use exr::meta::attribute::{AttributeValue, Text};
+        let bytes = fs::read(path).map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            action: "read",
+            source,
+        })?;
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+            .map_err(|e| OutputError::Decode {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            })?;
+        let text = meta.headers.first().and_then(|h| {
+            match h.own_attributes.other.get(&Text::from(METADATA_ATTRIBUTE)) {
+                Some(AttributeValue::Text(t)) => Some(t.to_string()),
+                _ => None,
+            }
+        });
+        Ok(text
+            .iter()
+            .flat_map(|t| t.split("; "))
+            .filter_map(|pair| pair.split_once('='))
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect())
+    }
+    #[cfg(not(feature = "exr"))]
+    {
+        Err(OutputError::Unsupported {
+            path: path.to_path_buf(),
+            feature: "exr",
+        })
+    }
+}
+
 /// Why an EXR could not be read.
 #[derive(Debug)]
 #[cfg_attr(not(feature = "exr"), allow(dead_code))]

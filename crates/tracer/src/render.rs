@@ -5,7 +5,9 @@
 //! pixel's samples are added to its running sum in increasing `s` by one thread, so the image is
 //! bit-identical whatever the number of threads or the scheduling order. A time-budget render
 //! adds passes of doubling size to the same running sums, so it equals a fixed-count render
-//! with the sample count it reached. Renders run in passes (see [`render_observed`]), which
+//! with the sample count it reached. A render can be restricted to one [`Shard`] of the rows
+//! (for renders split across machines); the rows it holds get exactly the values of the whole
+//! render, since their streams do not depend on the others. Renders run in passes (see [`render_observed`]), which
 //! neither change a pixel nor depend on the thread count; an interrupt
 //! ([`crate::interrupt`]) keeps the completed passes.
 
@@ -74,6 +76,82 @@ pub struct RenderOptions {
     pub budget: Budget,
     /// Seed of every random stream.
     pub seed: u64,
+    /// The rows rendered ([`Shard::WHOLE`]: all of them); the others are left black.
+    pub shard: Shard,
+}
+
+/// Shard `index` of `count` of an image: the rows `y` with `y mod count = index` (interleaved
+/// rows). Interleaving balances the load, since every shard samples every band of the image
+/// (a bright object in one band costs every shard alike), and any image height works: shards
+/// differ by at most one row. Written `index/count`, e.g. `2/8`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Shard {
+    index: u32,
+    count: u32,
+}
+
+impl Shard {
+    /// The whole image (`0/1`).
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// Shard `index` of `count`; `None` unless `index < count`.
+    pub fn new(index: u32, count: u32) -> Option<Self> {
+        (index < count).then_some(Self { index, count })
+    }
+
+    /// Its index (`0 ≤ index < count`).
+    pub fn index(self) -> u32 {
+        self.index
+    }
+
+    /// The number of shards of the image.
+    pub fn count(self) -> u32 {
+        self.count
+    }
+
+    /// True when row `y` belongs to this shard.
+    #[inline]
+    pub fn holds_row(self, y: u32) -> bool {
+        y % self.count == self.index
+    }
+
+    /// How many of `height` rows belong to this shard.
+    pub fn rows(self, height: u32) -> u32 {
+        (height + self.count - 1 - self.index) / self.count
+    }
+
+    /// True for [`Shard::WHOLE`].
+    pub fn is_whole(self) -> bool {
+        self.count == 1
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    /// Parses `I/N` with `0 ≤ I < N`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("expected I/N (shard I of N, 0 ≤ I < N), got `{s}`"))?;
+        let parse = |v: &str, what: &str| {
+            v.trim().parse::<u32>().map_err(|_| {
+                format!("expected I/N (shard I of N, 0 ≤ I < N): `{v}` is not a valid {what}")
+            })
+        };
+        let (i, n) = (parse(i, "shard index I")?, parse(n, "shard count N")?);
+        if n == 0 {
+            return Err(format!("the shard count N must be at least 1, got `{s}`"));
+        }
+        Shard::new(i, n).ok_or_else(|| {
+            format!("the shard index I must be below the count N (0 ≤ I < N), got `{s}`")
+        })
+    }
 }
 
 /// The image after a completed pass, for checkpoints.
@@ -185,6 +263,9 @@ pub fn render_observed<E: PixelEstimator, O: RenderObserver<E::Counters> + ?Size
             .map(|(y, (row, old))| {
                 let mut c = E::Counters::default();
                 row.copy_from_slice(old);
+                if !options.shard.holds_row(y as u32) {
+                    return Some(c);
+                }
                 for (x, sum) in row.iter_mut().enumerate() {
                     if observer.stop_requested() {
                         return None;
@@ -297,7 +378,11 @@ mod tests {
     }
 
     fn opts(budget: Budget) -> RenderOptions {
-        RenderOptions { budget, seed: 5 }
+        RenderOptions {
+            budget,
+            seed: 5,
+            shard: Shard::WHOLE,
+        }
     }
 
     #[test]
@@ -384,6 +469,45 @@ mod tests {
         let (spp, mean) = r.passes.lock().unwrap()[1].clone();
         assert_eq!((cut.spp, &cut.pixels), (spp, &mean));
         assert!(cut.spp < 9);
+    }
+
+    #[test]
+    fn shards_hold_their_rows_and_tile_the_image() {
+        let full = render(5, 7, &Noise, &opts(Budget::Samples(3)));
+        let mut covered = vec![0u32; 7];
+        for i in 0..3 {
+            let shard = Shard::new(i, 3).unwrap();
+            let part = render(
+                5,
+                7,
+                &Noise,
+                &RenderOptions {
+                    shard,
+                    ..opts(Budget::Samples(3))
+                },
+            );
+            let rows = (0..7).filter(|&y| shard.holds_row(y)).count() as u32;
+            assert_eq!(shard.rows(7), rows);
+            for (y, covers) in covered.iter_mut().enumerate() {
+                let (a, b) = (&part.pixels[y * 5..][..5], &full.pixels[y * 5..][..5]);
+                if shard.holds_row(y as u32) {
+                    *covers += 1;
+                    assert_eq!(a, b, "row {y} of shard {shard}");
+                } else {
+                    assert!(a.iter().all(|p| *p == Rgb::ZERO), "row {y} of {shard}");
+                }
+            }
+        }
+        assert_eq!(covered, vec![1; 7]);
+    }
+
+    #[test]
+    fn shard_syntax() {
+        assert_eq!("2/3".parse::<Shard>(), Ok(Shard::new(2, 3).unwrap()));
+        assert_eq!(Shard::new(2, 3).unwrap().to_string(), "2/3");
+        for bad in ["3/3", "1/0", "-1/3", "1", "a/3", "1/b", ""] {
+            assert!(bad.parse::<Shard>().is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -22,7 +22,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{LightStrategy, Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, render};
+use tracer::render::{Budget, RenderOptions, Shard, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::lambert_irradiance;
@@ -131,6 +131,7 @@ fn image_mean(scene: &Scene, method: Method, strategy: LightStrategy, spp: u32) 
                 &RenderOptions {
                     budget: Budget::Samples(spp),
                     seed: 7000 + seed,
+                    shard: Shard::WHOLE,
                 },
             );
             assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);
