@@ -175,6 +175,7 @@ fn prefiltered_and_monte_carlo_renders_agree_on_the_checker_slab() {
             &RenderOptions {
                 budget: Budget::Samples(2),
                 seed: 9,
+                shard: Shard::WHOLE,
             },
         )
     };
