@@ -82,8 +82,9 @@ pub struct SoneParams {
 
 /// Which scattering coefficient Eq. (2) uses when g ≠ 0. The paper calls its σs, σa and g
 /// "the reduced scattering and absorption coefficients, and the average cosine", which reads
-/// either way; the three readings differ only for g ≠ 0 (measured against the beam path
-/// tracer at g = 0.8 in `docs/physics.md#path-width`).
+/// either way; the three readings differ only for g ≠ 0. Measured against the beam light
+/// tracer at g = 0.8 (`docs/physics.md#path-width`): `Reduced` is the worst on both presets,
+/// `Unreduced` and `SimilarIsotropic` tie, all within 0.005 in mean |log10|.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum WidthScattering {
     /// σs and the phase function's own ⟨θ²⟩ (PAT04's path model of the real medium). Default.
