@@ -42,6 +42,8 @@ use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives
 const SAMPLE_COUNTS: [u32; 5] = [1, 4, 16, 64, 256];
 /// HG g of the benchmarked material (isotropic, as in the paper's Figure 4).
 const G: f64 = 0.0;
+/// Relative index of refraction of the benchmarked material (index-matched, as in Figure 4).
+const ETA: f64 = 1.0;
 
 /// Every estimator at every benchmarked sample count, with its benchmark label.
 fn estimators() -> Vec<(String, Estimator)> {
@@ -115,7 +117,9 @@ fn bench_scene<S, F>(
         })
     });
     for (label, estimator) in estimators() {
-        let prepared = estimator.prepare(G).expect("valid benchmark parameters");
+        let prepared = estimator
+            .prepare(G, ETA)
+            .expect("valid benchmark parameters");
         let mut rng = SplitMix64::new(7);
         let mut i = 0usize;
         group.bench_function(&label, |b| {
@@ -156,7 +160,7 @@ fn print_std_table<S, F>(
         ) {
             continue; // deterministic
         }
-        let prepared = estimator.prepare(G).expect("valid parameters");
+        let prepared = estimator.prepare(G, ETA).expect("valid parameters");
         let (mut sum_var, mut sum_rel_var) = (0.0, 0.0);
         for (p, (x_i, x_o)) in pairs.iter().enumerate() {
             let vals: Vec<f64> = (0..seeds)

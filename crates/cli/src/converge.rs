@@ -53,13 +53,14 @@ pub struct Args {
     beam: bool,
     #[command(flatten)]
     setup: SetupArgs,
-    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
+    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone,
+    /// kernel.
     #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
     /// Profile model of the BSSRDF methods (scene: default each material's).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment and Sone estimators.
+    /// Averaging samples per region of the segment, Sone and kernel estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in

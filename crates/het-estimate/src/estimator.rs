@@ -5,6 +5,8 @@ use bssrdf_core::ParamError;
 
 use crate::estimate::{Estimate, Region};
 use crate::field::CoefficientField;
+use crate::kernel::{self, KernelParams};
+use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::names::Named;
 use crate::point_lookup;
@@ -17,10 +19,11 @@ use crate::surface::SurfaceQuery;
 /// How the homogeneous parameters for a pair (x_i, x_o) are estimated.
 ///
 /// Names (`Display`/`FromStr`, used by the CLI and scene files): `jensen-in`, `jensen-out`,
-/// `endpoints`, `segment`, `sone`. Parsing a name gives the variant with default parameters.
+/// `endpoints`, `segment`, `sone`, `kernel`. Parsing a name gives the variant with default
+/// parameters.
 ///
-/// New methods (a diffusion-theory averaging kernel, prefiltered constant-time averaging, …)
-/// are one more variant each, with their parameters in their own module.
+/// New methods (prefiltered constant-time averaging, …) are one more variant each, with their
+/// parameters in their own module.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Estimator {
@@ -36,6 +39,9 @@ pub enum Estimator {
     Segment(SegmentParams),
     /// Sone, Hachisuka & Koike (paper §3): averages over the path-integral ellipse.
     Sone(SoneParams),
+    /// The diffusion-derived averaging kernel: σa and σs averaged with the depth-integrated
+    /// photon measurement density of the half-space diffusion approximation (docs/kernel.md).
+    Kernel(KernelParams),
 }
 
 impl Named for Estimator {
@@ -46,6 +52,7 @@ impl Named for Estimator {
         Estimator::Endpoints,
         Estimator::Segment(SegmentParams::new()),
         Estimator::Sone(SoneParams::paper()),
+        Estimator::Kernel(KernelParams::new()),
     ];
     fn name(self) -> &'static str {
         match self {
@@ -54,6 +61,7 @@ impl Named for Estimator {
             Estimator::Endpoints => "endpoints",
             Estimator::Segment(_) => "segment",
             Estimator::Sone(_) => "sone",
+            Estimator::Kernel(_) => "kernel",
         }
     }
 }
@@ -67,12 +75,16 @@ impl Estimator {
     }
 
     /// Validates the parameters and resolves the per-material constants (⟨θ²⟩ for Sone:
-    /// the exact value costs ~1 µs, so do this once per material, outside the pixel loop).
+    /// the exact value costs ~1 µs; the kernel's table: a few ms the first time a process
+    /// sees a given η, then shared), so do this once per material, outside the pixel loop.
     ///
-    /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1). Errors: `g` not
-    /// finite or out of range; a `SampleBudget::TargetRelError` with a non-positive or
-    /// non-finite target.
-    pub fn prepare(self, g: f64) -> Result<PreparedEstimator, ParamError> {
+    /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1) and `eta` its
+    /// relative index of refraction n_medium/n_outside (in [1, 3]; the kernel's extrapolated
+    /// boundary depends on it). Errors: `g` or `eta` not finite or out of range; a
+    /// `SampleBudget::TargetRelError` with a non-positive or non-finite target; kernel
+    /// parameters out of range ([`KernelParams::validate`]).
+    pub fn prepare(self, g: f64, eta: f64) -> Result<PreparedEstimator, ParamError> {
+        let a = crate::green::boundary_coefficient(eta)?;
         // Validate g for every estimator, so that a bad material fails early whatever is chosen.
         let theta2_of = |m: crate::path_integral::MeanSquareAngle| m.evaluate(g);
         let theta2 = match self {
@@ -90,10 +102,21 @@ impl Estimator {
                 p.ellipse.validate()?;
                 theta2_of(p.mean_square_angle)?
             }
+            Estimator::Kernel(p) => {
+                theta2_of(Default::default())?;
+                p.validate()?;
+                0.0
+            }
+        };
+        let kernel = match self {
+            Estimator::Kernel(_) => Some(KernelTable::shared(a)),
+            _ => None,
         };
         Ok(PreparedEstimator {
             estimator: self,
             theta2,
+            g,
+            kernel,
         })
     }
 }
@@ -104,6 +127,9 @@ impl Estimator {
 pub struct PreparedEstimator {
     estimator: Estimator,
     theta2: f64,
+    g: f64,
+    /// The kernel estimator's table (shared per η), `None` for the others.
+    kernel: Option<&'static KernelTable>,
 }
 
 impl PreparedEstimator {
@@ -161,6 +187,11 @@ impl PreparedEstimator {
             Estimator::Endpoints => point_lookup::endpoints(&mut probe),
             Estimator::Segment(p) => segment::estimate(p, &mut probe, &known, rng),
             Estimator::Sone(p) => sone::estimate(p, self.theta2, &mut probe, &known, rng),
+            Estimator::Kernel(p) => match self.kernel {
+                Some(table) => kernel::estimate(p, self.g, table, &mut probe, &known, rng),
+                // Unreachable: `prepare` gives every kernel estimator its table.
+                None => point_lookup::endpoints(&mut probe),
+            },
         };
         Estimate {
             coefficients: known.finish(raw),

@@ -129,7 +129,9 @@ impl Translucent {
         let model = model.or(self.profile).unwrap_or(ProfileModel::Dipole);
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
-        let prepared = estimator.prepare(self.g).map_err(|e| ("estimator", e))?;
+        let prepared = estimator
+            .prepare(self.g, self.eta)
+            .map_err(|e| ("estimator", e))?;
         Ok((family, prepared))
     }
 
