@@ -2,7 +2,7 @@
 //! deviation of the averaged coefficient versus the sample count (printed before the timings,
 //! so that a user can pick N).
 //!
-//! Run: `cargo bench --bench averaging` (add `-- sone` to filter). Benchmark ids are
+//! Run: `cargo bench --bench averaging` (add `-- sone` or `-- kernel` to filter). Benchmark ids are
 //! `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. Compare the
 //! estimators with the point-lookup estimator `jensen-out` of the same scene (and with
 //! `field-lookup`, one bare `CoefficientField::coefficients` call): absolute times depend on
@@ -31,8 +31,8 @@ use het_bssrdf::bssrdf_core::Rgb;
 use het_bssrdf::het_estimate::analytic::{ConstantField, Plane, PlanePoint, StripeField};
 use het_bssrdf::het_estimate::pattern::Stripe;
 use het_bssrdf::het_estimate::{
-    CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams, SplitMix64,
-    SurfaceQuery, UniformSource,
+    CoefficientField, Coefficients, Estimator, KernelParams, SampleBudget, SegmentParams,
+    SoneParams, SplitMix64, SurfaceQuery, UniformSource,
 };
 use het_bssrdf::tracer::field::{Field, MediumField, PlanarProjection};
 use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives};
@@ -40,6 +40,8 @@ use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives
 /// Sample counts benchmarked (per averaging stage: Sone uses N for the disk and N for the
 /// ellipse).
 const SAMPLE_COUNTS: [u32; 5] = [1, 4, 16, 64, 256];
+/// Points benchmarked for the kernel estimator (N points in all: 2N matches Sone's N).
+const KERNEL_SAMPLE_COUNTS: [u32; 6] = [2, 8, 16, 32, 128, 512];
 /// HG g of the benchmarked material (isotropic, as in the paper's Figure 4).
 const G: f64 = 0.0;
 /// Relative index of refraction of the benchmarked material (index-matched, as in Figure 4).
@@ -64,6 +66,15 @@ fn estimators() -> Vec<(String, Estimator)> {
         v.push((
             format!("sone samples={n}"),
             Estimator::Sone(SoneParams::paper().with_samples(budget)),
+        ));
+    }
+    // The kernel draws N points in all (Sone above draws N in the disk and N in the ellipse):
+    // compare `kernel samples=2N` with `sone samples=N` for equal lookups.
+    for n in KERNEL_SAMPLE_COUNTS {
+        let budget = SampleBudget::fixed(n);
+        v.push((
+            format!("kernel samples={n}"),
+            Estimator::Kernel(KernelParams::new().with_samples(budget)),
         ));
     }
     v

@@ -163,7 +163,7 @@ pub struct Args {
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
-    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 32 points for the kernel,
+    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
     /// at most 1024).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,

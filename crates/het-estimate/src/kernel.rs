@@ -57,7 +57,7 @@ use crate::surface::SurfaceQuery;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct KernelParams {
-    /// Points drawn from the proposal, each projected and looked up once (default 32). Only
+    /// Points drawn from the proposal, each projected and looked up once (default 64). Only
     /// fixed budgets, at most [`KernelParams::MAX_SAMPLES`].
     pub samples: SampleBudget,
     /// Weighted averages computed in all, each with the kernel of the previous estimate
@@ -65,6 +65,11 @@ pub struct KernelParams {
     pub iterations: u32,
     /// Projection misses: hits only (default) or endpoint mean.
     pub misses: MissPolicy,
+    /// The exponent p of the weighted power mean σ̄a = (Σ w σa^p / Σ w)^{1/p}, in (0, 1]
+    /// (default 0.75). p = 1 is the first-order (Born/Rytov) average; p = ½ is close to
+    /// averaging σtr ∝ √σa (the eikonal picture). Chosen by measurement
+    /// (docs/kernel.md#measurements). σs is averaged arithmetically.
+    pub exponent: f64,
 }
 
 impl KernelParams {
@@ -73,19 +78,27 @@ impl KernelParams {
     /// Largest number of iterations.
     pub const MAX_ITERATIONS: u32 = 8;
 
-    /// The defaults: 32 points, 2 iterations, hits only (chosen by measurement,
-    /// docs/kernel.md#measurements).
+    /// The defaults: 64 points, 2 iterations, hits only, power mean p = 0.75 (chosen by
+    /// measurement, docs/kernel.md#measurements).
     pub const fn new() -> Self {
         Self {
-            samples: SampleBudget::fixed(32),
+            samples: SampleBudget::fixed(64),
             iterations: 2,
             misses: MissPolicy::HitsOnly,
+            exponent: 0.75,
         }
     }
 
     /// The same parameters with `samples` points.
     pub const fn with_samples(mut self, samples: SampleBudget) -> Self {
         self.samples = samples;
+        self
+    }
+
+    /// The same parameters with the power-mean exponent `exponent` (p of
+    /// [`KernelParams::exponent`]).
+    pub const fn with_exponent(mut self, exponent: f64) -> Self {
+        self.exponent = exponent;
         self
     }
 
@@ -96,8 +109,22 @@ impl KernelParams {
     }
 
     /// Checks the parameters (used by `Estimator::prepare`): a fixed budget of at most
-    /// [`Self::MAX_SAMPLES`] points, 1 to [`Self::MAX_ITERATIONS`] iterations.
+    /// [`Self::MAX_SAMPLES`] points, 1 to [`Self::MAX_ITERATIONS`] iterations, an exponent in
+    /// (0, 1].
     pub fn validate(&self) -> Result<(), ParamError> {
+        if !self.exponent.is_finite() {
+            return Err(ParamError::NotFinite {
+                name: "kernel exponent",
+                value: self.exponent,
+            });
+        }
+        if !(self.exponent > 0.0 && self.exponent <= 1.0) {
+            return Err(ParamError::OutOfRange {
+                name: "kernel exponent",
+                range: "(0, 1]",
+                value: self.exponent,
+            });
+        }
         match self.samples {
             SampleBudget::Fixed(n) if n.get() <= Self::MAX_SAMPLES => {}
             SampleBudget::Fixed(n) => {
@@ -198,7 +225,9 @@ struct Sample {
     rho: (f64, f64),
     /// 1/q at the point (0 where q is infinite).
     inv_q: f64,
-    c: Coefficients,
+    /// σa^p per channel (p the power-mean exponent) and σs.
+    a_p: [f64; 3],
+    s: [f64; 3],
 }
 
 /// Estimates σ̄a, σ̄s for one pair (see the module docs). `g` is the material's HG mean
@@ -264,7 +293,14 @@ where
         } else {
             0.0
         };
-        store[len].write(Sample { rho, inv_q, c });
+        let p = params.exponent;
+        let a_p = c.sigma_a.0.map(|a| if p == 1.0 { a } else { a.powf(p) });
+        store[len].write(Sample {
+            rho,
+            inv_q,
+            a_p,
+            s: c.sigma_s.0,
+        });
         len += 1;
     }
     probe.diag.samples += n as u32;
@@ -293,7 +329,8 @@ where
                     && est.sigma_s[k] == est.sigma_s[c]
             });
             (0..3).for_each(|k| done[k] |= group[k]);
-            match weighted_means(samples, group, est.sigma_a[c], est.sigma_s[c], g, d, table) {
+            let medium = (est.sigma_a[c], est.sigma_s[c], g);
+            match weighted_means(samples, group, medium, d, table, params.exponent) {
                 Some(means) => {
                     for k in (0..3).filter(|&k| group[k]) {
                         next.sigma_a[k] = means[k].0;
@@ -309,18 +346,18 @@ where
     est
 }
 
-/// The W₂/q-weighted means (σa, σs) of the channels selected by `group` of `samples`, with
+/// The W₂/q-weighted means (σa as the power mean of exponent `exponent`, σs arithmetic) of
+/// the channels selected by `group` of `samples`, with
 /// the kernel of a homogeneous medium (`sigma_a`, `sigma_s`, `g`) for a chord of length `d`;
 /// `None` when that medium has no diffusion length (σt' = 0) or every weight is 0.
 #[inline]
 fn weighted_means(
     samples: &[Sample],
     group: [bool; 3],
-    sigma_a: f64,
-    sigma_s: f64,
-    g: f64,
+    (sigma_a, sigma_s, g): (f64, f64, f64),
     d: f64,
     table: &KernelTable,
+    exponent: f64,
 ) -> Option<[(f64, f64); 3]> {
     let st = sigma_a + (1.0 - g) * sigma_s;
     if !(st > 0.0 && st.is_finite()) {
@@ -337,12 +374,23 @@ fn weighted_means(
         let log_w = table.log_weight(ri, ro, kappa) - kappa * ((ri + ro) - d_t);
         let weight = log_w.exp() * s.inv_q;
         for k in 0..3 {
-            wa[k] += weight * mask[k] * s.c.sigma_a.0[k];
-            ws[k] += weight * mask[k] * s.c.sigma_s.0[k];
+            wa[k] += weight * mask[k] * s.a_p[k];
+            ws[k] += weight * mask[k] * s.s[k];
         }
         w += weight;
     }
-    (w > 0.0 && w.is_finite()).then(|| std::array::from_fn(|k| (wa[k] / w, ws[k] / w)))
+    if !(w > 0.0 && w.is_finite()) {
+        return None;
+    }
+    Some(std::array::from_fn(|k| {
+        let (a_p, s) = (wa[k] / w, ws[k] / w);
+        let a = if exponent == 1.0 {
+            a_p
+        } else {
+            a_p.powf(1.0 / exponent)
+        };
+        (a, s)
+    }))
 }
 
 #[cfg(test)]
@@ -413,6 +461,13 @@ mod tests {
         assert!(too_many.validate().is_err());
         assert!(KernelParams::new().with_iterations(0).validate().is_err());
         assert!(KernelParams::new().with_iterations(9).validate().is_err());
+        for p in [0.0, -0.5, 1.5, f64::NAN] {
+            assert!(
+                KernelParams::new().with_exponent(p).validate().is_err(),
+                "{p}"
+            );
+        }
+        assert!(KernelParams::new().with_exponent(1.0).validate().is_ok());
         let adaptive = KernelParams::new().with_samples(SampleBudget::TargetRelError {
             rel_se: 0.01,
             max: std::num::NonZeroU32::new(64).unwrap(),
@@ -427,17 +482,20 @@ mod tests {
             Sample {
                 rho: (0.0, 1.0),
                 inv_q: 0.0,
-                c: Coefficients::grey(0.1, 1.0),
+                a_p: [0.1; 3],
+                s: [1.0; 3],
             },
             Sample {
                 rho: (1e12, 1e12),
                 inv_q: 1e36,
-                c: Coefficients::grey(0.2, 1.0),
+                a_p: [0.2; 3],
+                s: [1.0; 3],
             },
             Sample {
                 rho: (0.5, 0.6),
                 inv_q: 1.0,
-                c: Coefficients::grey(0.3, 2.0),
+                a_p: [0.3; 3],
+                s: [2.0; 3],
             },
         ];
         for (a, s, g) in [
@@ -447,13 +505,13 @@ mod tests {
             (1e-6, 1e-6, -0.9),
         ] {
             for d in [1e-9, 1.0, 1e6] {
-                if let Some(m) = weighted_means(&samples, [true; 3], a, s, g, d, table) {
+                if let Some(m) = weighted_means(&samples, [true; 3], (a, s, g), d, table, 1.0) {
                     let (ma, ms) = m[0];
                     assert!(ma.is_finite() && ms.is_finite(), "{a} {s} {g} {d}");
                     assert!((0.1..=0.3).contains(&ma), "{ma}");
                 }
             }
         }
-        assert!(weighted_means(&samples, [true; 3], 0.0, 0.0, 0.0, 1.0, table).is_none());
+        assert!(weighted_means(&samples, [true; 3], (0.0, 0.0, 0.0), 1.0, table, 1.0).is_none());
     }
 }
