@@ -231,6 +231,7 @@ mod tests {
     /// W̃₂ by an independent rule: adaptive Simpson in ζ on [0, 1] and on [1, ∞) mapped by
     /// ζ = 1 + u/(1 − u), straight from the closed-form Green's function.
     fn direct(rho_i: f64, rho_o: f64, kappa: f64, zb: f64) -> f64 {
+        #[allow(clippy::too_many_arguments)] // one step of the textbook recursion
         fn simpson(
             f: &dyn Fn(f64) -> f64,
             a: f64,
