@@ -2,8 +2,8 @@
 //! deviation of the averaged coefficient versus the sample count (printed before the timings,
 //! so that a user can pick N).
 //!
-//! Run: `cargo bench --bench averaging` (add `-- sone` to filter). Benchmark ids are
-//! `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. `sone samples=<N>`
+//! Run: `cargo bench --bench averaging` (add `-- sone` or `-- kernel` to filter). Benchmark ids
+//! are `averaging/<scene>/<estimator> samples=<N>`; point lookups have no N. `sone samples=<N>`
 //! is Monte Carlo averaging; `sone prefiltered` is the default (closed-form averages where
 //! the field has them and the pair is flat, the paper's 16 + 32 samples elsewhere): run
 //! `cargo bench --bench averaging -- 'prefiltered|field-lookup|jensen-out'` to compare it
@@ -38,8 +38,8 @@ use het_bssrdf::het_estimate::analytic::{
 };
 use het_bssrdf::het_estimate::pattern::{Check, Stripe};
 use het_bssrdf::het_estimate::{
-    Averaging, CoefficientField, Coefficients, Estimator, SampleBudget, SegmentParams, SoneParams,
-    SplitMix64, SurfaceQuery, UniformSource,
+    Averaging, CoefficientField, Coefficients, Estimator, KernelParams, SampleBudget,
+    SegmentParams, SoneParams, SplitMix64, SurfaceQuery, UniformSource,
 };
 use het_bssrdf::tracer::field::{Field, MediumField, PlanarProjection};
 use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives};
@@ -47,8 +47,12 @@ use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives
 /// Sample counts benchmarked (per averaging stage: Sone uses N for the disk and N for the
 /// ellipse).
 const SAMPLE_COUNTS: [u32; 5] = [1, 4, 16, 64, 256];
+/// Points benchmarked for the kernel estimator (N points in all: 2N matches Sone's N).
+const KERNEL_SAMPLE_COUNTS: [u32; 6] = [2, 8, 16, 32, 128, 512];
 /// HG g of the benchmarked material (isotropic, as in the paper's Figure 4).
 const G: f64 = 0.0;
+/// Relative index of refraction of the benchmarked material (index-matched, as in Figure 4).
+const ETA: f64 = 1.0;
 
 /// Every estimator at every benchmarked sample count, with its benchmark label.
 fn estimators() -> Vec<(String, Estimator)> {
@@ -81,6 +85,15 @@ fn estimators() -> Vec<(String, Estimator)> {
         "sone prefiltered".to_string(),
         Estimator::Sone(SoneParams::paper()),
     ));
+    // The kernel draws N points in all (Sone above draws N in the disk and N in the ellipse):
+    // compare `kernel samples=2N` with `sone samples=N` for equal lookups.
+    for n in KERNEL_SAMPLE_COUNTS {
+        let budget = SampleBudget::fixed(n);
+        v.push((
+            format!("kernel samples={n}"),
+            Estimator::Kernel(KernelParams::new().with_samples(budget)),
+        ));
+    }
     v
 }
 
@@ -132,7 +145,9 @@ fn bench_scene<S, F>(
         })
     });
     for (label, estimator) in estimators() {
-        let prepared = estimator.prepare(G).expect("valid benchmark parameters");
+        let prepared = estimator
+            .prepare(G, ETA)
+            .expect("valid benchmark parameters");
         let mut rng = SplitMix64::new(7);
         let mut i = 0usize;
         group.bench_function(&label, |b| {
@@ -173,7 +188,7 @@ fn print_std_table<S, F>(
         ) {
             continue; // deterministic
         }
-        let prepared = estimator.prepare(G).expect("valid parameters");
+        let prepared = estimator.prepare(G, ETA).expect("valid parameters");
         let (mut sum_var, mut sum_rel_var) = (0.0, 0.0);
         for (p, (x_i, x_o)) in pairs.iter().enumerate() {
             let vals: Vec<f64> = (0..seeds)

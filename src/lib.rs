@@ -10,5 +10,11 @@ pub use experiments;
 /// workspace cite as `docs/physics.md#section`).
 #[doc = include_str!("../docs/physics.md")]
 pub mod physics {}
+
+/// The diffusion-derived averaging kernel (`--method kernel`): derivation, assumptions, the
+/// table and the sampler, and the measurements that chose its variants (the repository's
+/// `docs/kernel.md`, cited from the code as `docs/kernel.md#section`).
+#[doc = include_str!("../docs/kernel.md")]
+pub mod kernel {}
 pub use het_estimate;
 pub use tracer;

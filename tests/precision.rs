@@ -425,7 +425,7 @@ fn tracer_fields_and_estimators_on_pattern_boundaries() {
     let mut rng = Rng::from_keys(73, &[]);
     let prepared: Vec<_> = Estimator::ALL
         .iter()
-        .map(|e| e.prepare(0.2).expect("estimator"))
+        .map(|e| e.prepare(0.2, 1.0).expect("estimator"))
         .collect();
     for (name, field, pattern) in [
         (

@@ -702,7 +702,7 @@ fn estimators(r: &mut Report, case: usize, kind: FieldKind) {
     let mut rng = SplitMix64::new(0x5eed ^ case as u64);
     let dir = DVec3::new(30f64.to_radians().cos(), 30f64.to_radians().sin(), 0.0);
     for &g in gs {
-        let prepared = estimator.prepare(g).expect("valid estimator");
+        let prepared = estimator.prepare(g, 1.3).expect("valid estimator");
         for (i, &(a0, s0)) in pairs.iter().enumerate() {
             for (j, &(a1, s1)) in pairs.iter().enumerate() {
                 // The adaptive budget is ~10× dearer: a deterministic quarter of the pairs.
@@ -800,7 +800,7 @@ fn degenerate(r: &mut Report) {
     let cases = estimator_cases();
     let mut rng = SplitMix64::new(0xde9e);
     for (name, estimator) in &cases {
-        let prepared = estimator.prepare(0.3).expect("valid estimator");
+        let prepared = estimator.prepare(0.3, 1.3).expect("valid estimator");
         for kind in [FieldKind::Stripe, FieldKind::Check] {
             for &(a0, s0) in &contrast {
                 for &(a1, s1) in &contrast {

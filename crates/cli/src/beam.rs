@@ -156,14 +156,15 @@ pub struct Args {
     #[command(flatten)]
     setup: SetupArgs,
     /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
-    /// endpoints, segment, sone.
+    /// endpoints, segment, sone, kernel.
     #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
     /// Profile model for BSSRDF methods (default: tabulated, the exact profile).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
-    /// segment; 16 in the disk and 32 in the ellipse for Sone).
+    /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
+    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
+    /// at most 1024).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
     /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field

@@ -53,14 +53,15 @@ pub struct Args {
     beam: bool,
     #[command(flatten)]
     setup: SetupArgs,
-    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone.
+    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone,
+    /// kernel.
     #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
     /// Profile model of the BSSRDF methods (scene: default each material's, else tabulated
     /// where η ≤ 1.6 and pbd above; beam: tabulated).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment and Sone estimators.
+    /// Averaging samples per region of the segment, Sone and kernel estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
     /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field

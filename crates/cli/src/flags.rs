@@ -43,7 +43,7 @@ impl Given {
 
 /// Errors when `--profile` (`profile`) or `--estimator-samples` (`samples`) was given but
 /// none of `methods` uses it: the profile only matters to BSSRDF methods, the samples only to
-/// the segment and Sone estimators.
+/// the segment, Sone and kernel estimators.
 pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> anyhow::Result<()> {
     let names = || {
         methods
@@ -62,15 +62,15 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
         matches!(
             m,
             Method::Bssrdf {
-                estimator: Estimator::Segment(_) | Estimator::Sone(_),
+                estimator: Estimator::Segment(_) | Estimator::Sone(_) | Estimator::Kernel(_),
                 ..
             }
         )
     };
     if samples && !methods.iter().any(sampled) {
         bail!(
-            "--estimator-samples does not apply to `{}`: only the segment and sone estimators \
-             take averaging samples",
+            "--estimator-samples does not apply to `{}`: only the segment, sone and kernel \
+             estimators take averaging samples",
             names()
         );
     }

@@ -29,14 +29,15 @@ pub struct Args {
     /// The scene file (TOML).
     scene: PathBuf,
     /// `pt` (the path-traced reference) or a BSSRDF estimator: jensen-in, jensen-out,
-    /// endpoints, segment, sone. Default: the scene's `render.estimator`, else `sone`.
+    /// endpoints, segment, sone, kernel. Default: the scene's `render.estimator`, else `sone`.
     #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
     /// Profile model for BSSRDF methods (default: each material's, else dipole).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment and Sone estimators (default: 16 on the
-    /// segment; 16 in the disk and 32 in the ellipse for Sone).
+    /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
+    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
+    /// at most 1024).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
     /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field

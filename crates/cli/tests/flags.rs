@@ -13,6 +13,7 @@ const METHODS: &[&str] = &[
     "endpoints",
     "segment",
     "sone",
+    "kernel",
 ];
 const PROFILES: &[&str] = &["dipole", "pbd", "better-dipole", "tabulated"];
 const SCATTERING: &[&str] = &["multiple", "single", "all"];

@@ -73,11 +73,11 @@ fn main() {
     };
     let x_i = on_sphere(DVec3::new(1.0, 0.0, 0.1));
     let x_o = on_sphere(DVec3::new(1.0, 0.35, 0.6));
-    let g = 0.3; // the material's HG g
+    let (g, eta) = (0.3, 1.3); // the material's HG g and relative index
 
     for estimator in Estimator::ALL {
-        // Once per material (validates, and computes ⟨θ²⟩ for Sone).
-        let prepared = estimator.prepare(g).expect("valid parameters");
+        // Once per material (validates, and computes ⟨θ²⟩ for Sone, the table for the kernel).
+        let prepared = estimator.prepare(g, eta).expect("valid parameters");
         // Per (x_i, x_o) pair, with the pixel's random stream.
         let mut rng = SplitMix64::new(42);
         let est = prepared.estimate(&sphere, &Bands, &x_i, &x_o, &mut rng);

@@ -32,6 +32,9 @@ pub enum Region {
     /// The Sone ellipse with a vanishing minor axis (w = 0: ⟨θ²⟩ = 0, ⟨σs⟩ = 0, …): the
     /// average is taken along the chord with the ellipse's limiting (semicircle) density.
     DegenerateEllipse,
+    /// The diffusion-derived kernel's weighted average over points around the chord
+    /// (docs/kernel.md).
+    Kernel,
 }
 
 /// Diagnostics of one estimate (for rare-event counters and debugging; never needed to use

@@ -5,6 +5,8 @@ use bssrdf_core::ParamError;
 
 use crate::estimate::{Estimate, Region};
 use crate::field::CoefficientField;
+use crate::kernel::{self, KernelParams};
+use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::names::Named;
 use crate::point_lookup;
@@ -17,11 +19,12 @@ use crate::surface::SurfaceQuery;
 /// How the homogeneous parameters for a pair (x_i, x_o) are estimated.
 ///
 /// Names (`Display`/`FromStr`, used by the CLI and scene files): `jensen-in`, `jensen-out`,
-/// `endpoints`, `segment`, `sone`. Parsing a name gives the variant with default parameters.
+/// `endpoints`, `segment`, `sone`, `kernel`. Parsing a name gives the variant with default
+/// parameters.
 ///
-/// New methods (a diffusion-theory averaging kernel, …) are one more variant each, with their
-/// parameters in their own module. Prefiltered constant-time averaging is an option of
-/// `sone` ([`SoneParams::averaging`], on by default), not a separate estimator.
+/// New methods are one more variant each, with their parameters in their own module.
+/// Prefiltered constant-time averaging is an option of `sone` ([`SoneParams::averaging`], on
+/// by default), not a separate estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub enum Estimator {
@@ -37,6 +40,9 @@ pub enum Estimator {
     Segment(SegmentParams),
     /// Sone, Hachisuka & Koike (paper §3): averages over the path-integral ellipse.
     Sone(SoneParams),
+    /// The diffusion-derived averaging kernel: σa and σs averaged with the depth-integrated
+    /// photon measurement density of the half-space diffusion approximation (docs/kernel.md).
+    Kernel(KernelParams),
 }
 
 impl Named for Estimator {
@@ -47,6 +53,7 @@ impl Named for Estimator {
         Estimator::Endpoints,
         Estimator::Segment(SegmentParams::new()),
         Estimator::Sone(SoneParams::paper()),
+        Estimator::Kernel(KernelParams::new()),
     ];
     fn name(self) -> &'static str {
         match self {
@@ -55,6 +62,7 @@ impl Named for Estimator {
             Estimator::Endpoints => "endpoints",
             Estimator::Segment(_) => "segment",
             Estimator::Sone(_) => "sone",
+            Estimator::Kernel(_) => "kernel",
         }
     }
 }
@@ -68,12 +76,16 @@ impl Estimator {
     }
 
     /// Validates the parameters and resolves the per-material constants (⟨θ²⟩ for Sone:
-    /// the exact value costs ~1 µs, so do this once per material, outside the pixel loop).
+    /// the exact value costs ~1 µs; the kernel's table: a few ms the first time a process
+    /// sees a given η, then shared), so do this once per material, outside the pixel loop.
     ///
-    /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1). Errors: `g` not
-    /// finite or out of range; a `SampleBudget::TargetRelError` with a non-positive or
-    /// non-finite target.
-    pub fn prepare(self, g: f64) -> Result<PreparedEstimator, ParamError> {
+    /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1) and `eta` its
+    /// relative index of refraction n_medium/n_outside (in [1, 3]; the kernel's extrapolated
+    /// boundary depends on it). Errors: `g` or `eta` not finite or out of range; a
+    /// `SampleBudget::TargetRelError` with a non-positive or non-finite target; kernel
+    /// parameters out of range ([`KernelParams::validate`]).
+    pub fn prepare(self, g: f64, eta: f64) -> Result<PreparedEstimator, ParamError> {
+        let a = crate::green::boundary_coefficient(eta)?;
         // Validate g for every estimator, so that a bad material fails early whatever is chosen.
         let theta2_of = |m: crate::path_integral::MeanSquareAngle| m.evaluate(g);
         let theta2 = match self {
@@ -97,6 +109,15 @@ impl Estimator {
                 let (g_theta, _) = p.width_scattering.resolve(g);
                 p.mean_square_angle.evaluate(g_theta)?
             }
+            Estimator::Kernel(p) => {
+                theta2_of(Default::default())?;
+                p.validate()?;
+                0.0
+            }
+        };
+        let kernel = match self {
+            Estimator::Kernel(_) => Some(KernelTable::shared(a)),
+            _ => None,
         };
         let sigma_s_scale = match self {
             Estimator::Sone(p) => p.width_scattering.resolve(g).1,
@@ -106,6 +127,8 @@ impl Estimator {
             estimator: self,
             theta2,
             sigma_s_scale,
+            g,
+            kernel,
         })
     }
 }
@@ -118,6 +141,9 @@ pub struct PreparedEstimator {
     theta2: f64,
     /// Factor on σs in Eq. (2) (Sone; see `WidthScattering`).
     sigma_s_scale: f64,
+    g: f64,
+    /// The kernel estimator's table (shared per η), `None` for the others.
+    kernel: Option<&'static KernelTable>,
 }
 
 impl PreparedEstimator {
@@ -177,6 +203,11 @@ impl PreparedEstimator {
             Estimator::Sone(p) => {
                 sone::estimate(p, self.theta2, self.sigma_s_scale, &mut probe, &known, rng)
             }
+            Estimator::Kernel(p) => match self.kernel {
+                Some(table) => kernel::estimate(p, self.g, table, &mut probe, &known, rng),
+                // Unreachable: `prepare` gives every kernel estimator its table.
+                None => point_lookup::endpoints(&mut probe),
+            },
         };
         Estimate {
             coefficients: known.finish(raw),

@@ -20,8 +20,9 @@
 //!   `fixtures` feature). The point type is the
 //!   renderer's (`SurfaceQuery::Point`), so a lookup can use triangle ids and UVs.
 //! * **A closed set, resolved once.** [`Estimator`] is an enum (names `jensen-in`,
-//!   `jensen-out`, `endpoints`, `segment`, `sone`); [`Estimator::prepare`] validates it and
-//!   computes the per-material constants (the exact ⟨θ²⟩ is a ~1 µs quadrature) into a
+//!   `jensen-out`, `endpoints`, `segment`, `sone`, `kernel`); [`Estimator::prepare`] validates it
+//!   and computes the per-material constants (the exact ⟨θ²⟩ is a ~1 µs quadrature; the
+//!   kernel's table) into a
 //!   [`PreparedEstimator`], whose [`PreparedEstimator::estimate`] dispatches once per pair to
 //!   a generic loop over the samples (no allocation, no dynamic dispatch inside).
 //! * **Caller-provided randomness** ([`UniformSource`]) keeps renders deterministic per seed.
@@ -50,6 +51,9 @@ pub mod estimate;
 pub mod estimator;
 pub mod field;
 pub mod frame;
+pub mod green;
+pub mod kernel;
+pub mod kernel_table;
 mod known;
 pub mod path_integral;
 pub mod pattern;
@@ -72,6 +76,7 @@ pub use field::{CoefficientField, Coefficients, FieldBounds};
 /// The vector types of the public traits (`glam::DVec3`), re-exported so that implementors
 /// use the same glam version as this crate.
 pub use glam;
+pub use kernel::KernelParams;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use prefilter::{Averaging, Flatness};

@@ -11,9 +11,9 @@ use het_estimate::analytic::{
 };
 use het_estimate::pattern::{Check, Ramp, Stripe};
 use het_estimate::{
-    Averaging, CoefficientField, Coefficients, Estimate, Estimator, MissPolicy, Named, Region, Rgb,
-    SampleBudget, SegmentParams, SemiMinorAxis, SoneParams, SplitMix64, SurfacePoint, SurfaceQuery,
-    WidthScattering,
+    Averaging, CoefficientField, Coefficients, Estimate, Estimator, KernelParams, MissPolicy,
+    Named, Region, Rgb, SampleBudget, SegmentParams, SemiMinorAxis, SoneParams, SplitMix64,
+    SurfacePoint, SurfaceQuery, WidthScattering,
 };
 use proptest::prelude::*;
 
@@ -155,18 +155,19 @@ fn run<S: SurfaceQuery, F: CoefficientField<S::Point>>(
     x_o: &S::Point,
     seed: u64,
 ) -> Estimate {
-    e.prepare(g)
+    e.prepare(g, 1.3)
         .unwrap()
         .estimate(s, f, x_i, x_o, &mut SplitMix64::new(seed))
 }
 
-fn all_estimators(n: u32) -> [Estimator; 5] {
+fn all_estimators(n: u32) -> [Estimator; 6] {
     [
         Estimator::JensenIn,
         Estimator::JensenOut,
         Estimator::Endpoints,
         Estimator::Segment(segment(n)),
         Estimator::Sone(sone(n, n)),
+        Estimator::Kernel(KernelParams::new().with_samples(fixed(n))),
     ]
 }
 
@@ -185,7 +186,14 @@ fn names_round_trip_and_are_exact() {
     let names: Vec<&str> = Estimator::ALL.iter().map(|e| e.name()).collect();
     assert_eq!(
         names,
-        ["jensen-in", "jensen-out", "endpoints", "segment", "sone"]
+        [
+            "jensen-in",
+            "jensen-out",
+            "endpoints",
+            "segment",
+            "sone",
+            "kernel"
+        ]
     );
     for e in Estimator::ALL {
         let parsed: Estimator = e.to_string().parse().unwrap();
@@ -198,7 +206,7 @@ fn names_round_trip_and_are_exact() {
     let err = "Sone".parse::<Estimator>().unwrap_err();
     assert!(
         err.to_string()
-            .contains("jensen-in, jensen-out, endpoints, segment, sone")
+            .contains("jensen-in, jensen-out, endpoints, segment, sone, kernel")
     );
     assert_eq!(
         "endpoints".parse::<MissPolicy>().unwrap(),
@@ -209,21 +217,26 @@ fn names_round_trip_and_are_exact() {
 #[test]
 fn prepare_rejects_invalid_parameters() {
     for e in Estimator::ALL {
-        assert!(e.prepare(1.0).is_err());
-        assert!(e.prepare(f64::NAN).is_err());
-        assert!(e.prepare(-0.99).is_ok());
+        assert!(e.prepare(1.0, 1.3).is_err());
+        assert!(e.prepare(f64::NAN, 1.3).is_err());
+        assert!(e.prepare(-0.99, 1.3).is_ok());
+        assert!(e.prepare(0.0, 0.9).is_err());
+        assert!(e.prepare(0.0, f64::NAN).is_err());
+        assert!(e.prepare(0.0, 3.0).is_ok());
     }
     let mut p = SoneParams::paper();
     p.ellipse = SampleBudget::TargetRelError {
         rel_se: 0.0,
         max: NonZeroU32::new(64).unwrap(),
     };
-    assert!(Estimator::Sone(p).prepare(0.0).is_err());
-    let prepared = Estimator::Sone(SoneParams::paper()).prepare(0.0).unwrap();
+    assert!(Estimator::Sone(p).prepare(0.0, 1.0).is_err());
+    let prepared = Estimator::Sone(SoneParams::paper())
+        .prepare(0.0, 1.0)
+        .unwrap();
     assert!((prepared.mean_square_angle().unwrap() - ISO_THETA2).abs() < 1e-9);
     let mut p = SoneParams::paper();
     p.mean_square_angle = het_estimate::MeanSquareAngle::SmallAngle;
-    let prepared = Estimator::Sone(p).prepare(0.5).unwrap();
+    let prepared = Estimator::Sone(p).prepare(0.5, 1.0).unwrap();
     assert_eq!(prepared.mean_square_angle(), Some(1.0));
 }
 
@@ -802,7 +815,11 @@ fn all_misses_fall_back_to_the_endpoints() {
     let f = stripe_preset();
     let (x_i, x_o) = (PlanePoint::new(0.0, 0.0), PlanePoint::new(3.0, 0.0));
     let ends = run(Estimator::Endpoints, 0.0, &Plane, &f, &x_i, &x_o, 0).coefficients;
-    for e in [Estimator::Segment(segment(8)), Estimator::Sone(sone(8, 8))] {
+    for e in [
+        Estimator::Segment(segment(8)),
+        Estimator::Sone(sone(8, 8)),
+        Estimator::Kernel(KernelParams::new().with_samples(fixed(8))),
+    ] {
         let est = run(e, 0.0, &Nowhere, &f, &x_i, &x_o, 0);
         assert_eq!(est.coefficients, ends);
         assert!(est.diagnostics.fallback);

@@ -143,13 +143,15 @@ fn check_preset() -> CheckField {
 #[test]
 fn sone_prefiltered_matches_monte_carlo_on_the_check() {
     let f = check_preset();
-    let pre = Estimator::Sone(SoneParams::paper()).prepare(0.0).unwrap();
+    let pre = Estimator::Sone(SoneParams::paper())
+        .prepare(0.0, 1.0)
+        .unwrap();
     let mc = Estimator::Sone(
         SoneParams::paper()
             .with_averaging(Averaging::MonteCarlo)
             .with_samples(SampleBudget::fixed(4096)),
     )
-    .prepare(0.0)
+    .prepare(0.0, 1.0)
     .unwrap();
     let x_i = PlanePoint::new(0.3, -0.2);
     for x_o in [
@@ -240,9 +242,11 @@ fn fallback_triggers_on_a_small_sphere_and_is_counted() {
         },
         values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
     });
-    let pre = Estimator::Sone(SoneParams::paper()).prepare(0.0).unwrap();
+    let pre = Estimator::Sone(SoneParams::paper())
+        .prepare(0.0, 1.0)
+        .unwrap();
     let mc = Estimator::Sone(SoneParams::paper().with_averaging(Averaging::MonteCarlo))
-        .prepare(0.0)
+        .prepare(0.0, 1.0)
         .unwrap();
     let on = |theta: f64, phi: f64| {
         SpherePoint(

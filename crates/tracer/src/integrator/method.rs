@@ -10,8 +10,8 @@ use super::Method;
 
 impl FromStr for Method {
     type Err = String;
-    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`)
-    /// with the estimator's default parameters and each material's own profile.
+    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`,
+    /// `kernel`) with the estimator's default parameters and each material's own profile.
     fn from_str(s: &str) -> Result<Self, String> {
         if s == "pt" {
             return Ok(Method::PathTraced);
@@ -27,7 +27,8 @@ impl FromStr for Method {
 
 impl Method {
     /// The method with `n` averaging samples per region (segment: on the chord; Sone: in the
-    /// disk and in the ellipse); other methods are unchanged.
+    /// disk and in the ellipse; kernel: points drawn around the chord, at most
+    /// `KernelParams::MAX_SAMPLES`, which `prepare` enforces); other methods are unchanged.
     pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
         let Some(n) = n else { return self };
         let budget = het_estimate::SampleBudget::fixed(n.max(1));
@@ -44,6 +45,13 @@ impl Method {
                 profile,
             } => Method::Bssrdf {
                 estimator: Estimator::Sone(p.with_samples(budget)),
+                profile,
+            },
+            Method::Bssrdf {
+                estimator: Estimator::Kernel(p),
+                profile,
+            } => Method::Bssrdf {
+                estimator: Estimator::Kernel(p.with_samples(budget)),
                 profile,
             },
             m => m,

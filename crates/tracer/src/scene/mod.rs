@@ -136,7 +136,9 @@ impl Translucent {
             .unwrap_or(ProfileModel::default_for(self.eta));
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
-        let prepared = estimator.prepare(self.g).map_err(|e| ("estimator", e))?;
+        let prepared = estimator
+            .prepare(self.g, self.eta)
+            .map_err(|e| ("estimator", e))?;
         Ok((family, prepared))
     }
 
