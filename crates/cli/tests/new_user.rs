@@ -470,3 +470,46 @@ fn bssrdf_renders_warn_about_an_opaque_core() {
         r.stderr
     );
 }
+
+/// A translucent object thinner than a few diffusion lengths gets a warning with BSSRDF
+/// methods (the half-space assumption), kept in the sidecar; a large one and the path tracer
+/// do not. MINIMAL's box is 1 thick with 1/σtr = 1/√(3 · 0.1 · 1.1) = 1.741.
+#[test]
+fn small_translucent_objects_warn_with_bssrdf_methods() {
+    let s = Scratch::new();
+    s.write("small.toml", MINIMAL);
+    s.write(
+        "large.toml",
+        edit(
+            MINIMAL,
+            "min = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
+            "min = [-100.0, -100.0, -100.0]\nmax = [100.0, 100.0, 0.0]",
+        ),
+    );
+    let r = s.run(&["render", "small.toml", "--method", "sone", "--out", "s.exr"]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("diffusion lengths") && r.stderr.contains("1/σtr = 1.741"),
+        "{}",
+        r.stderr
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.join("s.json")).unwrap()).unwrap();
+    assert!(
+        json["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains("diffusion lengths")),
+        "{json}"
+    );
+    for (scene, method) in [("large.toml", "sone"), ("small.toml", "pt")] {
+        let r = s.run(&["render", scene, "--method", method, "--out", "o.exr"]);
+        assert_eq!(r.code, Some(0), "{}", r.stderr);
+        assert!(
+            !r.stderr.contains("diffusion lengths"),
+            "{scene} {method}: {}",
+            r.stderr
+        );
+    }
+}
