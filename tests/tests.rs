@@ -3,6 +3,7 @@
 mod common;
 mod fuzz_regressions;
 mod index_matched;
+mod image_prefilter;
 mod integrators;
 mod precision;
 mod readme;
