@@ -2,8 +2,8 @@
 
 mod common;
 mod fuzz_regressions;
-mod index_matched;
 mod image_prefilter;
+mod index_matched;
 mod integrators;
 mod precision;
 mod readme;

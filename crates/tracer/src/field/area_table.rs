@@ -72,6 +72,8 @@ pub struct AreaTable {
     width: usize,
     height: usize,
     mean: [f64; 3],
+    inv_w: f64,
+    inv_h: f64,
     /// `(W + 1) × (H + 1)` entries, row-major.
     sat: Vec<[f64; 3]>,
 }
@@ -153,6 +155,8 @@ impl AreaTable {
             width: w,
             height: h,
             mean,
+            inv_w: 1.0 / w as f64,
+            inv_h: 1.0 / h as f64,
             sat,
         }
     }
@@ -189,8 +193,9 @@ impl AreaTable {
                 // Whole periods integrate to zero (mean removed); the remainders remain.
                 // F(q_x W + r_x, y) = q_x F(W, y) + F(r_x, y), and F(W, y) is a sum over whole
                 // rows of periods only in y, so it is kept.
-                let (qx, rx) = ((x / w).floor(), x.rem_euclid(w).min(w));
-                let (qy, ry) = ((y / h).floor(), y.rem_euclid(h).min(h));
+                // floor and a multiply, not `rem_euclid` (an fmod: the hot path's main cost).
+                let (qx, qy) = ((x * self.inv_w).floor(), (y * self.inv_h).floor());
+                let (rx, ry) = ((x - qx * w).clamp(0.0, w), (y - qy * h).clamp(0.0, h));
                 let (a, b, c, d) = (
                     self.inside(w, h),
                     self.inside(w, ry),
@@ -230,6 +235,46 @@ impl AreaTable {
         }
     }
 
+    /// A row position `y ∈ [0, H]`: its cell row and fraction.
+    #[inline]
+    fn row(&self, y: f64) -> (usize, f64) {
+        let j = (y.floor() as usize).min(self.height - 1);
+        (j, y - j as f64)
+    }
+
+    /// `F(x, y1) − F(x, y0)` under `repeat`, as a function of `x` with the y terms
+    /// computed once (the hot path of [`AreaTable::ellipse_average`]: two calls per strip).
+    fn repeat_band(&self, y0: f64, y1: f64) -> impl Fn(f64) -> [f64; 3] + '_ {
+        let (w, h) = (self.width as f64, self.height as f64);
+        let split = |y: f64| {
+            let q = (y * self.inv_h).floor();
+            (q, (y - q * h).clamp(0.0, h))
+        };
+        let ((q0, r0), (q1, r1)) = (split(y0), split(y1));
+        let dq = q1 - q0;
+        let (a, b1, b0) = (self.inside(w, h), self.inside(w, r1), self.inside(w, r0));
+        let per_period: [f64; 3] = std::array::from_fn(|k| dq * a[k] + b1[k] - b0[k]);
+        let (row0, row1) = (self.row(r0), self.row(r1));
+        let top = self.height;
+        move |x: f64| {
+            let qx = (x * self.inv_w).floor();
+            let rx = (x - qx * w).clamp(0.0, w);
+            let i = (rx.floor() as usize).min(self.width - 1);
+            let fx = rx - i as f64;
+            let lerp = |j: usize, k: usize| {
+                let (p, q) = (self.s(i, j)[k], self.s(i + 1, j)[k]);
+                p + fx * (q - p)
+            };
+            std::array::from_fn(|k| {
+                let d = |(j, fy): (usize, f64)| {
+                    let lo = lerp(j, k);
+                    lo + fy * (lerp(j + 1, k) - lo)
+                };
+                qx * per_period[k] + dq * lerp(top, k) + d(row1) - d(row0)
+            })
+        }
+    }
+
     /// The integral of the nearest-filtered texture (extended by `wrap`) over the rectangle
     /// `[x0, x1] × [y0, y1]` in texel coordinates (texel units² × value), exact to rounding.
     pub fn rect_integral(&self, x0: f64, x1: f64, y0: f64, y1: f64, wrap: Wrap) -> [f64; 3] {
@@ -247,7 +292,13 @@ impl AreaTable {
     /// ellipse `e` (see the module docs for the strips and the error bound). `None` for a
     /// non-finite or zero-area ellipse, or one taller than `2^40·MAX_ROWS` rows.
     pub fn ellipse_average(&self, e: &TexelEllipse, wrap: Wrap) -> Option<[f64; 3]> {
-        let [cx, cy] = e.centre;
+        let [mut cx, mut cy] = e.centre;
+        if wrap == Wrap::Repeat && cx.is_finite() && cy.is_finite() {
+            // Whole periods do not change the average: keep the coordinates small.
+            let (w, h) = (self.width as f64, self.height as f64);
+            cx -= (cx * self.inv_w).floor() * w;
+            cy -= (cy * self.inv_h).floor() * h;
+        }
         let (au, av) = (e.axis_u, e.axis_v);
         let det = au[0] * av[1] - au[1] * av[0];
         let hy = e.half_height();
@@ -274,6 +325,7 @@ impl AreaTable {
         let last = (bottom / band).floor();
         let mut sum = [0.0; 3];
         let mut b = first;
+        let mut g0 = g(-1.0);
         while b <= last {
             let y0 = (b * band).max(top);
             let y1 = ((b + 1.0) * band).min(bottom);
@@ -281,14 +333,24 @@ impl AreaTable {
             if y1 <= y0 {
                 continue;
             }
-            // Exact area of the ellipse within the strip: hw0·hy·(G(z1) − G(z0)).
-            let area = hw0 * hy * (g((y1 - cy) / hy) - g((y0 - cy) / hy));
+            // Exact area of the ellipse within the strip: hw0·hy·(G(z1) − G(z0)); G(z0) is
+            // the previous strip's G(z1).
+            let g1 = g((y1 - cy) / hy);
+            let area = hw0 * hy * (g1 - g0);
+            g0 = g1;
             if area <= 0.0 {
                 continue;
             }
             let half = 0.5 * area / (y1 - y0);
             let xc = cx + shear * (0.5 * (y0 + y1) - cy);
-            let i = self.rect_integral(xc - half, xc + half, y0, y1, wrap);
+            let i = match wrap {
+                Wrap::Repeat => {
+                    let band = self.repeat_band(y0, y1);
+                    let (r1, r0) = (band(xc + half), band(xc - half));
+                    std::array::from_fn(|k| r1[k] - r0[k] + self.mean[k] * area)
+                }
+                Wrap::Clamp => self.rect_integral(xc - half, xc + half, y0, y1, wrap),
+            };
             for c in 0..3 {
                 sum[c] += i[c];
             }
