@@ -20,6 +20,10 @@
 //! * `plane-check`: the same pairs over the Figure 4 check preset (cells of width 4);
 //! * `plane-constant`: the same pairs over a constant field (the short-circuit: every estimator
 //!   should cost about the same as a point lookup, or less);
+//! * `plane-image`: the same pairs over a planar-projected 256 × 256 RGB image σa (random
+//!   texels in [0.005, 0.1], nearest filtering, 30 × 30 scene units: about 8.5 texels per
+//!   unit), σs 1; `sone prefiltered` reads the texture's summed-area table (built before the
+//!   timings);
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
 //!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
 //!   pairs of surface points at most 8 apart: every projection is two BVH rays.
@@ -41,7 +45,10 @@ use het_bssrdf::het_estimate::{
     Averaging, CoefficientField, Coefficients, Estimator, KernelParams, SampleBudget,
     SegmentParams, SoneParams, SplitMix64, SurfaceQuery, UniformSource,
 };
-use het_bssrdf::tracer::field::{Field, MediumField, PlanarProjection};
+use het_bssrdf::het_estimate::{FieldBounds, PlanarEllipse};
+use het_bssrdf::tracer::field::{
+    Axis, Field, Filter, ImageMapping, MediumField, PlanarProjection, Texture, Wrap,
+};
 use het_bssrdf::tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, primitives};
 
 /// Sample counts benchmarked (per averaging stage: Sone uses N for the disk and N for the
@@ -215,6 +222,52 @@ fn print_std_table<S, F>(
     println!();
 }
 
+/// A tracer [`MediumField`] read on the analytic plane z = 0 (its planar projection along z
+/// sees the plane's points as they are), for the `plane-image` scene.
+struct PlaneMedium(MediumField);
+
+impl CoefficientField<PlanePoint> for PlaneMedium {
+    #[inline]
+    fn coefficients(&self, p: &PlanePoint) -> Coefficients {
+        self.0.at_point(DVec3::new(p.x, p.y, 0.0))
+    }
+    fn bounds(&self) -> Option<FieldBounds> {
+        Some(self.0.field_bounds())
+    }
+    fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
+        CoefficientField::<Hit>::ellipse_average(&self.0, e)
+    }
+    fn has_ellipse_average(&self) -> bool {
+        CoefficientField::<Hit>::has_ellipse_average(&self.0)
+    }
+}
+
+/// The `plane-image` field (see the module docs), its summed-area table already built.
+fn image_preset() -> PlaneMedium {
+    let n = 256u32;
+    let mut rng = SplitMix64::new(11);
+    let texels = (0..n * n)
+        .map(|_| std::array::from_fn(|_| (0.005 + 0.095 * rng.next_f64()) as f32))
+        .collect();
+    let tex = std::sync::Arc::new(Texture::from_texels("random", n, n, texels).expect("valid"));
+    tex.area_table();
+    let sigma_a = Field::image(
+        tex,
+        ImageMapping::Planar {
+            projection: PlanarProjection::new(Axis::Z, DVec3::ZERO),
+            size: [30.0, 30.0],
+        },
+        Wrap::Repeat,
+        Filter::Nearest,
+        Rgb::ONE,
+    )
+    .expect("valid image field");
+    PlaneMedium(MediumField::new(
+        sigma_a,
+        Field::constant(Rgb::ONE).expect("valid constant"),
+    ))
+}
+
 /// The BVH-mesh scene: sphere, stripe field, pairs of nearby surface points.
 fn mesh_scene() -> (Geometry, MediumField, Vec<(Hit, Hit)>) {
     let geometry = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 10.0, 6)]);
@@ -294,6 +347,8 @@ fn averaging(c: &mut Criterion) {
     bench_scene(c, "plane-check", &Plane, &check, &pairs);
     let constant = ConstantField(Coefficients::grey(0.05, 1.0));
     bench_scene(c, "plane-constant", &Plane, &constant, &pairs);
+    let image = image_preset();
+    bench_scene(c, "plane-image", &Plane, &image, &pairs);
     let (geometry, field, mesh_pairs) = mesh_scene();
     let surface = ObjectSurface::new(&geometry, 0);
     print_std_table("mesh-stripe", &surface, &field, &mesh_pairs[..64], 64);

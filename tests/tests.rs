@@ -2,6 +2,7 @@
 
 mod common;
 mod fuzz_regressions;
+mod image_prefilter;
 mod index_matched;
 mod integrators;
 mod precision;

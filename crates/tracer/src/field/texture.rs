@@ -10,6 +10,9 @@
 //! are those divided by the image size (`v_down` grows downward).
 
 use std::path::Path;
+use std::sync::OnceLock;
+
+use super::area_table::AreaTable;
 
 use crate::error::TextureError;
 
@@ -46,6 +49,28 @@ pub struct Texture {
     min: [f32; 3],
     max: [f32; 3],
     grey: bool,
+    area: LazyAreaTable,
+}
+
+/// The summed-area table, built on first use (see [`Texture::area_table`]). Equal and
+/// printed regardless of whether it was built: it is a cache of the texels.
+#[derive(Clone, Default)]
+struct LazyAreaTable(OnceLock<AreaTable>);
+
+impl PartialEq for LazyAreaTable {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for LazyAreaTable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if self.0.get().is_some() {
+            "built"
+        } else {
+            "not built"
+        })
+    }
 }
 
 impl Texture {
@@ -92,6 +117,7 @@ impl Texture {
             min,
             max,
             grey,
+            area: LazyAreaTable::default(),
         })
     }
 
@@ -212,6 +238,19 @@ impl Texture {
     /// True when every texel has equal channels.
     pub fn is_grey(&self) -> bool {
         self.grey
+    }
+
+    /// The texture's summed-area table ([`super::area_table`]), built on the first call (once,
+    /// thread-safe; later calls wait for or share it). Only prefiltered averaging calls this,
+    /// so textures read by other methods never pay for a table.
+    pub fn area_table(&self) -> &AreaTable {
+        self.area.0.get_or_init(|| AreaTable::build(self))
+    }
+
+    /// True once [`Texture::area_table`] has built the table (observability for tests and
+    /// tools: a texture no prefiltered average read has none).
+    pub fn has_area_table(&self) -> bool {
+        self.area.0.get().is_some()
     }
 
     /// The filtered value at normalised image coordinates `(u, v_down)` (see the module docs).
