@@ -13,7 +13,7 @@ use tracer::field::{Texture, Wrap};
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Rendered, render};
+use tracer::render::{Budget, RenderOptions, Rendered, Shard, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// A 16 × 16 texture of σa values in [0.005, 0.1] (per channel, fixed seed), spread over the
@@ -82,6 +82,7 @@ fn run(scene: &Scene, method: Method, seed: u64) -> Rendered<tracer::integrator:
         &RenderOptions {
             budget: Budget::Samples(2),
             seed,
+            shard: Shard::WHOLE,
         },
     )
 }
