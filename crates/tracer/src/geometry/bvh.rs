@@ -150,7 +150,7 @@ impl RayCounter {
 /// `1/x` for the BVH node test, finite and with the sign convention of obvhs's octant test
 /// (`x < 0` ⇔ negative inverse; `±0` → `+1e30`).
 #[inline]
-fn safe_inv(x: f32) -> f32 {
+pub(super) fn safe_inv(x: f32) -> f32 {
     if x == 0.0 {
         1e30
     } else {

@@ -24,7 +24,7 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray as BvhRay, RayHit};
 
-use super::bvh::{PaddedBox, build_cwbvh};
+use super::bvh::{PaddedBox, build_cwbvh, safe_inv};
 
 /// Target extent of the scene in the tree's scaled space: 2¹², as for objects.
 const SCALED_EXTENT_LOG2: i32 = 12;
@@ -75,16 +75,6 @@ fn round_f32(x: f64, down: bool) -> f32 {
         (true, v) if v > x => r.next_down(),
         (false, v) if v < x => r.next_up(),
         _ => r,
-    }
-}
-
-/// `1/x` as a finite `f32` (±1e30 for an axis-parallel ray), so that `0 · inv` is never NaN.
-#[inline]
-fn safe_inv(x: f32) -> f32 {
-    if x == 0.0 {
-        1e30
-    } else {
-        (1.0 / x).clamp(-1e30, 1e30)
     }
 }
 
