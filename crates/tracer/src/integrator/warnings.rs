@@ -104,7 +104,7 @@ fn hidden_cores(scene: &Scene) -> Vec<String> {
 }
 
 /// Objects whose thinnest side spans fewer diffusion lengths than this are reported by
-/// [`small_objects`].
+/// [`scene_warnings`].
 pub const SMALL_OBJECT_DIFFUSION_LENGTHS: f64 = 5.0;
 
 /// One warning per translucent object whose bounding box's thinnest side is shorter than
