@@ -144,6 +144,15 @@ impl Tlas {
             return;
         };
         let inv = DVec3::ONE / dir;
+        // One object (a medium alone, as in most validation scenes): its exact box is the
+        // whole tree, so skip the tree.
+        if let [object] = self.objects[..] {
+            let (lo, hi) = self.boxes[0];
+            if let Some(enter) = slab(lo, hi, origin, inv, t_min, t_max) {
+                visit(object, enter, t_max);
+            }
+            return;
+        }
         let Some(enter) = slab(self.lo, self.hi, origin, inv, t_min, t_max) else {
             return;
         };
