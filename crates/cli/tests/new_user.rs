@@ -513,3 +513,57 @@ fn small_translucent_objects_warn_with_bssrdf_methods() {
         );
     }
 }
+
+/// Every example scene the README points at loads and renders with the path tracer and with
+/// Sone (1 spp), to a finite image that is not black. The bunny is skipped when the shared
+/// assets it reads are not beside the repository.
+#[test]
+fn example_scenes_render() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let s = Scratch::new();
+    let mut rendered = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        if text.contains("shared/assets") && !dir.join("../../../shared/assets").is_dir() {
+            continue;
+        }
+        for method in ["pt", "sone"] {
+            let out = format!(
+                "{}-{method}.exr",
+                path.file_stem().unwrap().to_string_lossy()
+            );
+            let r = s.run(&[
+                "render",
+                path.to_str().unwrap(),
+                "--method",
+                method,
+                "--spp",
+                "1",
+                "--out",
+                &out,
+            ]);
+            assert_eq!(r.code, Some(0), "{}: {}", path.display(), r.stderr);
+            let json: serde_json::Value = serde_json::from_slice(
+                &std::fs::read(s.join(&out.replace(".exr", ".json"))).unwrap(),
+            )
+            .unwrap();
+            let mean: Vec<f64> = json["mean_rgb"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            assert!(
+                mean.iter().all(|m| m.is_finite()) && mean.iter().any(|&m| m > 0.0),
+                "{} {method}: mean {mean:?}",
+                path.display()
+            );
+        }
+        rendered += 1;
+    }
+    assert!(rendered >= 4, "only {rendered} example scenes rendered");
+}
