@@ -146,6 +146,31 @@ impl Ledger {
         self.save()
     }
 
+    /// Step `key` of the run: the earlier run's result when it may be reused
+    /// ([`Ledger::reuse`]), else `run()`'s, recorded. `progress` gets `label` before the work,
+    /// or `label (done earlier)` when nothing is run.
+    pub fn step<T, E>(
+        &mut self,
+        key: &str,
+        files: &[&Path],
+        progress: &mut dyn FnMut(&str),
+        label: &str,
+        run: impl FnOnce() -> Result<T, E>,
+    ) -> Result<T, E>
+    where
+        T: Serialize + DeserializeOwned,
+        E: From<WriteError>,
+    {
+        if let Some(done) = self.reuse(key, files)? {
+            progress(&format!("{label} (done earlier)"));
+            return Ok(done);
+        }
+        progress(label);
+        let value = run()?;
+        self.record(key, &value)?;
+        Ok(value)
+    }
+
     /// How many steps were reused, of how many asked about.
     pub fn reused(&self) -> (usize, usize) {
         (self.reused, self.steps)

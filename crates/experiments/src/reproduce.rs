@@ -262,33 +262,27 @@ pub fn reproduce(
                 let path = dir.join(format!("{name}.exr"));
                 let key = format!("beam/{preset}/{name}");
                 images.push(format!("![{name}](beam/{preset}/{name}.png)"));
-                if let Some(row) = ledger.reuse::<ErrorRow>(&key, &[&path])? {
-                    step(&format!(
-                        "beam {preset}: {est} with {profile} (done earlier)"
-                    ));
-                    rows.push(row);
-                    continue;
-                }
-                step(&format!("beam {preset}: {est} with {profile}"));
-                let map = run_method(
-                    &setup,
-                    method(est),
-                    profile,
-                    PhotonBudget::Count(1),
-                    scale.beam_subsamples,
-                    seed,
-                    &|_| {},
-                )?;
-                write_beam_map(&map, &setup, &path, serde_json::json!({"seed": seed}))?;
-                let metrics =
-                    compare(&map.values, &pt_values, 1, keep).map_err(StudyError::from)?;
-                let row = ErrorRow {
-                    experiment: format!("beam {preset}"),
-                    method: name,
-                    seconds: map.seconds,
-                    metrics,
-                };
-                ledger.record(&key, &row)?;
+                let label = format!("beam {preset}: {est} with {profile}");
+                let row = ledger.step(&key, &[&path], step, &label, || {
+                    let map = run_method(
+                        &setup,
+                        method(est),
+                        profile,
+                        PhotonBudget::Count(1),
+                        scale.beam_subsamples,
+                        seed,
+                        &|_| {},
+                    )?;
+                    write_beam_map(&map, &setup, &path, serde_json::json!({"seed": seed}))?;
+                    let metrics =
+                        compare(&map.values, &pt_values, 1, keep).map_err(StudyError::from)?;
+                    Ok::<_, ReproduceError>(ErrorRow {
+                        experiment: format!("beam {preset}"),
+                        method: name,
+                        seconds: map.seconds,
+                        metrics,
+                    })
+                })?;
                 rows.push(row);
             }
         }
@@ -350,28 +344,24 @@ pub fn reproduce(
         let path = slab_dir.join(format!("{name}.exr"));
         let key = format!("slab/{name}");
         slab_images.push(format!("![{name}](slab/{name}.png)"));
-        if let Some(row) = ledger.reuse::<ErrorRow>(&key, &[&path])? {
-            step(&format!("checker slab: {name} (done earlier)"));
-            rows.push(row);
-            continue;
-        }
-        step(&format!("checker slab: {name} at {} spp", scale.slab_spp));
-        let job = RenderJob {
-            method: method(name),
-            budget: Budget::Samples(scale.slab_spp),
-            ..base.clone()
-        };
-        let outcome = render_scene(&scene, &job).map_err(StudyError::from)?;
-        write_render(&outcome, &scene, &job, &path, 0.0)?;
-        let metrics =
-            compare_films(&outcome.film, &reference_film, None).map_err(StudyError::from)?;
-        let row = ErrorRow {
-            experiment: "checker slab".into(),
-            method: name.into(),
-            seconds: outcome.seconds,
-            metrics,
-        };
-        ledger.record(&key, &row)?;
+        let label = format!("checker slab: {name} at {} spp", scale.slab_spp);
+        let row = ledger.step(&key, &[&path], step, &label, || {
+            let job = RenderJob {
+                method: method(name),
+                budget: Budget::Samples(scale.slab_spp),
+                ..base.clone()
+            };
+            let outcome = render_scene(&scene, &job).map_err(StudyError::from)?;
+            write_render(&outcome, &scene, &job, &path, 0.0)?;
+            let metrics =
+                compare_films(&outcome.film, &reference_film, None).map_err(StudyError::from)?;
+            Ok::<_, ReproduceError>(ErrorRow {
+                experiment: "checker slab".into(),
+                method: name.into(),
+                seconds: outcome.seconds,
+                metrics,
+            })
+        })?;
         rows.push(row);
     }
     let _ = writeln!(
@@ -389,69 +379,67 @@ pub fn reproduce(
     let methods: Vec<Method> = CONVERGE_METHODS.iter().map(|m| method(m)).collect();
     let dir = out.join("converge-slab");
     mkdir(&dir)?;
-    let key = "converge-slab";
-    let slab_summary = if let Some(s) =
-        ledger.reuse::<Vec<MethodSummary>>(key, &[&dir.join("convergence.csv")])?
-    {
-        step("convergence study: checker slab (done earlier)");
-        s
-    } else {
-        step("convergence study: checker slab");
-        let spp: Vec<u32> = std::iter::successors(Some(1u32), |s| Some(s * 2))
-            .take_while(|&s| s <= scale.converge_max_spp)
-            .collect();
-        let slab_runs = scene_study(&scene, &base, &methods, &spp, &reference_film, |_, _| {})?;
-        let slab_summary = summarize(&slab_runs);
-        write_outputs(
-            &dir,
-            "checker slab — error against time",
-            &slab_runs,
-            &slab_summary,
-            serde_json::json!({"reference_spp": scale.slab_reference_spp}),
-        )?;
-        ledger.record(key, &slab_summary)?;
-        slab_summary
-    };
+    let csv = dir.join("convergence.csv");
+    let slab_summary = ledger.step(
+        "converge-slab",
+        &[&csv],
+        step,
+        "convergence study: checker slab",
+        || {
+            let spp: Vec<u32> = std::iter::successors(Some(1u32), |s| Some(s * 2))
+                .take_while(|&s| s <= scale.converge_max_spp)
+                .collect();
+            let slab_runs = scene_study(&scene, &base, &methods, &spp, &reference_film, |_, _| {})?;
+            let slab_summary = summarize(&slab_runs);
+            write_outputs(
+                &dir,
+                "checker slab — error against time",
+                &slab_runs,
+                &slab_summary,
+                serde_json::json!({"reference_spp": scale.slab_reference_spp}),
+            )?;
+            Ok::<_, ReproduceError>(slab_summary)
+        },
+    )?;
     let (setup, pt_values) = stripe_reference.expect("the stripe preset ran");
     let dir = out.join("converge-beam-stripe");
     mkdir(&dir)?;
-    let key = "converge-beam-stripe";
-    let beam_summary = if let Some(s) =
-        ledger.reuse::<Vec<MethodSummary>>(key, &[&dir.join("convergence.csv")])?
-    {
-        step("convergence study: beam, stripe preset (done earlier)");
-        s
-    } else {
-        step("convergence study: beam, stripe preset");
-        let budgets = BeamBudgets {
-            photons: std::iter::successors(Some(1u64 << 16), |p| Some(p * 2))
-                .take_while(|&p| p <= scale.converge_max_photons.max(1 << 16))
-                .collect(),
-            subsamples: std::iter::successors(Some(1u32), |k| Some(k * 2))
-                .take_while(|&k| k <= scale.converge_max_subsamples)
-                .collect(),
-        };
-        let beam_runs = beam_study(
-            &setup,
-            &methods,
-            ProfileModel::Dipole,
-            &budgets,
-            seed,
-            &pt_values,
-            1.0,
-            |_, _| {},
-        )?;
-        let beam_summary = summarize(&beam_runs);
-        write_outputs(
-            &dir,
-            "beam (stripe) — error against time",
-            &beam_runs,
-            &beam_summary,
-            serde_json::json!({"setup": setup, "min_radius": 1.0}),
-        )?;
-        ledger.record(key, &beam_summary)?;
-        beam_summary
-    };
+    let csv = dir.join("convergence.csv");
+    let beam_summary = ledger.step(
+        "converge-beam-stripe",
+        &[&csv],
+        step,
+        "convergence study: beam, stripe preset",
+        || {
+            let budgets = BeamBudgets {
+                photons: std::iter::successors(Some(1u64 << 16), |p| Some(p * 2))
+                    .take_while(|&p| p <= scale.converge_max_photons.max(1 << 16))
+                    .collect(),
+                subsamples: std::iter::successors(Some(1u32), |k| Some(k * 2))
+                    .take_while(|&k| k <= scale.converge_max_subsamples)
+                    .collect(),
+            };
+            let beam_runs = beam_study(
+                &setup,
+                &methods,
+                ProfileModel::Dipole,
+                &budgets,
+                seed,
+                &pt_values,
+                1.0,
+                |_, _| {},
+            )?;
+            let beam_summary = summarize(&beam_runs);
+            write_outputs(
+                &dir,
+                "beam (stripe) — error against time",
+                &beam_runs,
+                &beam_summary,
+                serde_json::json!({"setup": setup, "min_radius": 1.0}),
+            )?;
+            Ok::<_, ReproduceError>(beam_summary)
+        },
+    )?;
     let _ = writeln!(
         report,
         "## Error against time\n\nEach method at doubling budgets against the references above \
