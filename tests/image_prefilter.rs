@@ -4,17 +4,19 @@
 
 use std::sync::Arc;
 
-use bssrdf_core::{Rgb, Scattering};
+use bssrdf_core::Rgb;
 use glam::DVec3;
 use het_estimate::Averaging;
 use tracer::camera::Camera;
 use tracer::field::{Axis, Field, Filter, ImageMapping, MediumField, PlanarProjection};
 use tracer::field::{Texture, Wrap};
 use tracer::geometry::primitives;
-use tracer::integrator::{Method, PathIntegrator, PathOptions};
+use tracer::integrator::Method;
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Rendered, Shard, render};
+use tracer::render::Rendered;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+
+use crate::common::harness::{render_multiple, sone};
 
 /// A 16 × 16 texture of σa values in [0.005, 0.1] (per channel, fixed seed), spread over the
 /// 20 × 20 region the camera sees.
@@ -66,33 +68,7 @@ fn image_scene(filter: Filter) -> (Scene, Arc<Texture>) {
 }
 
 fn run(scene: &Scene, method: Method, seed: u64) -> Rendered<tracer::integrator::PathCounters> {
-    let integrator = PathIntegrator::new(
-        scene,
-        method,
-        PathOptions {
-            scattering: Scattering::Multiple,
-            max_depth: 8,
-        },
-    )
-    .unwrap();
-    render(
-        32,
-        32,
-        &integrator,
-        &RenderOptions {
-            budget: Budget::Samples(2),
-            seed,
-            shard: Shard::WHOLE,
-        },
-    )
-}
-
-fn sone(samples: u32, averaging: Averaging) -> Method {
-    "sone"
-        .parse::<Method>()
-        .unwrap()
-        .with_estimator_samples(Some(samples))
-        .with_averaging(Some(averaging))
+    render_multiple(scene, method, 32, 2, seed)
 }
 
 /// Relative L2 distance over all three channels.

@@ -15,6 +15,7 @@ use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
 use crate::common::half_space::{half_space_scene, half_space_scene_with, mean_and_se};
+use crate::common::harness::{render_multiple, sone};
 
 #[test]
 fn path_tracer_emergent_radiance_matches_chandrasekhar() {
@@ -153,32 +154,7 @@ fn prefiltered_and_monte_carlo_renders_agree_on_the_checker_slab() {
     .unwrap()
     .with_resolution(32, 32)
     .unwrap();
-    let run = |averaging: Averaging| {
-        let method = "sone"
-            .parse::<Method>()
-            .unwrap()
-            .with_estimator_samples(Some(64))
-            .with_averaging(Some(averaging));
-        let integrator = PathIntegrator::new(
-            &scene,
-            method,
-            PathOptions {
-                scattering: Scattering::Multiple,
-                max_depth: 8,
-            },
-        )
-        .unwrap();
-        render(
-            32,
-            32,
-            &integrator,
-            &RenderOptions {
-                budget: Budget::Samples(2),
-                seed: 9,
-                shard: Shard::WHOLE,
-            },
-        )
-    };
+    let run = |averaging: Averaging| render_multiple(&scene, sone(64, averaging), 32, 2, 9);
     let (pre, mc) = (run(Averaging::Prefiltered), run(Averaging::MonteCarlo));
     let (mut diff, mut norm) = (0.0, 0.0);
     for (a, b) in pre.pixels.iter().zip(&mc.pixels) {

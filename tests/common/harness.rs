@@ -1,0 +1,46 @@
+//! Test harness, not a reference: the render calls several test modules share.
+
+use bssrdf_core::Scattering;
+use het_estimate::Averaging;
+use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions};
+use tracer::render::{Budget, RenderOptions, Rendered, Shard, render};
+use tracer::scene::Scene;
+
+/// `method` on `scene` at `n × n` pixels, `spp` samples per pixel and `seed`, multiple
+/// scattering, at most 8 surface interactions, the whole image.
+pub fn render_multiple(
+    scene: &Scene,
+    method: Method,
+    n: u32,
+    spp: u32,
+    seed: u64,
+) -> Rendered<PathCounters> {
+    let integrator = PathIntegrator::new(
+        scene,
+        method,
+        PathOptions {
+            scattering: Scattering::Multiple,
+            max_depth: 8,
+        },
+    )
+    .unwrap();
+    render(
+        n,
+        n,
+        &integrator,
+        &RenderOptions {
+            budget: Budget::Samples(spp),
+            seed,
+            shard: Shard::WHOLE,
+        },
+    )
+}
+
+/// Sone with `samples` per averaging stage and the given averaging.
+pub fn sone(samples: u32, averaging: Averaging) -> Method {
+    "sone"
+        .parse::<Method>()
+        .unwrap()
+        .with_estimator_samples(Some(samples))
+        .with_averaging(Some(averaging))
+}
