@@ -474,6 +474,18 @@ mod tests {
         }
     }
 
+    /// Mean and standard error of the mean of `n` draws of `draw`.
+    fn mean_se(n: usize, mut draw: impl FnMut() -> f64) -> (f64, f64) {
+        let (mut s, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let w = draw();
+            s += w;
+            s2 += w * w;
+        }
+        let mean = s / n as f64;
+        (mean, ((s2 / n as f64 - mean * mean) / n as f64).sqrt())
+    }
+
     /// `E[Σ_hits f/p] = ∫ f dA` over the surface inside the largest probe sphere (radius R),
     /// here for `f = e^{−|x − x_o|/ℓ}` on a slab of thickness h < R, with closed forms
     /// `2πℓ²[1 − (1 + R/ℓ)e^{−R/ℓ}]` on the top face and `2πℓ²[(1 + h/ℓ)e^{−h/ℓ} −
@@ -497,18 +509,12 @@ mod tests {
         let x_o = P(DVec3::ZERO, DVec3::Z);
         let mut rng = SplitMix64::new(11);
         let n = 200_000;
-        let (mut s, mut s2) = (0.0, 0.0);
-        for _ in 0..n {
-            let set = probe(&Slab(h), &x_o, c, &sampler, &mut rng);
-            let w: f64 = set
+        let (mean, se) = mean_se(n, || {
+            probe(&Slab(h), &x_o, c, &sampler, &mut rng)
                 .iter()
                 .map(|hit| (-hit.hit.position().length() / ell).exp() * hit.weight)
-                .sum();
-            s += w;
-            s2 += w * w;
-        }
-        let mean = s / n as f64;
-        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+                .sum()
+        });
         assert!(
             (mean - want).abs() < 4.0 * se,
             "{mean} ± {se}, integral {want}"
@@ -535,17 +541,12 @@ mod tests {
         let x_o = P(DVec3::ZERO, DVec3::Z);
         let mut rng = SplitMix64::new(5);
         let n = 100_000;
-        let (mut s, mut s2) = (0.0, 0.0);
-        for _ in 0..n {
-            let w: f64 = probe(&Slab(1e9), &x_o, dark, &sampler, &mut rng)
+        let (mean, se) = mean_se(n, || {
+            probe(&Slab(1e9), &x_o, dark, &sampler, &mut rng)
                 .iter()
                 .map(|h| profile.eval(h.hit.position().length()) * h.weight)
-                .sum();
-            s += w;
-            s2 += w * w;
-        }
-        let mean = s / n as f64;
-        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+                .sum()
+        });
         // 4 SE, plus 0.2 % for the table's piecewise-linear approximation of the profile.
         assert!(
             (mean - want).abs() < 4.0 * se + 2e-3 * want,
