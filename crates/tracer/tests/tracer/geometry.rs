@@ -362,7 +362,7 @@ fn empty_and_tiny_objects() {
 /// Many objects of mixed sizes (600 boxes and spheres from 1e-3 to 1 across, touching and
 /// overlapping, plus one 200-wide floor), optionally far from the origin: the top-level tree
 /// must give the brute-force closest hit and occlusion, for rays starting inside the cluster
-/// and for rays from 1e4 away.
+/// and for rays from 1e4 and 1e8 away.
 #[test]
 fn many_objects_match_brute_force() {
     for offset in [DVec3::ZERO, DVec3::new(1e6, -3e5, 2e5)] {
@@ -385,10 +385,14 @@ fn many_objects_match_brute_force() {
         for i in 0..4000 {
             let target =
                 offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0 - 2.0;
-            let o = if i % 2 == 0 {
-                offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 5.0 - 2.5
-            } else {
-                target + 1e4 * random_dir(&mut rng)
+            // Inside the cluster, or from far away (1e4 and 1e8: the top-level tree must move
+            // a far origin toward the scene before its f32 test).
+            let o = match i % 4 {
+                0 | 2 => {
+                    offset + DVec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 5.0 - 2.5
+                }
+                1 => target + 1e4 * random_dir(&mut rng),
+                _ => target + 1e8 * random_dir(&mut rng),
             };
             let ray = Ray::new(o, (target - o).normalize());
             let fast = g.intersect(&ray).map(|h| (h.object, h.prim, h.t));
