@@ -27,7 +27,9 @@ pub struct PathCounters {
     pub leaks: u64,
     /// Boundary hits seen from the wrong side inside a medium (numerical), stepped over.
     pub wrong_side: u64,
-    /// BSSRDF probe rays that found no incident point.
+    /// BSSRDF shading points that traced probes (the denominator of `probe_misses`).
+    pub probe_sets: u64,
+    /// BSSRDF shading points whose probes found no incident point.
     pub probe_misses: u64,
     /// BSSRDF parameter estimates made.
     pub estimates: u64,
@@ -113,6 +115,7 @@ impl Counters for PathCounters {
         self.capped += o.capped;
         self.leaks += o.leaks;
         self.wrong_side += o.wrong_side;
+        self.probe_sets += o.probe_sets;
         self.probe_misses += o.probe_misses;
         self.estimates += o.estimates;
         self.estimator_samples += o.estimator_samples;

@@ -918,6 +918,7 @@ impl<'s> PathIntegrator<'s> {
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
         let set = probe(self.scene.geometry(), object, hit, at_xo, &b.sampler, rng);
+        counters.probe_sets += 1;
         if set.is_empty() {
             counters.probe_misses += 1;
             return Step::Stop;
