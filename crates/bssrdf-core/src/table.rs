@@ -291,6 +291,32 @@ impl ProfileTable {
         self.row_c(i)[j] / self.z[i]
     }
 
+    /// The CDF of the mixture `Σ w_k row_k` (weights sum to 1) at optical radius `x ≥ 0`:
+    /// the trapezoid cumulative to the cell, the linear density's area within it, and the
+    /// exponential tail beyond the last radius.
+    fn mixture_cdf(&self, rows: [(usize, f64); 2], x: f64) -> f64 {
+        let mut f = 0.0;
+        for (i, w) in rows {
+            if w <= 0.0 {
+                continue;
+            }
+            let (p, z) = (self.row_p(i), self.z[i]);
+            let row = if x >= XLAST {
+                let last = self.row_cdf_node(i, COLS - 1);
+                let tail = p[COLS - 1] * XLAST / z;
+                last + tail * (-(-(x - XLAST) / XLAST).exp_m1())
+            } else {
+                let j = self.cell(x);
+                let (x0, x1) = (self.x[j], self.x[j + 1]);
+                let tau = (x - x0).clamp(0.0, x1 - x0);
+                let slope = (p[j + 1] - p[j]) / (x1 - x0);
+                self.row_cdf_node(i, j) + (p[j] * tau + 0.5 * slope * tau * tau) / z
+            };
+            f += w * row;
+        }
+        f.clamp(0.0, 1.0)
+    }
+
     /// Inverts the CDF of the mixture `Σ w_k row_k` (weights sum to 1) at `f`.
     fn invert_mixture(&self, rows: [(usize, f64); 2], f: f64) -> f64 {
         let cdf = |j: usize| -> f64 {
@@ -379,6 +405,20 @@ impl TableSampler<'_> {
     fn rows(&self) -> [(usize, f64); 2] {
         [(self.row, 1.0 - self.t), (self.row + 1, self.t)]
     }
+
+    /// The sampling density's cumulative distribution at radius `r` (length): the fraction
+    /// of [`RadialProfile::sample_r`]'s draws below `r`, the exact integral of
+    /// [`RadialProfile::pdf_r`] over `[0, r]` (in `[0, 1]`; 0 for the zero profile and for
+    /// `r ≤ 0` or NaN, 1 at `r = ∞`). The inverse of [`RadialProfile::radius_for_fraction`].
+    pub fn fraction_within(&self, r: f64) -> f64 {
+        if self.is_zero() || r.is_nan() || r <= 0.0 {
+            return 0.0;
+        }
+        if r == f64::INFINITY {
+            return 1.0;
+        }
+        self.table.mixture_cdf(self.rows(), optical(r, self.scale))
+    }
 }
 
 impl RadialProfile for TableSampler<'_> {
@@ -427,6 +467,47 @@ impl RadialProfile for TableSampler<'_> {
 mod tests {
     use super::*;
     use crate::{ProfileModel, Scattering};
+
+    /// `fraction_within` inverts `radius_for_fraction` and integrates `pdf_r` (midpoint rule
+    /// on a fine geometric grid, independent of the table's own cumulative).
+    #[test]
+    fn fraction_within_is_the_cdf_of_the_sampling_density() {
+        for model in [ProfileModel::Dipole, ProfileModel::Tabulated] {
+            let family = ProfileFamily::new(model, Scattering::Multiple, 0.0, 1.3).unwrap();
+            let t = ProfileTable::new(family);
+            for (a, s) in [(0.1, 0.9), (0.01, 0.99), (1e-4, 2.0), (0.3, 1e3)] {
+                let sm = t.sampler(a, s).unwrap();
+                for f in [0.01, 0.3, 0.7, 0.99, 0.999] {
+                    let r = sm.radius_for_fraction(f);
+                    let got = sm.fraction_within(r);
+                    assert!((got - f).abs() < 1e-9, "{model:?} ({a}, {s}) f {f}: {got}");
+                }
+                let r_end = sm.radius_for_fraction(0.9);
+                let n = 200_000;
+                let (lo, hi) = (1e-9 * r_end, r_end);
+                let q = (hi / lo).powf(1.0 / n as f64);
+                let mut integral = 0.0;
+                let mut x = lo;
+                for _ in 0..n {
+                    let x1 = x * q;
+                    integral += sm.pdf_r(0.5 * (x + x1)) * (x1 - x);
+                    x = x1;
+                }
+                integral += sm.fraction_within(lo);
+                assert!(
+                    (integral - 0.9).abs() < 1e-4,
+                    "{model:?} ({a}, {s}): {integral}"
+                );
+            }
+            let zero = t.sampler(0.0, 0.0).unwrap();
+            assert_eq!(zero.fraction_within(1.0), 0.0);
+            let sm = t.sampler(0.1, 1.0).unwrap();
+            assert_eq!(sm.fraction_within(0.0), 0.0);
+            assert_eq!(sm.fraction_within(f64::NAN), 0.0);
+            assert_eq!(sm.fraction_within(f64::INFINITY), 1.0);
+            assert!(sm.fraction_within(1e300) <= 1.0);
+        }
+    }
 
     /// The cell found from the approximate logarithm is the one a linear search finds, at
     /// random radii and on and next to every grid node.

@@ -35,7 +35,7 @@ use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
-use crate::integrator::probe::{ProbeSampler, probe};
+use crate::integrator::probe::{ProbeSampler, probe_within};
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
@@ -88,6 +88,9 @@ struct BssrdfObject {
     estimator: PreparedEstimator,
     /// c = 1 − 2·C1(1/η), the normalisation of pbrt-v4's `NormalizedFresnelBxDF` S_w.
     sw_norm: f64,
+    /// The longest side of the object's bounding box: the extent the probe radii are drawn
+    /// within ([`super::probe::probe_within`]).
+    extent: f64,
 }
 
 /// Per-object data prepared once per render.
@@ -353,7 +356,7 @@ impl<'s> PathIntegrator<'s> {
             scene.require_path_traceable()?;
         }
         let mut objects = Vec::with_capacity(scene.objects().len());
-        for object in scene.objects() {
+        for (index, object) in scene.objects().iter().enumerate() {
             objects.push(match &object.material {
                 Material::Translucent(t) => {
                     let bssrdf = match method {
@@ -364,11 +367,13 @@ impl<'s> PathIntegrator<'s> {
                                 .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
                             let sw_norm =
                                 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / t.eta);
+                            let (lo, hi) = scene.geometry().object_bounds(index as u32);
                             Some(Box::new(BssrdfObject {
                                 sampler: ProbeSampler::new(family, &t.medium),
                                 family,
                                 estimator,
                                 sw_norm,
+                                extent: (hi - lo).max_element(),
                             }))
                         }
                     };
@@ -917,7 +922,15 @@ impl<'s> PathIntegrator<'s> {
         }
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
-        let set = probe(self.scene.geometry(), object, hit, at_xo, &b.sampler, rng);
+        let set = probe_within(
+            self.scene.geometry(),
+            object,
+            hit,
+            at_xo,
+            &b.sampler,
+            b.extent,
+            rng,
+        );
         counters.probe_sets += 1;
         if set.is_empty() {
             counters.probe_misses += 1;

@@ -56,11 +56,35 @@ pub fn probe(
     sampler: &ProbeSampler,
     rng: &mut Rng,
 ) -> ProbeSet {
+    probe_within(geometry, object, x_o, coeffs, sampler, f64::INFINITY, rng)
+}
+
+/// [`probe`] with the probe radius at most `max_radius` ([`het_estimate::probe::probe_within`]).
+pub fn probe_within(
+    geometry: &Geometry,
+    object: u32,
+    x_o: &Hit,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    max_radius: f64,
+    rng: &mut Rng,
+) -> ProbeSet {
     let surface = ObjectSurface { geometry, object };
-    lib::probe(&surface, x_o, coeffs, &sampler.0, rng)
+    lib::probe_within(&surface, x_o, coeffs, &sampler.0, max_radius, rng)
 }
 
 /// The density `p(x)` (1/length²) with which [`probe`] around `x_o` finds `x_i`.
 pub fn probe_density(x_o: &Hit, coeffs: Coefficients, sampler: &ProbeSampler, x_i: &Hit) -> f64 {
     lib::probe_density(x_o, coeffs, &sampler.0, x_i)
+}
+
+/// The density with which [`probe_within`] (radius at most `max_radius`) finds `x_i`.
+pub fn probe_density_within(
+    x_o: &Hit,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    max_radius: f64,
+    x_i: &Hit,
+) -> f64 {
+    lib::probe_density_within(x_o, coeffs, &sampler.0, max_radius, x_i)
 }
