@@ -4,3 +4,4 @@
 pub mod chandrasekhar;
 pub mod half_space;
 pub mod harness;
+pub mod shapes;

@@ -34,13 +34,15 @@ pub enum Shape {
     Sphere(f64),
     /// The corner of a 10-mfp cube seen along its diagonal, over a 2 × 2 window about it.
     BoxCorner,
-    /// The Stanford bunny of `examples/scenes/bunny.toml` (about 9 mfp tall), seen whole from
+    /// (Used by `examples/shapes.rs` only.) The Stanford bunny of `examples/scenes/bunny.toml` (about 9 mfp tall), seen whole from
     /// the side.
+    #[allow(dead_code)]
     Bunny,
 }
 
 impl Shape {
-    /// The shapes of the table, in its order.
+    /// The shapes of the table, in its order (`examples/shapes.rs`).
+    #[allow(dead_code)]
     pub const TABLE: [Shape; 6] = [
         Shape::Slab(0.5),
         Shape::Slab(2.0),
@@ -131,7 +133,8 @@ pub struct Medium {
 }
 
 impl Medium {
-    /// The four g = 0 columns.
+    /// The four g = 0 columns (`examples/shapes.rs`).
+    #[allow(dead_code)]
     pub const COLUMNS: [Medium; 4] = [
         Medium::new(0.9, 1.0),
         Medium::new(0.99, 1.0),
@@ -215,7 +218,8 @@ pub fn outside_light(scene: &Scene, eta: f64, k: u32) -> f64 {
 pub struct Sample {
     /// Image mean minus [`outside_light`].
     pub through: f64,
-    /// Probe misses / probe sets.
+    /// Probe misses / probe sets (`examples/shapes.rs`).
+    #[allow(dead_code)]
     pub miss_fraction: f64,
 }
 

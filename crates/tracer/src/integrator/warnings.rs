@@ -103,49 +103,167 @@ fn hidden_cores(scene: &Scene) -> Vec<String> {
         .collect()
 }
 
-/// Objects whose thinnest side spans fewer diffusion lengths than this are reported by
-/// [`scene_warnings`].
+/// Objects whose thinnest side spans fewer diffusion lengths (or transport mean free paths,
+/// whichever is longer) than this are reported by [`scene_warnings`].
 pub const SMALL_OBJECT_DIFFUSION_LENGTHS: f64 = 5.0;
 
+/// Camera samples per side of the grid that measures an object's share of the image.
+const SHARE_GRID: u32 = 128;
+
 /// One warning per translucent object whose bounding box's thinnest side is shorter than
-/// [`SMALL_OBJECT_DIFFUSION_LENGTHS`] diffusion lengths 1/σtr of its most translucent part
-/// (σtr = √(3σa(σa + (1 − g)σs)) at the field's smallest σa, any channel). Every BSSRDF profile
-/// here is a half-space profile: on such an object light that leaves through other faces, or
-/// that a small curved body never returns, is not modelled (measured on the bunny: 16 % darker
-/// than the path tracer with the exact profile; docs/physics.md#hazards).
+/// [`SMALL_OBJECT_DIFFUSION_LENGTHS`] times the longer of the diffusion length 1/σtr and the
+/// transport mean free path 1/σt' of its most translucent part (σt' = σa + (1 − g)σs, σtr =
+/// √(3σa σt'), at the field's smallest σa and σt', any channel), with the share of the image's
+/// pixels that see the object. Every BSSRDF profile here is a half-space profile: on such an
+/// object light that leaves through other faces, or that a small curved body never returns,
+/// is not modelled. Measured against the path tracer (docs/shapes.md, `examples/shapes.rs`):
+/// slabs of 0.5 and 2 mfp render ×2.2 to ×6.7 and ×0.85 to ×1.47 too bright, a sphere of
+/// radius 1 mfp ×0.40 to ×0.95; at g = 0.8 sizes in transport mean free paths are 5× smaller
+/// and the errors grow (docs/physics.md#hazards).
 fn small_objects(scene: &Scene) -> Vec<String> {
     let mut warnings = Vec::new();
     for (i, t) in scene.translucent_objects() {
         let (lo, hi) = scene.geometry().object_bounds(i);
         let thinnest = (hi - lo).min_element();
         let b = t.medium.field_bounds();
-        let longest = (0..3)
-            .filter_map(|c| {
-                let (a, s) = (b.min.sigma_a[c], b.max.sigma_s[c] * (1.0 - t.g));
-                let sigma_tr = (3.0 * a * (a + s)).sqrt();
-                (sigma_tr > 0.0).then_some(1.0 / sigma_tr)
+        // The longest length over the channels, and whether it is the diffusion length.
+        let (longest, diffusive) = (0..3)
+            .map(|c| {
+                let (a, s) = (b.min.sigma_a[c], b.min.sigma_s[c] * (1.0 - t.g));
+                let sigma_tp = a + s;
+                let sigma_tr = (3.0 * a * sigma_tp).sqrt();
+                let diffusion = if sigma_tr > 0.0 { 1.0 / sigma_tr } else { 0.0 };
+                let transport = if sigma_tp > 0.0 { 1.0 / sigma_tp } else { 0.0 };
+                if sigma_tp > 0.0 && sigma_tr == 0.0 {
+                    (f64::INFINITY, true)
+                } else {
+                    (diffusion.max(transport), diffusion >= transport)
+                }
             })
-            .fold(0.0, f64::max);
-        let longest = if longest > 0.0 {
-            longest
-        } else {
-            f64::INFINITY
-        };
-        if thinnest.is_finite() && thinnest < SMALL_OBJECT_DIFFUSION_LENGTHS * longest {
+            .fold((0.0, true), |acc, x| if x.0 > acc.0 { x } else { acc });
+        if longest > 0.0
+            && thinnest.is_finite()
+            && thinnest < SMALL_OBJECT_DIFFUSION_LENGTHS * longest
+        {
+            let share = 100.0 * image_share(scene, i);
+            let (unit, symbol) = if diffusive {
+                ("diffusion lengths", "1/σtr")
+            } else {
+                ("transport mean free paths", "1/σt'")
+            };
+            let value = if longest.is_finite() {
+                format!("{longest:.3}")
+            } else {
+                "∞".to_string()
+            };
             warnings.push(format!(
-                "translucent object `{}` is {thinnest:.3} across its thinnest side, {:.2} \
-                 diffusion lengths of its most translucent part (1/σtr = {}): BSSRDF profiles \
-                 assume a half-space, so light leaving through other faces, or never returning \
-                 from a small curved part, is not modelled; compare with `--method pt`",
+                "translucent object `{}` ({share:.1} % of the image's pixels) is {thinnest:.3} \
+                 across its thinnest side, {:.2} {unit} of its most translucent part \
+                 ({symbol} = {value}, g = {}): BSSRDF profiles assume a half-space, so light \
+                 leaving through other faces, or never returning from a small curved part, is \
+                 not modelled, and those pixels can be several times too bright (thin parts) \
+                 or too dark (small bodies); compare with `--method pt`",
                 scene.objects()[i as usize].name,
                 thinnest / longest,
-                if longest.is_finite() {
-                    format!("{longest:.3}")
-                } else {
-                    "∞".to_string()
-                }
+                t.g
             ));
         }
     }
     warnings
+}
+
+/// The fraction of the image's pixels whose camera ray first hits `object`, from a grid of at
+/// most [`SHARE_GRID`]² pixel centres spread evenly over the image.
+fn image_share(scene: &Scene, object: u32) -> f64 {
+    let camera = scene.camera();
+    let (w, h) = camera.resolution();
+    let (nx, ny) = (w.min(SHARE_GRID), h.min(SHARE_GRID));
+    let mut seen = 0u32;
+    for j in 0..ny {
+        for i in 0..nx {
+            let px = ((i as f64 + 0.5) * w as f64 / nx as f64).floor() + 0.5;
+            let py = ((j as f64 + 0.5) * h as f64 / ny as f64).floor() + 0.5;
+            let ray = camera.ray(px, py);
+            if scene
+                .geometry()
+                .intersect(&ray)
+                .is_some_and(|hit| hit.object == object)
+            {
+                seen += 1;
+            }
+        }
+    }
+    f64::from(seen) / f64::from(nx * ny)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::field::MediumField;
+    use crate::geometry::primitives;
+    use crate::scene::{Material, RenderSettings, SceneBuilder, Translucent};
+    use bssrdf_core::Rgb;
+    use glam::DVec3;
+    use het_estimate::Coefficients;
+
+    /// A sphere of radius 1.5 (σa = σs = 1) seen whole by a 64 × 64 orthographic view 4.4
+    /// wide: it covers π·1.5²/4.4² = 36.5 % of the image.
+    fn sphere_scene(g: f64) -> Scene {
+        let camera = Camera::orthographic(
+            DVec3::new(0.0, 0.0, 5.0),
+            DVec3::NEG_Z,
+            DVec3::Y,
+            4.4,
+            4.4,
+            64,
+            64,
+        )
+        .unwrap();
+        let medium = MediumField::homogeneous(Coefficients::grey(1.0, 1.0)).unwrap();
+        SceneBuilder::new(RenderSettings::new(64, 64, 1), camera)
+            .light(Light::environment(Rgb::ONE).unwrap())
+            .object(
+                "ball",
+                primitives::icosphere(DVec3::ZERO, 1.5, 3),
+                Material::Translucent(Translucent::new("m", medium, g, 1.0)),
+            )
+            .build()
+            .unwrap()
+    }
+
+    /// At g = 0 the ball (3 across) is 6 transport mean free paths (1/σt' = 0.5) and 7.3
+    /// diffusion lengths thick: no warning. At g = 0.8 the transport mean free path is
+    /// 1/1.2 = 0.833, longer than the diffusion length 1/√3.6 = 0.527, and the ball is 3.6 of
+    /// them: the warning says so, with the ball's share of the image.
+    #[test]
+    fn small_object_warning_covers_forward_scattering_and_gives_the_image_share() {
+        let method: Method = "sone".parse().unwrap();
+        let small = |w: &String| w.contains("half-space");
+        assert!(!scene_warnings(&sphere_scene(0.0), method).iter().any(small));
+        let warnings = scene_warnings(&sphere_scene(0.8), method);
+        let w = warnings
+            .iter()
+            .find(|w| small(w))
+            .expect("a small-object warning");
+        assert!(
+            w.contains("transport mean free paths") && w.contains("1/σt' = 0.833"),
+            "{w}"
+        );
+        let share: f64 = w
+            .split("`ball` (")
+            .nth(1)
+            .and_then(|s| s.split(" %").next())
+            .and_then(|s| s.parse().ok())
+            .expect("a share");
+        let want = 100.0 * std::f64::consts::PI * 1.5 * 1.5 / (4.4 * 4.4);
+        // One pixel row of the disk's rim is 2πr/(4.4/64) ≈ 137 pixels of 4096 (3.3 %).
+        assert!((share - want).abs() < 2.0, "share {share} %, disk {want} %");
+        // The path tracer is not warned.
+        assert!(
+            !scene_warnings(&sphere_scene(0.8), Method::PathTraced)
+                .iter()
+                .any(small)
+        );
+    }
 }

@@ -1,0 +1,147 @@
+//! The BSSRDF renderer against the path tracer beyond half-spaces (issue 18): slabs, spheres
+//! and a box corner, homogeneous, g = 0, multiple scattering, uniform environment light,
+//! orthographic view, tabulated profile (`tests/common/shapes.rs` has the set-up;
+//! `examples/shapes.rs` prints the whole table with more samples).
+//!
+//! Each case is the double ratio q = (BSSRDF/PT on the shape) / (BSSRDF/PT on the
+//! half-space), with its standard error over 4 fixed seeds. The accepted tolerance is stated
+//! per case:
+//! * `Within15` — the half-space profile is good enough here: |q − 1| < 0.15 (+ 4 SE).
+//! * `Band(q0)` — still outside 15 % (thin parts double-count, small and curved bodies lose or
+//!   gain light; docs/shapes.md). `q0` is the value `examples/shapes.rs` measured (8 seeds,
+//!   4–16× these samples), so this is a regression guard, not a reference: q must stay within
+//!   ±10 % (+ 4 SE) of it, so that a change that makes the case worse — or better, which
+//!   should then move the case to `Within15` or a new band — fails.
+//!
+//! The half-space ratio itself (the tabulated profile's own error) must be within 5 %.
+
+use bssrdf_core::ProfileModel;
+use tracer::integrator::Method;
+
+use crate::common::shapes::{
+    Medium, Shape, bssrdf, mean_se, measure, outside_light, ratio, shape_scene,
+};
+
+/// Accepted tolerance of one case.
+#[derive(Debug, Clone, Copy)]
+enum Tolerance {
+    /// |q − 1| < 0.15.
+    Within15,
+    /// Measured q0 (outside 15 %): q within ±10 % of it.
+    Band(f64),
+}
+
+const SEEDS: u64 = 4;
+
+/// Light through the medium (mean, SE) for the path tracer and the tabulated BSSRDF.
+fn pair(shape: Shape, medium: Medium, seed0: u64) -> ((f64, f64), (f64, f64)) {
+    let bunny = std::path::Path::new("unused");
+    let scene = shape_scene(shape, medium, bunny);
+    let outside = outside_light(&scene, medium.eta, 16);
+    let (spp_pt, spp_b) = if shape.pixels() <= 4 {
+        (1024, 256)
+    } else {
+        (64, 16)
+    };
+    let seeds = seed0..seed0 + SEEDS;
+    let pt = measure(&scene, Method::PathTraced, outside, spp_pt, seeds.clone());
+    let b = measure(
+        &scene,
+        bssrdf(ProfileModel::Tabulated),
+        outside,
+        spp_b,
+        seeds,
+    );
+    (
+        mean_se(pt.iter().map(|s| s.through)),
+        mean_se(b.iter().map(|s| s.through)),
+    )
+}
+
+fn check(medium: Medium, cases: &[(Shape, Tolerance)], seed0: u64) {
+    let (pt_hs, b_hs) = pair(Shape::HalfSpace, medium, seed0);
+    let hs = ratio(b_hs, pt_hs);
+    assert!(
+        (hs.0 - 1.0).abs() < 0.05 + 4.0 * hs.1,
+        "{}: half-space BSSRDF/PT {:.3} ± {:.3}",
+        medium.label(),
+        hs.0,
+        hs.1
+    );
+    let mut failures = Vec::new();
+    for (k, &(shape, tol)) in cases.iter().enumerate() {
+        let (pt, b) = pair(shape, medium, seed0 + 100 * (k as u64 + 1));
+        let (q, se) = ratio(ratio(b, pt), hs);
+        assert!(se < 0.03 * q, "test too weak: {} {q} ± {se}", shape.label());
+        let ok = match tol {
+            Tolerance::Within15 => (q - 1.0).abs() < 0.15 + 4.0 * se,
+            Tolerance::Band(q0) => (q - q0).abs() < 0.1 * q0 + 4.0 * se,
+        };
+        if !ok {
+            failures.push(format!("{}: q = {q:.3} ± {se:.3}, {tol:?}", shape.label()));
+        }
+    }
+    assert!(failures.is_empty(), "{}: {failures:#?}", medium.label());
+}
+
+use Tolerance::{Band, Within15};
+
+#[test]
+fn shapes_index_matched_albedo_0_9() {
+    check(
+        Medium::new(0.9, 1.0),
+        &[
+            (Shape::Slab(0.5), Band(3.85)),
+            (Shape::Slab(2.0), Within15),
+            (Shape::Sphere(1.0), Band(0.79)),
+            (Shape::Sphere(10.0), Band(0.83)),
+            (Shape::BoxCorner, Band(0.74)),
+        ],
+        10_000,
+    );
+}
+
+#[test]
+fn shapes_index_matched_albedo_0_99() {
+    check(
+        Medium::new(0.99, 1.0),
+        &[
+            (Shape::Slab(0.5), Band(6.65)),
+            (Shape::Slab(2.0), Band(1.47)),
+            (Shape::Sphere(1.0), Within15),
+            (Shape::Sphere(10.0), Within15),
+            (Shape::BoxCorner, Within15),
+        ],
+        20_000,
+    );
+}
+
+#[test]
+fn shapes_refractive_albedo_0_9() {
+    check(
+        Medium::new(0.9, 1.3),
+        &[
+            (Shape::Slab(0.5), Band(2.20)),
+            (Shape::Slab(2.0), Band(0.85)),
+            (Shape::Sphere(1.0), Band(0.40)),
+            (Shape::Sphere(10.0), Band(0.78)),
+            (Shape::BoxCorner, Band(0.60)),
+        ],
+        30_000,
+    );
+}
+
+#[test]
+fn shapes_refractive_albedo_0_99() {
+    check(
+        Medium::new(0.99, 1.3),
+        &[
+            (Shape::Slab(0.5), Band(3.95)),
+            (Shape::Slab(2.0), Band(1.34)),
+            (Shape::Sphere(1.0), Band(0.47)),
+            (Shape::Sphere(10.0), Band(0.80)),
+            (Shape::BoxCorner, Band(0.76)),
+        ],
+        40_000,
+    );
+}
