@@ -379,7 +379,7 @@ pub fn probe<C: ProbeChords, U: UniformSource>(
 /// A channel whose probe radius exceeds `max_radius / 2` draws `r`, with probability
 /// [`NARROW_SHARE`], from its radial density truncated to `[0, max_radius/2)` and
 /// renormalised (mass `F`), and otherwise from the density itself: a defensive mixture
-/// (Hesterberg 1995; Veach 1997 §9.2) whose density `p_r · (NARROW_SHARE·[r < max_radius/2]/F
+/// (Hes95 in `docs/references.md`; Vea97 §9.2) whose density `p_r · (NARROW_SHARE·[r < max_radius/2]/F
 /// + 1 − NARROW_SHARE)` is positive wherever [`probe`]'s is, so the estimate stays unbiased
 /// for the same integral `∫ f dA` over the surface in the probe sphere. On a sphere of
 /// diameter `D = max_radius`, every truncated draw along the normal crosses the body (its
