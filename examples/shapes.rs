@@ -4,7 +4,9 @@
 //! the same ratio on a half-space, with standard errors over seeds; and the fraction of BSSRDF
 //! shading points whose probes found nothing.
 //!
-//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8]
+//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8] [-- --oblique]
+//!
+//! `--oblique` replaces the shapes by the half-space seen at μ = 0.58 and 0.3 from its normal.
 //!
 //! The set-up is in `tests/common/shapes.rs` (shared with the `shapes` tests). The bunny is
 //! read from `../shared/assets/bunny.obj` relative to the repository's root and skipped when
@@ -48,11 +50,16 @@ fn main() {
     let columns: Vec<Medium> = Medium::COLUMNS.iter().map(|m| Medium { g, ..*m }).collect();
     let models = [ProfileModel::Tabulated, ProfileModel::Dipole];
     let mut shapes_list = vec![Shape::HalfSpace];
-    shapes_list.extend(
-        Shape::TABLE
-            .into_iter()
-            .filter(|s| *s != Shape::Bunny || bunny.exists()),
-    );
+    if args.iter().any(|a| a == "--oblique") {
+        // The half-space seen obliquely: the part of the error due to the exit direction.
+        shapes_list.extend([Shape::Oblique(0.58), Shape::Oblique(0.3)]);
+    } else {
+        shapes_list.extend(
+            Shape::TABLE
+                .into_iter()
+                .filter(|s| *s != Shape::Bunny || bunny.exists()),
+        );
+    }
     // results[shape][column] = (PT, per-model BSSRDF, per-model miss fraction)
     let mut through = Vec::new();
     let mut misses = Vec::new();

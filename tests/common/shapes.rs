@@ -28,6 +28,10 @@ use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 pub enum Shape {
     /// The reference: a 400 × 400 × 200 box seen on a 0.5 × 0.5 patch of its top.
     HalfSpace,
+    /// The half-space seen on a 0.5-wide window at this cosine μ from its normal
+    /// (`examples/shapes.rs -- --oblique`): the exit-direction part of the error.
+    #[allow(dead_code)]
+    Oblique(f64),
     /// A 100 × 100 slab of this thickness seen on a 0.5 × 0.5 patch of its top.
     Slab(f64),
     /// A sphere of this radius, seen whole.
@@ -56,6 +60,7 @@ impl Shape {
     pub fn label(self) -> String {
         match self {
             Shape::HalfSpace => "half-space".into(),
+            Shape::Oblique(mu) => format!("half-space seen at μ = {mu}"),
             Shape::Slab(t) => format!("slab {t} mfp"),
             Shape::Sphere(r) => format!("sphere r = {r} mfp"),
             Shape::BoxCorner => "box corner".into(),
@@ -66,7 +71,7 @@ impl Shape {
     /// Pixels per side of the image (uniform views need few).
     pub fn pixels(self) -> u32 {
         match self {
-            Shape::HalfSpace | Shape::Slab(_) | Shape::BoxCorner => 4,
+            Shape::HalfSpace | Shape::Oblique(_) | Shape::Slab(_) | Shape::BoxCorner => 4,
             Shape::Sphere(_) | Shape::Bunny => 16,
         }
     }
@@ -83,6 +88,13 @@ impl Shape {
                 primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
                 top_view(0.5, 1.0),
             ),
+            Shape::Oblique(mu) => {
+                let d = DVec3::new(-(1.0 - mu * mu).sqrt(), 0.0, -mu);
+                (
+                    primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
+                    Camera::orthographic(-d, d, DVec3::Y, 0.5, 0.5, n, n).unwrap(),
+                )
+            }
             Shape::Slab(t) => (
                 primitives::subdivided_cuboid(
                     DVec3::new(-50.0, -50.0, -t),
