@@ -7,6 +7,7 @@ mod index_matched;
 mod integrators;
 mod precision;
 mod readme;
+mod reciprocity;
 mod stability;
 mod stiff;
 mod tabulated;
