@@ -43,9 +43,16 @@ fn patterned_medium() -> MediumField {
 }
 
 fn mesh_scene(mesh: TriangleMesh, eta: f64) -> Scene {
-    let camera =
-        Camera::orthographic(DVec3::new(0.0, 0.0, 5.0), DVec3::NEG_Z, DVec3::Y, 4.0, 4.0, 4, 4)
-            .unwrap();
+    let camera = Camera::orthographic(
+        DVec3::new(0.0, 0.0, 5.0),
+        DVec3::NEG_Z,
+        DVec3::Y,
+        4.0,
+        4.0,
+        4,
+        4,
+    )
+    .unwrap();
     SceneBuilder::new(RenderSettings::new(4, 4, 1), camera)
         .object(
             "mesh",
@@ -68,7 +75,9 @@ fn estimators() -> Vec<Estimator> {
     ];
     for averaging in [Averaging::Prefiltered, Averaging::MonteCarlo] {
         v.push(Estimator::Sone(
-            SoneParams::paper().with_samples(n).with_averaging(averaging),
+            SoneParams::paper()
+                .with_samples(n)
+                .with_averaging(averaging),
         ));
     }
     // An adaptive budget draws replicate point sets: the same under the swap too.
@@ -116,7 +125,11 @@ fn pairs(scene: &Scene, count: usize, seed: u64) -> Vec<(Hit, Hit)> {
 
 /// A unit direction in front of the shading normal of `h`.
 fn outward(h: &Hit, rng: &mut Rng) -> DVec3 {
-    let v = DVec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5);
+    let v = DVec3::new(
+        rng.uniform() - 0.5,
+        rng.uniform() - 0.5,
+        rng.uniform() - 0.5,
+    );
     (h.ns + 0.9 * v).normalize()
 }
 
@@ -157,8 +170,12 @@ fn check_reciprocity(scene: &Scene, count: usize) {
             // The full S with directions in front of each point.
             let mut dirs = Rng::from_keys(10, &[k as u64]);
             let (wa, wb) = (outward(a, &mut dirs), outward(b, &mut dirs));
-            let s_ab = integrator.evaluate_bssrdf(a, wa, b, wb, &mut rng()).unwrap();
-            let s_ba = integrator.evaluate_bssrdf(b, wb, a, wa, &mut rng()).unwrap();
+            let s_ab = integrator
+                .evaluate_bssrdf(a, wa, b, wb, &mut rng())
+                .unwrap();
+            let s_ba = integrator
+                .evaluate_bssrdf(b, wb, a, wa, &mut rng())
+                .unwrap();
             match e {
                 // The point lookups are the non-reciprocal baselines: swapping the points of
                 // jensen-in gives jensen-out, for the coefficients and for S.
@@ -169,7 +186,9 @@ fn check_reciprocity(scene: &Scene, count: usize) {
                         .estimate(&surface, medium, b, a, &mut rng());
                     assert_eq!(ab.coefficients, out_ba.coefficients, "pair {k}");
                     jensen_differs += usize::from(ab.coefficients != ba.coefficients);
-                    let s_out = jensen_out.evaluate_bssrdf(b, wb, a, wa, &mut rng()).unwrap();
+                    let s_out = jensen_out
+                        .evaluate_bssrdf(b, wb, a, wa, &mut rng())
+                        .unwrap();
                     assert_eq!(s_ab, s_out, "pair {k}");
                     s_jensen_differs += usize::from(s_ab != s_ba);
                 }
@@ -269,7 +288,15 @@ fn slab_scene(eta: f64, n: u32, perspective: bool) -> Scene {
         let fov = 2.0 * (1.5f64 / 6.0).atan().to_degrees();
         Camera::perspective(DVec3::new(0.0, 0.0, 6.0), DVec3::ZERO, DVec3::Y, fov, n, n)
     } else {
-        Camera::orthographic(DVec3::new(0.0, 0.0, 3.0), DVec3::NEG_Z, DVec3::Y, 3.0, 3.0, n, n)
+        Camera::orthographic(
+            DVec3::new(0.0, 0.0, 3.0),
+            DVec3::NEG_Z,
+            DVec3::Y,
+            3.0,
+            3.0,
+            n,
+            n,
+        )
     }
     .unwrap();
     // A 2 × 2 quad centred at (3.5, 0, 2.5), facing the slab's centre.
@@ -284,7 +311,12 @@ fn slab_scene(eta: f64, n: u32, perspective: bool) -> Scene {
     assert!(q.normal.dot(normal) > 0.999, "the quad faces the slab");
     if perspective {
         // The reflections of the outermost camera rays pass beside the light.
-        for (fx, fy) in [(0.0, 0.0), (n as f64, 0.0), (0.0, n as f64), (n as f64, n as f64)] {
+        for (fx, fy) in [
+            (0.0, 0.0),
+            (n as f64, 0.0),
+            (0.0, n as f64),
+            (n as f64, n as f64),
+        ] {
             let ray = camera.ray(fx, fy);
             let p = ray.origin + (-ray.origin.z / ray.dir.z) * ray.dir;
             let r = DVec3::new(ray.dir.x, ray.dir.y, -ray.dir.z);
@@ -426,12 +458,20 @@ fn light_traced_sone_agrees_with_camera_traced_sone() {
         let camera = camera_traced(&scene, sone(), 16);
         let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
         let (max_z, ratio, ratio_se) = compare(&light, &camera);
-        eprintln!("η = {eta}, perspective {perspective}: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
+        eprintln!(
+            "η = {eta}, perspective {perspective}: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}"
+        );
         assert!(max_z < Z_MAX, "η = {eta}: max |z| = {max_z}");
         // The stripes show (the comparison is not between two flat images).
-        let (lo, hi) = camera.mean.iter().fold((f64::MAX, 0.0f64), |(a, b), &m| (a.min(m), b.max(m)));
+        let (lo, hi) = camera
+            .mean
+            .iter()
+            .fold((f64::MAX, 0.0f64), |(a, b), &m| (a.min(m), b.max(m)));
         assert!(hi > 2.0 * lo, "no contrast: {lo} .. {hi}");
-        assert!((ratio - 1.0).abs() < 3.0 * ratio_se, "η = {eta}: {ratio} ± {ratio_se}");
+        assert!(
+            (ratio - 1.0).abs() < 3.0 * ratio_se,
+            "η = {eta}: {ratio} ± {ratio_se}"
+        );
         assert!(ratio_se < 0.02, "test too weak: ratio ± {ratio_se}");
     }
 }
@@ -447,9 +487,123 @@ fn jensen_out_light_traced_needs_the_physical_roles() {
     let right = light_traced(&scene, Estimator::JensenOut, Roles::Physical, 120_000);
     let (max_z, ratio, ratio_se) = compare(&right, &camera);
     eprintln!("jensen-out: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
-    assert!(max_z < Z_MAX, "jensen-out, physical roles: max |z| = {max_z}");
+    assert!(
+        max_z < Z_MAX,
+        "jensen-out, physical roles: max |z| = {max_z}"
+    );
     let swapped = light_traced(&scene, Estimator::JensenOut, Roles::Swapped, 120_000);
     let (max_z, ratio, ratio_se) = compare(&swapped, &camera);
-    eprintln!("jensen-out swapped: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
-    assert!(max_z > 3.0 * Z_MAX, "swapped roles go unnoticed: max |z| = {max_z}");
+    eprintln!(
+        "jensen-out swapped: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}"
+    );
+    assert!(
+        max_z > 3.0 * Z_MAX,
+        "swapped roles go unnoticed: max |z| = {max_z}"
+    );
+}
+
+/// Light from infinity (a directional light and a uniform environment, emitted from a disk
+/// covering the slab's bounding sphere): light- and camera-traced sone agree at η = 1 (no
+/// Fresnel reflection of the sky, which the light tracer would not render).
+#[test]
+fn light_traced_sone_agrees_under_distant_lights() {
+    let base = slab_scene(1.0, N, false);
+    let mut builder = SceneBuilder::new(RenderSettings::new(N, N, 1), *base.camera())
+        .light(Light::directional(DVec3::new(-0.6, 0.2, -1.0), Rgb::splat(1.5)).unwrap())
+        .light(Light::environment(Rgb::splat(0.4)).unwrap());
+    for (k, o) in base.objects().iter().enumerate() {
+        if let Material::Translucent(_) = o.material {
+            builder = builder.object(
+                o.name.clone(),
+                base.geometry().mesh(k as u32).clone(),
+                o.material.clone(),
+            );
+        }
+    }
+    let scene = builder.build().unwrap();
+    let camera = camera_traced(&scene, sone(), 16);
+    let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
+    let (max_z, ratio, ratio_se) = compare(&light, &camera);
+    eprintln!("distant lights: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
+    assert!(max_z < Z_MAX, "max |z| = {max_z}");
+    assert!((ratio - 1.0).abs() < 3.0 * ratio_se, "{ratio} ± {ratio_se}");
+    assert!(ratio_se < 0.02, "test too weak: ratio ± {ratio_se}");
+}
+
+#[test]
+fn light_traced_renders_are_identical_whatever_the_thread_count() {
+    let scene = slab_scene(1.3, 8, true);
+    let tracer = LightTracer::new(
+        &scene,
+        Method::Bssrdf {
+            estimator: sone(),
+            profile: None,
+        },
+        OPTIONS,
+    )
+    .unwrap();
+    // More than one batch of chunks, and a last chunk that is not full.
+    let opts = LightTraceOptions {
+        paths: 70 * 4096 + 123,
+        seed: 3,
+    };
+    let with = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| tracer.render(&opts))
+    };
+    let (one, three) = (with(1), with(3));
+    assert_eq!(one.film, three.film);
+    assert_eq!(one.counters, three.counters);
+    assert_eq!(one.counters.paths, opts.paths);
+    assert!(one.film.mean()[0] > 0.0);
+}
+
+#[test]
+fn light_tracer_refuses_what_it_cannot_render() {
+    use tracer::integrator::LightTraceError;
+    let scene = slab_scene(1.0, 4, false);
+    let sone_method = Method::Bssrdf {
+        estimator: sone(),
+        profile: None,
+    };
+    assert!(matches!(
+        LightTracer::new(&scene, Method::PathTraced, OPTIONS),
+        Err(LightTraceError::NotBssrdf)
+    ));
+    let camera = *scene.camera();
+    let slab = || primitives::subdivided_cuboid(DVec3::splat(-1.0), DVec3::splat(1.0), [1, 1, 1]);
+    let translucent = scene.objects()[1].material.clone();
+    let beam = SceneBuilder::new(RenderSettings::new(4, 4, 1), camera)
+        .light(Light::beam(DVec3::Z, DVec3::NEG_Z, Rgb::ONE).unwrap())
+        .object("slab", slab(), translucent.clone())
+        .build()
+        .unwrap();
+    assert!(matches!(
+        LightTracer::new(&beam, sone_method, OPTIONS),
+        Err(LightTraceError::UnsupportedLight { index: 0, .. })
+    ));
+    let floor = SceneBuilder::new(RenderSettings::new(4, 4, 1), camera)
+        .light(Light::environment(Rgb::ONE).unwrap())
+        .object("slab", slab(), translucent)
+        .object(
+            "floor",
+            primitives::quad(
+                DVec3::new(-5.0, -5.0, -2.0),
+                10.0 * DVec3::X,
+                10.0 * DVec3::Y,
+            ),
+            Material::Diffuse {
+                albedo: Rgb::splat(0.5),
+            },
+        )
+        .build()
+        .unwrap();
+    let e = LightTracer::new(&floor, sone_method, OPTIONS)
+        .err()
+        .unwrap();
+    assert!(matches!(e, LightTraceError::DiffuseSurface { .. }), "{e}");
+    assert!(e.to_string().contains("floor"), "{e}");
 }

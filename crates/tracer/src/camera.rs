@@ -385,8 +385,7 @@ mod tests {
     /// in one pixel is 1 (the pixel's value is the mean radiance over it).
     #[test]
     fn perspective_importance_integrates_to_one_per_pixel() {
-        let cam =
-            Camera::perspective(DVec3::ZERO, DVec3::NEG_Z, DVec3::Y, 60.0, 8, 6).unwrap();
+        let cam = Camera::perspective(DVec3::ZERO, DVec3::NEG_Z, DVec3::Y, 60.0, 8, 6).unwrap();
         // A plane z = -2 tilted: normal n, points p = base + u·a + v·b.
         let n = DVec3::new(0.3, 0.2, 1.0).normalize();
         let (a, b) = orthonormal(n);

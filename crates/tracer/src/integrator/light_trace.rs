@@ -199,7 +199,10 @@ impl<'s> LightTracer<'s> {
                     value: e.radiance,
                 },
                 Light::Beam(_) => {
-                    return Err(LightTraceError::UnsupportedLight { index, kind: "beam" });
+                    return Err(LightTraceError::UnsupportedLight {
+                        index,
+                        kind: "beam",
+                    });
                 }
             });
         }

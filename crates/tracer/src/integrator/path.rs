@@ -33,9 +33,9 @@ use het_estimate::{CoefficientField, Estimator};
 
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
+use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
-use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::probe::probe;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
