@@ -222,8 +222,9 @@ pub struct CameraConnection {
     /// `importance · cos θ · L · dA` to the pixel's value (the mean radiance over the pixel,
     /// as [`crate::render`] computes it). Perspective: `1/(A_p cos³θ_c d²)`, with `A_p` the
     /// pixel's area on the image plane at distance 1 and `θ_c` the angle between the ray and
-    /// the view direction (pbrt-v4 §16.1.1, `PerspectiveCamera::We`, for one pixel instead of
-    /// the whole film); orthographic: `1/A_p` with `A_p` the pixel's area on the view plane.
+    /// the view direction (pbrt3 §16.1.1 and pbrt-v4's `PerspectiveCamera::We`, for one pixel
+    /// instead of the whole film); orthographic: `1/A_p` with `A_p` the pixel's area on the
+    /// view plane.
     pub importance: f64,
 }
 

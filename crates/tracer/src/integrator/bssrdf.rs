@@ -4,7 +4,8 @@
 //! S(x_i, ω_i; x_o, ω_o) = (1 − F_r(cos θ_o)) · R(|x_i − x_o|; σ̄a, σ̄s) · S_w(ω_i),
 //! S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
 //!
-//! (pbrt-v4 §11.4, `SeparableBSSRDF` with its `NormalizedFresnelBxDF`; F_r the dielectric
+//! (pbrt3 §11.4.1, the separable BSSRDF, with the normalised Fresnel lobe of pbrt-v4's
+//! `NormalizedFresnelBxDF` (key pbrt4, its source); F_r the dielectric
 //! Fresnel reflectance at relative index η, C1 its first moment), with R the material's
 //! diffuse reflectance profile (1/length²) at the homogeneous coefficients σ̄a, σ̄s the
 //! estimator gives for the pair (x_i, x_o). The directions ω_i (toward the light) and ω_o

@@ -10,7 +10,7 @@
 //!    x_i (`het_estimate::probe`, the same sampler and density as the camera tracer's search
 //!    for x_i around x_o);
 //! 4. connects every x_o to the camera ([`crate::camera::Camera::connect`]: the pinhole's
-//!    importance as pbrt-v4's `PerspectiveCamera::We`, §16.1.1, or the orthographic pixel
+//!    importance W_e, pbrt3 §16.1.1, pbrt-v4's `PerspectiveCamera::We`, or the orthographic pixel
 //!    whose ray reaches x_o, with the cos/area Jacobian), checks visibility, evaluates the
 //!    BSSRDF S(x_i, ω_i; x_o, ω_o) with the estimator in its physical roles (x_i is where the
 //!    light enters; `integrator/bssrdf.rs`) and splats the contribution into that pixel.
@@ -18,7 +18,8 @@
 //! Path weight: a light path starting with flux weight Φ (below) reaching x_i with geometric
 //! cosine cos_g and shading-side cosine cos_s (the normal rule of S) carries
 //! Φ · cos_s / cos_g (the projected solid angle of the camera tracer's irradiance integral is
-//! measured against the shading normal; Veach 1997 §5.3's adjoint correction), and adds
+//! measured against the shading normal: the adjoint's shading-normal correction, Vea97 §5.3),
+//! and adds
 //! Φ · (cos_s/cos_g) · S · (1/p(x_o)) · W_e · cos_o to the pixel, p the probe density and
 //! W_e cos_o the camera importance at x_o.
 //!
