@@ -386,7 +386,7 @@ impl<'s> LightTracer<'s> {
                     None => (-uniform_sphere(u), 4.0 * PI),
                 };
                 let d = self.disk;
-                if !(d.radius > 0.0) {
+                if d.radius.is_nan() || d.radius <= 0.0 {
                     return None;
                 }
                 let (t, b) = het_estimate::frame::orthonormal_basis(dir);
