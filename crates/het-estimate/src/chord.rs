@@ -26,10 +26,10 @@ fn canonical(v: DVec3) -> DVec3 {
 /// The chord and its averaging frame.
 ///
 /// Orientation is canonical: the chord direction x̂ is ±(x_o − x_i)/d with the sign chosen so
-/// that x̂ is lexicographically positive, and all points are built from the midpoint m. So
-/// swapping x_i and x_o gives bit-identical sample points whenever the plane normal is the same
-/// (on a plane, or n_i = n_o), which makes every estimator exactly symmetric there
-/// (reciprocity), with the same random numbers.
+/// that x̂ is lexicographically positive, and all points are built from the midpoint m. With
+/// the plane normal symmetric in the two points too (below), swapping x_i and x_o gives
+/// bit-identical sample points, which makes every averaging estimator exactly symmetric
+/// (reciprocity, docs/reciprocity.md), with the same random numbers.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Chord {
     /// Midpoint m = (x_i + x_o)/2.
