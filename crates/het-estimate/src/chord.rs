@@ -162,6 +162,28 @@ mod tests {
         assert_eq!(a.minor_dir, b.minor_dir);
     }
 
+    /// Different normals (a curved surface): the frame is still bit-identical under the
+    /// swap, and differs from the frame the paper's n_i* alone would give.
+    #[test]
+    fn swapping_points_with_different_normals_gives_the_same_frame() {
+        let x_i = DVec3::new(0.3, -1.0, 0.1);
+        let x_o = DVec3::new(-2.0, 0.5, -0.4);
+        let n_i = DVec3::new(0.3, 0.1, 1.0).normalize();
+        let n_o = DVec3::new(-0.4, 0.2, 0.9).normalize();
+        let a = Chord::new(x_i, n_i, x_o, n_o).unwrap();
+        let b = Chord::new(x_o, n_o, x_i, n_i).unwrap();
+        assert!(!a.normal_fallback);
+        assert_eq!(
+            (a.mid, a.half_len, a.x_hat, a.normal, a.minor_dir),
+            (b.mid, b.half_len, b.x_hat, b.normal, b.minor_dir)
+        );
+        for t in [0.0, 0.3, 1.0] {
+            assert_eq!(a.point(t), b.point(t));
+        }
+        let paper = canonical(modified_normal(n_i, x_i, x_o));
+        assert!((paper - a.normal).length() > 1e-3);
+    }
+
     #[test]
     fn degenerate_cases() {
         let p = DVec3::new(1.0, 2.0, 3.0);
