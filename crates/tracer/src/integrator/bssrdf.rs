@@ -117,16 +117,16 @@ impl BssrdfObject {
 }
 
 /// The normal the BSSRDF measures the direction `w` (unit, pointing away from the surface)
-/// against at `hit`: the shading normal where `w` is in front of it, else the geometric
-/// normal; `None` when `w` is not in front of the geometric normal either (light cannot
-/// cross there). The same rule at x_i and x_o keeps S reciprocal.
+/// against at `hit`: `None` when `w` is not in front of the geometric normal (light cannot
+/// cross the surface from there), else the shading normal where `w` is in front of it too,
+/// else the geometric normal. The same rule at x_i and x_o keeps S reciprocal.
 #[inline]
 pub(crate) fn facing_normal(hit: &Hit, w: DVec3) -> Option<DVec3> {
-    if w.dot(hit.ns) > 0.0 {
-        Some(hit.ns)
-    } else if w.dot(hit.ng) > 0.0 {
-        Some(hit.ng)
-    } else {
+    if w.dot(hit.ng) <= 0.0 {
         None
+    } else if w.dot(hit.ns) > 0.0 {
+        Some(hit.ns)
+    } else {
+        Some(hit.ng)
     }
 }

@@ -951,6 +951,10 @@ impl<'s> PathIntegrator<'s> {
         let Some((wi, cos)) = cosine_continuation(x_i.ns, rng) else {
             return Step::Stop;
         };
+        if facing_normal(&x_i, wi).is_none() {
+            // Below the geometric surface: S is 0 there (light cannot arrive from inside).
+            return Step::Stop;
+        }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
         st.prev = Prev::Sampled {
