@@ -16,5 +16,11 @@ pub mod physics {}
 /// `docs/kernel.md`, cited from the code as `docs/kernel.md#section`).
 #[doc = include_str!("../docs/kernel.md")]
 pub mod kernel {}
+
+/// Reciprocity: which estimates and BSSRDF values are symmetric in (x_i, x_o) and why, the
+/// non-reciprocal point lookups, and the light-traced render that checks it (the repository's
+/// `docs/reciprocity.md`).
+#[doc = include_str!("../docs/reciprocity.md")]
+pub mod reciprocity {}
 pub use het_estimate;
 pub use tracer;

@@ -7,6 +7,7 @@ mod index_matched;
 mod integrators;
 mod precision;
 mod readme;
+mod reciprocity;
 mod shapes;
 mod stability;
 mod stiff;

@@ -23,6 +23,18 @@ use crate::common::{
 use crate::flags::{check_averaging_flag, check_method_flags};
 use crate::interrupt;
 
+/// Which way paths are traced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Trace {
+    /// From the camera (every method).
+    #[default]
+    Camera,
+    /// From the lights, splatted to the camera (BSSRDF methods; quad, point, directional and
+    /// environment lights; no diffuse surfaces): light entering a translucent object once
+    /// and leaving it toward the camera, for reciprocity checks (docs/reciprocity.md).
+    Light,
+}
+
 /// Arguments of `het-bssrdf render`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -80,6 +92,10 @@ pub struct Args {
     /// each pass that ends at least this many seconds after the previous checkpoint.
     #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     checkpoint: Option<Duration>,
+    /// Trace paths from the `camera` (default) or from the `light`s. A light-traced render
+    /// traces spp × width × height light paths; it takes no --time, --tile or --checkpoint.
+    #[arg(long, value_enum, default_value_t = Trace::Camera)]
+    trace: Trace,
 }
 
 /// Runs the subcommand.
@@ -147,6 +163,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (width, height) = scene.camera().resolution();
     check_image_memory(width, height, &args.scene)?;
     note_triangles(&scene);
+    if args.trace == Trace::Light {
+        if args.time.is_some() || args.tile.is_some() || args.checkpoint.is_some() {
+            bail!("--trace light takes a sample count (--spp), not --time, --tile or --checkpoint");
+        }
+        return run_light_traced(&scene, &job, &out, args.exposure);
+    }
     set_collision_cap(args.max_collisions);
     interrupt::install()?;
     let rays_before = scene.geometry().rays_traced();
@@ -226,6 +248,65 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mean[0],
         mean[1],
         mean[2]
+    );
+    for w in &outcome.warnings {
+        eprintln!("warning: {w}");
+    }
+    warn_counters(&outcome.counters);
+    Ok(())
+}
+
+/// `render --trace light`: the light tracer ([`tracer::integrator::LightTracer`]) with
+/// spp × width × height light paths, written as a camera-traced render is.
+fn run_light_traced(
+    scene: &Scene,
+    job: &RenderJob,
+    out: &std::path::Path,
+    exposure: f64,
+) -> anyhow::Result<()> {
+    use tracer::integrator::{LightTraceOptions, LightTracer, PathOptions};
+    let Budget::Samples(spp) = job.budget else {
+        bail!("--trace light takes a sample count (--spp)");
+    };
+    let options = PathOptions {
+        scattering: job.scattering,
+        max_depth: job.max_depth,
+    };
+    let tracer = LightTracer::new(scene, job.method, options)
+        .with_context(|| format!("cannot light-trace `{}`", scene.display_name()))?;
+    let (width, height) = scene.camera().resolution();
+    let paths = u64::from(spp) * u64::from(width) * u64::from(height);
+    let rays_before = scene.geometry().rays_traced();
+    let traced = tracer.render(&LightTraceOptions {
+        paths,
+        seed: job.seed,
+    });
+    let method = format!("{}-light-traced", job.method.name());
+    let mut outcome = RenderOutcome::checkpoint(
+        traced.film,
+        spp,
+        traced.seconds,
+        scene.geometry().rays_traced() - rays_before,
+        traced.counters,
+        method,
+    );
+    outcome.checkpoint = false;
+    outcome.warnings = tracer.warnings().to_vec();
+    write_render(&outcome, scene, job, out, exposure)?;
+    let (png, json) = sidecar_paths(out);
+    let mean = outcome.film.mean();
+    eprintln!(
+        "{}: {paths} light paths in {:.2} s ({:.2} Mrays/s); wrote {}, {}, {}",
+        outcome.method,
+        outcome.seconds,
+        outcome.rays as f64 / outcome.seconds.max(1e-9) / 1e6,
+        out.display(),
+        png.display(),
+        json.display()
+    );
+    eprintln!(
+        "mean pixel value (R, G, B): {:.6}, {:.6}, {:.6}",
+        mean[0], mean[1], mean[2]
     );
     for w in &outcome.warnings {
         eprintln!("warning: {w}");

@@ -107,3 +107,53 @@ fn short_out_and_threads() {
         &["--threads"],
     );
 }
+
+/// `render --trace light` light-traces a BSSRDF render into the same files as a camera-traced
+/// one (the sidecar names the method `sone-light-traced`), and refuses what it cannot render
+/// with a message naming the reason: the path tracer, a time budget, a diffuse surface.
+#[test]
+fn render_trace_light_writes_an_image_and_refuses_what_it_cannot_trace() {
+    let s = Scratch::new();
+    s.write("scene.toml", MINIMAL);
+    let r = s.run(&[
+        "render",
+        "scene.toml",
+        "--method",
+        "sone",
+        "--trace",
+        "light",
+        "--spp",
+        "64",
+        "-o",
+        "light.exr",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("sone-light-traced: 4096 light paths"),
+        "{}",
+        r.stderr
+    );
+    let film = tracer::output::read_exr(&s.join("light.exr")).unwrap();
+    assert!(film.mean()[0] > 0.0);
+    let json = std::fs::read_to_string(s.join("light.json")).unwrap();
+    assert!(json.contains("sone-light-traced"), "{json}");
+    for (extra, says) in [
+        (&["--method", "pt"][..], "BSSRDF methods only"),
+        (&["--time", "1"][..], "--trace light takes a sample count"),
+    ] {
+        let mut args = vec!["render", "scene.toml", "--trace", "light", "-o", "x.exr"];
+        args.extend_from_slice(extra);
+        let r = s.run(&args);
+        assert_ne!(r.code, Some(0));
+        assert!(r.stderr.contains(says), "{extra:?}: {}", r.stderr);
+    }
+    let diffuse = MINIMAL.replace(
+        "type = \"translucent\"\nsigma_a = 0.1\nsigma_s = 1.0",
+        "type = \"diffuse\"\nalbedo = 0.5",
+    );
+    assert_ne!(diffuse, MINIMAL);
+    s.write("diffuse.toml", diffuse);
+    let r = s.run(&["render", "diffuse.toml", "--trace", "light", "-o", "d.exr"]);
+    assert_ne!(r.code, Some(0));
+    assert!(r.stderr.contains("is diffuse"), "{}", r.stderr);
+}

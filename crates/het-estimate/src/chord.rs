@@ -26,10 +26,10 @@ fn canonical(v: DVec3) -> DVec3 {
 /// The chord and its averaging frame.
 ///
 /// Orientation is canonical: the chord direction x̂ is ±(x_o − x_i)/d with the sign chosen so
-/// that x̂ is lexicographically positive, and all points are built from the midpoint m. So
-/// swapping x_i and x_o gives bit-identical sample points whenever the plane normal is the same
-/// (on a plane, or n_i = n_o), which makes every estimator exactly symmetric there
-/// (reciprocity), with the same random numbers.
+/// that x̂ is lexicographically positive, and all points are built from the midpoint m. With
+/// the plane normal symmetric in the two points too (below), swapping x_i and x_o gives
+/// bit-identical sample points, which makes every averaging estimator exactly symmetric
+/// (reciprocity, docs/reciprocity.md), with the same random numbers.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Chord {
     /// Midpoint m = (x_i + x_o)/2.
@@ -160,6 +160,28 @@ mod tests {
         assert_eq!(a.x_hat, b.x_hat);
         assert_eq!(a.normal, b.normal);
         assert_eq!(a.minor_dir, b.minor_dir);
+    }
+
+    /// Different normals (a curved surface): the frame is still bit-identical under the
+    /// swap, and differs from the frame the paper's n_i* alone would give.
+    #[test]
+    fn swapping_points_with_different_normals_gives_the_same_frame() {
+        let x_i = DVec3::new(0.3, -1.0, 0.1);
+        let x_o = DVec3::new(-2.0, 0.5, -0.4);
+        let n_i = DVec3::new(0.3, 0.1, 1.0).normalize();
+        let n_o = DVec3::new(-0.4, 0.2, 0.9).normalize();
+        let a = Chord::new(x_i, n_i, x_o, n_o).unwrap();
+        let b = Chord::new(x_o, n_o, x_i, n_i).unwrap();
+        assert!(!a.normal_fallback);
+        assert_eq!(
+            (a.mid, a.half_len, a.x_hat, a.normal, a.minor_dir),
+            (b.mid, b.half_len, b.x_hat, b.normal, b.minor_dir)
+        );
+        for t in [0.0, 0.3, 1.0] {
+            assert_eq!(a.point(t), b.point(t));
+        }
+        let paper = canonical(modified_normal(n_i, x_i, x_o));
+        assert!((paper - a.normal).length() > 1e-3);
     }
 
     #[test]

@@ -402,6 +402,12 @@ fn weighted_means(
         // is ≤ h and nothing underflows near the chord whatever σt·d.
         let log_w = table.log_weight(ri, ro, kappa) - kappa * ((ri + ro) - d_t);
         let weight = log_w.exp() * s.inv_q;
+        // A subnormal weight has lost its precision: weight·σ / weight would be off by up to
+        // ~1e-9 relative (outside the field's range). Such a point carries nothing next to
+        // any normal one, so it is dropped (all dropped: the caller's fallback).
+        if weight < f64::MIN_POSITIVE {
+            continue;
+        }
         for k in 0..3 {
             wa[k] += weight * mask[k] * s.a_p[k];
             ws[k] += weight * mask[k] * s.s[k];

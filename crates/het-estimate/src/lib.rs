@@ -35,8 +35,9 @@
 //! # Conventions
 //! Lengths in scene units, coefficients in 1/length, f64 throughout. Normals point out of the
 //! medium. Colour is linear RGB ([`Rgb`]), each channel estimated separately (sharing samples).
-//! Estimates are symmetric in x_i ↔ x_o whenever both points have the same normal
-//! (canonical chord orientation; see the Sone docs for n_i ≠ n_o).
+//! The averaging estimators' estimates are symmetric in x_i ↔ x_o, bit for bit with the same
+//! random numbers, on curved surfaces too (canonical chord orientation and an averaging plane
+//! from n_i + n_o; docs/reciprocity.md); the point lookups `jensen-in`/`jensen-out` are not.
 #![deny(missing_docs)]
 
 #[macro_use]

@@ -204,6 +204,91 @@ impl Camera {
     }
 }
 
+/// How a point is seen by the camera, for light tracing ([`Camera::connect`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraConnection {
+    /// Film position (pixels, see the module docs) of the camera ray through the point.
+    pub film: (f64, f64),
+    /// Pixel `(x, y)` holding [`CameraConnection::film`].
+    pub pixel: (u32, u32),
+    /// Unit direction from the point toward the camera (the camera ray reversed).
+    pub to_camera: DVec3,
+    /// Distance from the point to the eye (perspective) or to the view plane
+    /// (orthographic) along `to_camera`: a visibility segment is this long.
+    pub dist: f64,
+    /// The importance of the point for its pixel per unit surface area and unit projected
+    /// cosine (1/length²): radiance `L` leaving an area `dA` at the point toward the camera,
+    /// with cosine `cos θ` between `to_camera` and the surface's geometric normal, adds
+    /// `importance · cos θ · L · dA` to the pixel's value (the mean radiance over the pixel,
+    /// as [`crate::render`] computes it). Perspective: `1/(A_p cos³θ_c d²)`, with `A_p` the
+    /// pixel's area on the image plane at distance 1 and `θ_c` the angle between the ray and
+    /// the view direction (pbrt3 §16.1.1 and pbrt-v4's `PerspectiveCamera::We`, for one pixel
+    /// instead of the whole film); orthographic: `1/A_p` with `A_p` the pixel's area on the
+    /// view plane.
+    pub importance: f64,
+}
+
+impl Camera {
+    /// The pixel through which the camera sees the point `p`, and its importance (see
+    /// [`CameraConnection`]); `None` when `p` is outside the film, behind the eye or behind
+    /// the orthographic view plane. Visibility is the caller's (a segment of length
+    /// [`CameraConnection::dist`] from `p` along [`CameraConnection::to_camera`]).
+    pub fn connect(&self, p: DVec3) -> Option<CameraConnection> {
+        let (w, h) = self.resolution();
+        let (w, h) = (w as f64, h as f64);
+        let (film, to_camera, dist, importance) = match self {
+            Camera::Perspective(c) => {
+                let d = p - c.eye;
+                let dist = d.length();
+                if !(dist > 0.0 && dist.is_finite()) {
+                    return None;
+                }
+                let dir = d / dist;
+                let cos = dir.dot(c.frame.forward);
+                if cos <= 0.0 {
+                    return None;
+                }
+                let sx = dir.dot(c.frame.right) / cos;
+                let sy = dir.dot(c.frame.up) / cos;
+                let film = (
+                    (sx / (c.tan_half_fov_y * (w / h)) + 1.0) * 0.5 * w,
+                    (1.0 - sy / c.tan_half_fov_y) * 0.5 * h,
+                );
+                let side = 2.0 * c.tan_half_fov_y / h;
+                let importance = 1.0 / (side * side * cos * cos * cos * dist * dist);
+                (film, -dir, dist, importance)
+            }
+            Camera::Orthographic(c) => {
+                let rel = p - c.centre;
+                let dist = rel.dot(c.frame.forward);
+                if !(dist > 0.0 && dist.is_finite()) {
+                    return None;
+                }
+                let film = (
+                    (rel.dot(c.frame.right) / c.view_width + 0.5) * w,
+                    (0.5 - rel.dot(c.frame.up) / c.view_height) * h,
+                );
+                let area = (c.view_width / w) * (c.view_height / h);
+                (film, -c.frame.forward, dist, 1.0 / area)
+            }
+        };
+        if !(film.0 >= 0.0 && film.0 < w && film.1 >= 0.0 && film.1 < h) {
+            return None;
+        }
+        let pixel = (
+            (film.0 as u32).min(w as u32 - 1),
+            (film.1 as u32).min(h as u32 - 1),
+        );
+        Some(CameraConnection {
+            film,
+            pixel,
+            to_camera,
+            dist,
+            importance,
+        })
+    }
+}
+
 fn check_resolution(width: u32, height: u32) -> Result<(), CameraError> {
     if width == 0 || height == 0 {
         Err(CameraError::BadResolution(width, height))
@@ -251,6 +336,83 @@ mod tests {
                 .origin
                 .abs_diff_eq(DVec3::new(10.0, -10.0, 5.0), 1e-12)
         );
+    }
+
+    /// `connect` inverts `ray`: the point a film position's ray reaches maps back to that
+    /// film position, and the direction to the camera is the ray's reversed.
+    #[test]
+    fn connect_inverts_the_camera_ray() {
+        let cams = [
+            Camera::perspective(
+                DVec3::new(0.3, -2.0, 4.0),
+                DVec3::ZERO,
+                DVec3::Z,
+                50.0,
+                40,
+                30,
+            )
+            .unwrap(),
+            Camera::orthographic(
+                DVec3::new(0.0, 0.0, 5.0),
+                DVec3::new(0.2, 0.1, -1.0),
+                DVec3::Y,
+                6.0,
+                4.0,
+                30,
+                20,
+            )
+            .unwrap(),
+        ];
+        for cam in cams {
+            let (w, h) = cam.resolution();
+            for (fx, fy) in [(0.25, 0.5), (13.7, 9.2), (w as f64 - 0.01, h as f64 - 0.01)] {
+                let ray = cam.ray(fx, fy);
+                let p = ray.origin + 3.5 * ray.dir;
+                let c = cam.connect(p).unwrap();
+                assert!((c.film.0 - fx).abs() < 1e-9 && (c.film.1 - fy).abs() < 1e-9);
+                assert_eq!(c.pixel, (fx as u32, fy as u32));
+                assert!(c.to_camera.abs_diff_eq(-ray.dir, 1e-12));
+                assert!((c.dist - 3.5).abs() < 1e-9);
+                assert!(c.importance > 0.0 && c.importance.is_finite());
+            }
+            // Behind the camera.
+            let ray = cam.ray(1.0, 1.0);
+            assert!(cam.connect(ray.origin - ray.dir).is_none());
+        }
+    }
+
+    /// The perspective importance integrates to 1 over a pixel's footprint: on a plane
+    /// facing the camera, Σ importance · cos · dA over a fine grid of the plane that lands
+    /// in one pixel is 1 (the pixel's value is the mean radiance over it).
+    #[test]
+    fn perspective_importance_integrates_to_one_per_pixel() {
+        let cam = Camera::perspective(DVec3::ZERO, DVec3::NEG_Z, DVec3::Y, 60.0, 8, 6).unwrap();
+        // A plane z = -2 tilted: normal n, points p = base + u·a + v·b.
+        let n = DVec3::new(0.3, 0.2, 1.0).normalize();
+        let (a, b) = orthonormal(n);
+        let base = DVec3::new(0.0, 0.0, -2.0);
+        let (m, half) = (1500, 2.5);
+        let step = 2.0 * half / m as f64;
+        let mut sums = [0.0f64; 48];
+        for i in 0..m {
+            for j in 0..m {
+                let u = -half + (i as f64 + 0.5) * step;
+                let v = -half + (j as f64 + 0.5) * step;
+                let p = base + u * a + v * b;
+                if let Some(c) = cam.connect(p) {
+                    let cos = c.to_camera.dot(n).abs();
+                    sums[(c.pixel.1 * 8 + c.pixel.0) as usize] += c.importance * cos * step * step;
+                }
+            }
+        }
+        for (k, s) in sums.iter().enumerate() {
+            assert!((s - 1.0).abs() < 5e-3, "pixel {k}: {s}");
+        }
+    }
+
+    fn orthonormal(n: DVec3) -> (DVec3, DVec3) {
+        let a = n.cross(DVec3::X).normalize();
+        (a, n.cross(a))
     }
 
     #[test]

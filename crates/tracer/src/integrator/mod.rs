@@ -1,8 +1,11 @@
 //! Integrators. The reference volumetric path tracer and the BSSRDF renderer are one camera
 //! path loop ([`path`]) that differs only at translucent surfaces; the random walk inside a
-//! medium ([`walk`]) also serves the light tracer of the beam experiment.
+//! medium ([`walk`]) also serves the light tracer of the beam experiment. [`light_trace`] is
+//! the BSSRDF renderer's adjoint (light paths splatted to the camera), for reciprocity checks.
 
+mod bssrdf;
 pub mod counters;
+pub mod light_trace;
 pub mod lighting;
 mod method;
 pub mod path;
@@ -11,6 +14,7 @@ pub mod walk;
 pub mod warnings;
 
 pub use counters::PathCounters;
+pub use light_trace::{LightTraceError, LightTraceOptions, LightTraced, LightTracer, Roles};
 pub use path::{LightStrategy, Method, PathIntegrator, PathOptions};
 
 /// Why a render could not start.

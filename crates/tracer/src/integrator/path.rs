@@ -27,15 +27,16 @@
 //! estimation through the medium, cosine continuation) and the path walks on in the same
 //! medium. Shadow rays know the medium they start in.
 
-use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
+use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
-use het_estimate::{CoefficientField, Estimator, PreparedEstimator};
+use het_estimate::{CoefficientField, Estimator};
 
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
+use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
-use crate::integrator::probe::{ProbeSampler, probe_within};
+use crate::integrator::probe::probe_within;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
@@ -79,18 +80,6 @@ pub struct PathOptions {
     pub scattering: Scattering,
     /// Most surface interactions per path.
     pub max_depth: u32,
-}
-
-/// BSSRDF data of one translucent object, prepared once per render.
-struct BssrdfObject {
-    family: ProfileFamily,
-    sampler: ProbeSampler,
-    estimator: PreparedEstimator,
-    /// c = 1 − 2·C1(1/η), the normalisation of pbrt-v4's `NormalizedFresnelBxDF` S_w.
-    sw_norm: f64,
-    /// The longest side of the object's bounding box: the extent the probe radii are drawn
-    /// within ([`super::probe::probe_within`]).
-    extent: f64,
 }
 
 /// Per-object data prepared once per render.
@@ -362,19 +351,17 @@ impl<'s> PathIntegrator<'s> {
                     let bssrdf = match method {
                         Method::PathTraced => None,
                         Method::Bssrdf { estimator, profile } => {
-                            let (family, estimator) = t
-                                .prepare_bssrdf(profile, options.scattering, estimator)
-                                .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
-                            let sw_norm =
-                                1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / t.eta);
                             let (lo, hi) = scene.geometry().object_bounds(index as u32);
-                            Some(Box::new(BssrdfObject {
-                                sampler: ProbeSampler::new(family, &t.medium),
-                                family,
-                                estimator,
-                                sw_norm,
-                                extent: (hi - lo).max_element(),
-                            }))
+                            Some(Box::new(
+                                BssrdfObject::new(
+                                    t,
+                                    profile,
+                                    options.scattering,
+                                    estimator,
+                                    (hi - lo).max_element(),
+                                )
+                                .map_err(|(what, e)| RenderError::param(&object.name, what, e))?,
+                            ))
                         }
                     };
                     ObjectKind::Translucent {
@@ -906,10 +893,8 @@ impl<'s> PathIntegrator<'s> {
         if ray.dir.dot(hit.ng) >= 0.0 {
             return Step::Continue(hit.spawn_ray(ray.dir));
         }
-        let n_o = if hit.ns.dot(ray.dir) < 0.0 {
-            hit.ns
-        } else {
-            hit.ng
+        let Some(n_o) = facing_normal(hit, -ray.dir) else {
+            return Step::Continue(hit.spawn_ray(ray.dir));
         };
         if material.eta != 1.0 {
             let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
@@ -940,26 +925,23 @@ impl<'s> PathIntegrator<'s> {
             geometry: self.scene.geometry(),
             object,
         };
-        let eta = material.eta;
-        let sw = |cos: f64| {
-            (1.0 - bssrdf_core::fresnel::dielectric(cos, eta)) / (b.sw_norm * std::f64::consts::PI)
-        };
         // Every hit gathers light; one, chosen uniformly, carries the path on (weight n).
         let carrier = rng.below(set.len() as u32) as usize;
         let mut next = None;
         for (k, ph) in set.iter().enumerate() {
             let x_i = ph.hit;
-            let n_i = x_i.ns;
             let ld = self.direct(
                 x_i.p,
                 |wi| x_i.spawn_origin(wi),
                 |wi| {
-                    let cos = wi.dot(n_i);
-                    if cos > 0.0 {
-                        (sw(cos) * cos, cos / std::f64::consts::PI)
-                    } else {
-                        (0.0, 0.0)
-                    }
+                    // S_w · cos against the continuation's pdf (cosine about the shading
+                    // normal), with the normal rule the light tracer uses too.
+                    let Some(n) = facing_normal(&x_i, wi) else {
+                        return (0.0, 0.0);
+                    };
+                    let cos = wi.dot(n);
+                    let pdf = wi.dot(x_i.ns).max(0.0) / std::f64::consts::PI;
+                    (b.entry_lobe(cos) * cos, pdf)
                 },
                 Channels::All,
                 None,
@@ -970,13 +952,7 @@ impl<'s> PathIntegrator<'s> {
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather: skip the (costly) estimate
             }
-            let est = b
-                .estimator
-                .estimate(&surface, &material.medium, &x_i, hit, rng);
-            counters.record_estimate(&est.diagnostics);
-            let r = (x_i.p - hit.p).length();
-            let c = est.coefficients;
-            let rd = counters.eval_profile(&b.family, c, r);
+            let rd = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
             let w = rd * ph.weight;
             st.l += st.beta * w * ld;
             if k == carrier {
@@ -993,13 +969,76 @@ impl<'s> PathIntegrator<'s> {
         let Some((wi, cos)) = cosine_continuation(x_i.ns, rng) else {
             return Step::Stop;
         };
+        if facing_normal(&x_i, wi).is_none() {
+            // Below the geometric surface: S is 0 there (light cannot arrive from inside).
+            return Step::Stop;
+        }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
-        st.beta *= sw(cos) * std::f64::consts::PI;
+        st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
         st.prev = Prev::Sampled {
             p: x_i.p,
             pdf: cos / std::f64::consts::PI,
         };
         Step::Continue(x_i.spawn_ray(wi))
+    }
+
+    /// The translucent material and BSSRDF data of `object`, when it is rendered with a
+    /// BSSRDF.
+    pub(crate) fn bssrdf_object(&self, object: u32) -> Option<(&'s Translucent, &BssrdfObject)> {
+        match self.objects.get(object as usize)? {
+            ObjectKind::Translucent {
+                material,
+                bssrdf: Some(b),
+                ..
+            } => Some((*material, b.as_ref())),
+            _ => None,
+        }
+    }
+
+    /// The BSSRDF S(x_i, ω_i; x_o, ω_o) this renderer evaluates (1/(length²·sr), per channel;
+    /// see `integrator/bssrdf.rs`): light entering at `x_i` from the direction `w_i` (unit,
+    /// pointing out of the medium toward the light) and leaving at `x_o` toward `w_o` (unit,
+    /// toward the viewer), with the coefficients the method's estimator gives for the pair
+    /// (random numbers from `rng`). `None` unless both points lie on the same object and that
+    /// object is rendered with a BSSRDF (a BSSRDF method, a translucent object). Symmetric
+    /// under (x_i, ω_i) ↔ (x_o, ω_o) for the averaging estimators (docs/reciprocity.md).
+    pub fn evaluate_bssrdf(
+        &self,
+        x_i: &Hit,
+        w_i: DVec3,
+        x_o: &Hit,
+        w_o: DVec3,
+        rng: &mut Rng,
+    ) -> Option<Rgb> {
+        if x_i.object != x_o.object {
+            return None;
+        }
+        let (material, b) = self.bssrdf_object(x_i.object)?;
+        let surface = ObjectSurface {
+            geometry: self.scene.geometry(),
+            object: x_i.object,
+        };
+        let mut counters = PathCounters::default();
+        Some(b.eval(
+            &surface,
+            &material.medium,
+            x_i,
+            w_i,
+            x_o,
+            w_o,
+            rng,
+            &mut counters,
+        ))
+    }
+
+    /// The scene rendered.
+    pub fn scene(&self) -> &'s Scene {
+        self.scene
+    }
+
+    /// The options rendered with.
+    pub fn options(&self) -> PathOptions {
+        self.options
     }
 
     /// The coefficients of object `object` at its surface point `hit` (point lookup).

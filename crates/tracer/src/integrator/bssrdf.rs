@@ -1,0 +1,137 @@
+//! The separable BSSRDF both BSSRDF renderers evaluate (the camera-traced one in
+//! [`super::path`], the light-traced one in [`super::light_trace`]):
+//!
+//! S(x_i, ω_i; x_o, ω_o) = (1 − F_r(cos θ_o)) · R(|x_i − x_o|; σ̄a, σ̄s) · S_w(ω_i),
+//! S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
+//!
+//! (pbrt3 §11.4.1, the separable BSSRDF, with the normalised Fresnel lobe of pbrt-v4's
+//! `NormalizedFresnelBxDF` (key pbrt4, its source); F_r the dielectric
+//! Fresnel reflectance at relative index η, C1 its first moment), with R the material's
+//! diffuse reflectance profile (1/length²) at the homogeneous coefficients σ̄a, σ̄s the
+//! estimator gives for the pair (x_i, x_o). The directions ω_i (toward the light) and ω_o
+//! (toward the viewer) point out of the medium.
+//!
+//! Reciprocity: written as R · (1 − F_r(cos θ_i))(1 − F_r(cos θ_o)) / (c π), S is symmetric
+//! under (x_i, ω_i) ↔ (x_o, ω_o) whenever the estimate is (every averaging estimator;
+//! not the point lookups `jensen-in`/`jensen-out`, see docs/reciprocity.md). Both cosines use
+//! the same rule ([`facing_normal`]), and the product of the two Fresnel factors is formed
+//! before it meets the profile, so the swap gives the same value bit for bit.
+
+use std::f64::consts::PI;
+
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
+use glam::DVec3;
+use het_estimate::{Estimator, PreparedEstimator};
+
+use crate::field::MediumField;
+use crate::geometry::{Hit, ObjectSurface};
+use crate::integrator::counters::PathCounters;
+use crate::integrator::probe::ProbeSampler;
+use crate::rng::Rng;
+use crate::scene::Translucent;
+
+/// BSSRDF data of one translucent object, prepared once per render.
+pub(crate) struct BssrdfObject {
+    /// The profile family R.
+    pub family: ProfileFamily,
+    /// Probe sampling of the other point of a pair around a given one.
+    pub sampler: ProbeSampler,
+    /// How a pair becomes homogeneous coefficients.
+    pub estimator: PreparedEstimator,
+    /// c = 1 − 2·C1(1/η), the normalisation of S_w.
+    sw_norm: f64,
+    /// Relative index of refraction η.
+    eta: f64,
+    /// The longest side of the object's bounding box: the extent the probe radii are drawn
+    /// within ([`super::probe::probe_within`]).
+    pub extent: f64,
+}
+
+impl BssrdfObject {
+    /// Prepares `material` for a BSSRDF render with `estimator` and the profile `profile`
+    /// (or the material's own), for an object whose bounding box's longest side is `extent`;
+    /// the error names the failing part (see [`Translucent::prepare_bssrdf`]).
+    pub fn new(
+        material: &Translucent,
+        profile: Option<ProfileModel>,
+        scattering: Scattering,
+        estimator: Estimator,
+        extent: f64,
+    ) -> Result<Self, (&'static str, bssrdf_core::ParamError)> {
+        let (family, estimator) = material.prepare_bssrdf(profile, scattering, estimator)?;
+        Ok(Self {
+            sampler: ProbeSampler::new(family, &material.medium),
+            family,
+            estimator,
+            sw_norm: 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / material.eta),
+            eta: material.eta,
+            extent,
+        })
+    }
+
+    /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
+    /// (unitless; 1 for η = 1).
+    #[inline]
+    pub fn transmission(&self, cos: f64) -> f64 {
+        1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta)
+    }
+
+    /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π).
+    #[inline]
+    pub fn entry_lobe(&self, cos: f64) -> f64 {
+        self.transmission(cos) / (self.sw_norm * PI)
+    }
+
+    /// R(|x_i − x_o|) (1/length², per channel) at the coefficients the estimator gives for
+    /// the pair, `x_i` the incident point (where light enters) and `x_o` the exitant one;
+    /// the estimate and profile evaluation are recorded in `counters`.
+    pub fn profile(
+        &self,
+        surface: &ObjectSurface<'_>,
+        medium: &MediumField,
+        x_i: &Hit,
+        x_o: &Hit,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Rgb {
+        let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
+        counters.record_estimate(&est.diagnostics);
+        counters.eval_profile(&self.family, est.coefficients, (x_i.p - x_o.p).length())
+    }
+
+    /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs); 0
+    /// when either direction is behind its surface ([`facing_normal`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn eval(
+        &self,
+        surface: &ObjectSurface<'_>,
+        medium: &MediumField,
+        x_i: &Hit,
+        w_i: DVec3,
+        x_o: &Hit,
+        w_o: DVec3,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Rgb {
+        let (Some(n_i), Some(n_o)) = (facing_normal(x_i, w_i), facing_normal(x_o, w_o)) else {
+            return Rgb::ZERO;
+        };
+        let fresnel = self.transmission(w_i.dot(n_i)) * self.transmission(w_o.dot(n_o));
+        self.profile(surface, medium, x_i, x_o, rng, counters) * (fresnel / (self.sw_norm * PI))
+    }
+}
+
+/// The normal the BSSRDF measures the direction `w` (unit, pointing away from the surface)
+/// against at `hit`: `None` when `w` is not in front of the geometric normal (light cannot
+/// cross the surface from there), else the shading normal where `w` is in front of it too,
+/// else the geometric normal. The same rule at x_i and x_o keeps S reciprocal.
+#[inline]
+pub(crate) fn facing_normal(hit: &Hit, w: DVec3) -> Option<DVec3> {
+    if w.dot(hit.ng) <= 0.0 {
+        None
+    } else if w.dot(hit.ns) > 0.0 {
+        Some(hit.ns)
+    } else {
+        Some(hit.ng)
+    }
+}
