@@ -487,6 +487,15 @@ impl MediumField {
         self.artist.as_ref()
     }
 
+    /// The same medium with the estimators inverting an artist's parameters at `invert` (a
+    /// σ medium is returned unchanged).
+    pub fn with_invert(mut self, invert: InvertAt) -> Self {
+        if let Some(map) = self.artist.take() {
+            self.artist = Some(map.with_invert(invert));
+        }
+        self
+    }
+
     /// The medium multiplied by `k` (unit conversion: coefficients per file unit ×
     /// `unit_scale` = per scene unit; an artist's mean free path is divided by `k`).
     pub fn scaled(self, k: f64) -> Self {

@@ -258,6 +258,31 @@ impl Scene {
         Ok(self)
     }
 
+    /// The same scene with every artist material's estimators inverting at `invert`
+    /// (overriding the materials' `invert` keys; σ materials are unchanged).
+    pub fn with_invert(mut self, invert: crate::field::InvertAt) -> Self {
+        for o in &mut self.objects {
+            if let Material::Translucent(t) = &mut o.material {
+                t.medium = t.medium.clone().with_invert(invert);
+            }
+        }
+        self
+    }
+
+    /// Where each artist material's estimators invert, by material name (empty when the scene
+    /// has no artist material), for provenance.
+    pub fn artist_inversions(&self) -> Vec<(String, crate::field::InvertAt)> {
+        let mut out: Vec<(String, crate::field::InvertAt)> = Vec::new();
+        for (_, t) in self.translucent_objects() {
+            if let Some(map) = t.medium.artist_map()
+                && !out.iter().any(|(n, _)| *n == t.name)
+            {
+                out.push((t.name.clone(), map.invert()));
+            }
+        }
+        out
+    }
+
     /// The files read while loading besides the scene file itself: every mesh, and every
     /// texture of a used material (for cache keys and provenance).
     pub fn input_files(&self) -> &[PathBuf] {
