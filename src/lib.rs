@@ -16,5 +16,10 @@ pub mod physics {}
 /// `docs/kernel.md`, cited from the code as `docs/kernel.md#section`).
 #[doc = include_str!("../docs/kernel.md")]
 pub mod kernel {}
+/// Artist parameters (`subsurface_color`, `subsurface_radius`): the colour-to-albedo inversion
+/// per profile, where the estimators invert, the limits and the before/after measurement (the
+/// repository's `docs/artist-parameters.md`).
+#[doc = include_str!("../docs/artist-parameters.md")]
+pub mod artist_parameters {}
 pub use het_estimate;
 pub use tracer;

@@ -5,10 +5,10 @@
 //! `subsurface_color` and `subsurface_radius` (× `subsurface_radius_scale`), with extinction
 //! `μt = 1 / (radius · radius_scale)` (the *unreduced* σt). The single-scattering albedo α that
 //! gives the colour depends on the profile the renderer uses, so, as pbrt-v4 does for its
-//! tabulated BSSRDF (`SubsurfaceFromDiffuse`, pbrt-v4 book §11.4.3 "Subsurface from diffuse"),
-//! this module tabulates the profile's own total diffuse reflectance and inverts it
+//! tabulated BSSRDF (pbrt4's `SubsurfaceFromDiffuse`; pbrt3 §15.5, "Setting Scattering
+//! Properties"), this module tabulates the profile's own total diffuse reflectance and inverts it
 //! numerically, rather than using a fitted closed form (OpenPBR's van de Hulst fit, Christensen
-//! & Burley's polynomial), which is exact for no profile.
+//! & Burley's polynomial: OpenPBR11, CB15), which is exact for no profile.
 //!
 //! # What is inverted
 //! `R_d(α) = ∫₀^∞ 2πr R(r) dr` at σt = 1 (the tabulated profile's interpolated values

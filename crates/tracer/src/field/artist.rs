@@ -30,7 +30,7 @@ impl InvertAt {
     pub const ALL: &'static [InvertAt] = &[InvertAt::Before, InvertAt::After];
 
     /// The default: the one closer to the path tracer on the measured painted scene
-    /// (`docs/artist-parameters.md#before-or-after`).
+    /// (`docs/artist-parameters.md`, "Where to invert").
     pub const DEFAULT: InvertAt = InvertAt::Before;
 
     /// The name used in scene files and on the command line.

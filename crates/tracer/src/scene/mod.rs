@@ -18,8 +18,13 @@
 //! * `[[material]]`: `type = "translucent"` with `name`, `sigma_a`, `sigma_s` (fields, see
 //!   below), `g` (default 0, |g| < 1), `eta` (default 1, ≥ 1), optional `profile`
 //!   (`dipole | pbd | better-dipole | tabulated`; default tabulated where η ≤ 1.6, else pbd), `unit_scale` (default 1: file coefficients × unit_scale =
-//!   1/scene-unit); or `type = "diffuse"` with `name`, `albedo`. Unused materials are validated
-//!   but their textures are not decoded.
+//!   1/scene-unit). Instead of `sigma_a` and `sigma_s`, a translucent material may give the
+//!   artist parameters `subsurface_color` (field, in [0, 1]) and `subsurface_radius` (field,
+//!   mean free path per channel in file units), with optional `radius_scale` (RGB, default 1)
+//!   and `invert = "before" | "after"`; `anisotropy` is another name for `g`
+//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). Or `type =
+//!   "diffuse"` with `name`, `albedo`. Unused materials are validated but their textures are
+//!   not decoded.
 //! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
 //!   `constant` (`value`); `stripe` (`width`, `angle` in degrees, `values = [v0, v1]`, `axis`,
 //!   `origin`); `check` (`width`, `values`, `axis`, `origin`); `image` (`texture`, `mapping =
