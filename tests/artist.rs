@@ -88,7 +88,7 @@ fn mean_and_se_rgb(scene: &Scene, method: Method, spp: u32, seeds: u64) -> (Rgb,
     for x in &means {
         m += *x;
     }
-    m = m * (1.0 / seeds as f64);
+    m *= 1.0 / seeds as f64;
     let mut var = Rgb::ZERO;
     for x in &means {
         let d = *x - m;
@@ -242,7 +242,7 @@ fn painted_box_renders_under_every_estimator() {
         .unwrap();
         let mut t = Translucent::new("painted", medium, 0.0, 1.0);
         t.profile = Some(model);
-        let scene = SceneBuilder::new(RenderSettings::new(n, n, 1), camera.clone())
+        let scene = SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
             .light(Light::environment(Rgb::ONE).unwrap())
             .object(
                 "box",

@@ -170,7 +170,7 @@ impl PreparedEstimator {
     /// any lookup or projection ([`crate::Diagnostics::short_circuit`]); components that the
     /// bounds show to be constant are not averaged. Fields with their own averaging space
     /// ([`CoefficientField::averaged`]) are averaged there and each mean is mapped back with
-    /// [`CoefficientField::from_average`].
+    /// [`CoefficientField::coefficients_of_mean`].
     #[inline]
     pub fn estimate<S, F, U>(
         &self,

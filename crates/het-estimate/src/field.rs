@@ -113,7 +113,7 @@ pub trait CoefficientField<P> {
     /// σs are averaged). A field whose coefficients are a nonlinear function of other
     /// quantities may average those instead (e.g. an artist's colour and mean free path,
     /// inverted to σa, σs only after averaging: `docs/artist-parameters.md`); it then
-    /// overrides [`CoefficientField::from_average`] to map a mean back to coefficients, and
+    /// overrides [`CoefficientField::coefficients_of_mean`] to map a mean back to coefficients, and
     /// returns [`CoefficientField::bounds`] and [`CoefficientField::ellipse_average`] in the
     /// averaging space too. Values must be finite and non-negative.
     #[inline]
@@ -126,7 +126,7 @@ pub trait CoefficientField<P> {
     /// kernel's weights, the final estimate) through this. Must return finite, non-negative
     /// coefficients for finite, non-negative input.
     #[inline]
-    fn from_average(&self, mean: Coefficients) -> Coefficients {
+    fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         mean
     }
 
@@ -157,8 +157,8 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
         (**self).averaged(p)
     }
     #[inline]
-    fn from_average(&self, mean: Coefficients) -> Coefficients {
-        (**self).from_average(mean)
+    fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
+        (**self).coefficients_of_mean(mean)
     }
     fn averages_coefficients(&self) -> bool {
         (**self).averages_coefficients()

@@ -225,10 +225,10 @@ where
         sanitise(self.field.averaged(p))
     }
 
-    /// The coefficients of a mean in the averaging space ([`CoefficientField::from_average`]).
+    /// The coefficients of a mean in the averaging space ([`CoefficientField::coefficients_of_mean`]).
     #[inline]
     pub fn to_coefficients(&self, mean: Coefficients) -> Coefficients {
-        sanitise(self.field.from_average(mean))
+        sanitise(self.field.coefficients_of_mean(mean))
     }
 
     /// The chord x_i → x_o and its averaging-plane normal, recording the normal fallback in the

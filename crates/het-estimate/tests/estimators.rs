@@ -1091,13 +1091,13 @@ fn averaging_estimators_are_reciprocal_on_a_curved_surface() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The optional averaging space (`CoefficientField::averaged` / `from_average`).
+// The optional averaging space (`CoefficientField::averaged` / `coefficients_of_mean`).
 
 /// A stripe field whose coefficients are twice the stored values, stated in two ways: `Direct`
 /// returns 2·v as coefficients; `Halved` averages v and maps each mean m to 2·m. Doubling is
 /// exact in floating point, so every estimator must give bit-identical results for the two
 /// if and only if it maps every mean it uses (widths, weights, fallbacks, the result) through
-/// `from_average` and nothing else.
+/// `coefficients_of_mean` and nothing else.
 struct Doubled {
     stripes: StripeField,
     averaging_space: bool,
@@ -1145,7 +1145,7 @@ impl CoefficientField<PlanePoint> for Doubled {
             self.coefficients(p)
         }
     }
-    fn from_average(&self, mean: Coefficients) -> Coefficients {
+    fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         if self.averaging_space {
             Self::double(mean)
         } else {

@@ -646,7 +646,7 @@ impl CoefficientField<Hit> for MediumField {
     }
 
     #[inline]
-    fn from_average(&self, mean: Coefficients) -> Coefficients {
+    fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         if self.inverts_after() {
             self.to_sigma(mean)
         } else {
