@@ -22,7 +22,7 @@ mod artist;
 mod texture;
 mod texture_mapping;
 
-pub use artist::{ArtistMap, InvertAt};
+pub use artist::{ArtistMap, InvertAt, MFP_FLOOR_FRACTION};
 pub use texture::{Filter, Texture, Wrap};
 pub use texture_mapping::{Axis, PlanarProjection};
 
