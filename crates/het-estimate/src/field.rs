@@ -130,9 +130,10 @@ pub trait CoefficientField<P> {
         mean
     }
 
-    /// False when [`CoefficientField::averaged`] is not σa, σs: estimators then take plain
-    /// arithmetic means (the kernel estimator's power mean of σa is specific to σa). Default:
-    /// true.
+    /// False when [`CoefficientField::averaged`] is not σa, σs. Estimators then map means
+    /// through [`CoefficientField::coefficients_of_mean`] (which they skip, at no cost, when
+    /// this is true: override the three methods together) and take plain arithmetic means
+    /// (the kernel estimator's power mean of σa is specific to σa). Default: true.
     #[inline]
     fn averages_coefficients(&self) -> bool {
         true

@@ -225,10 +225,16 @@ where
         sanitise(self.field.averaged(p))
     }
 
-    /// The coefficients of a mean in the averaging space ([`CoefficientField::coefficients_of_mean`]).
+    /// The coefficients of a mean in the averaging space
+    /// ([`CoefficientField::coefficients_of_mean`]); the mean itself, at no cost, for fields
+    /// that average their coefficients.
     #[inline]
     pub fn to_coefficients(&self, mean: Coefficients) -> Coefficients {
-        sanitise(self.field.coefficients_of_mean(mean))
+        if self.field.averages_coefficients() {
+            mean
+        } else {
+            sanitise(self.field.coefficients_of_mean(mean))
+        }
     }
 
     /// The chord x_i → x_o and its averaging-plane normal, recording the normal fallback in the

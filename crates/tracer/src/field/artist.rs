@@ -141,6 +141,12 @@ impl ArtistMap {
         out
     }
 
+    /// [`ArtistMap::coefficients`], not inlined (for callers whose other path is hot).
+    #[inline(never)]
+    pub(crate) fn coefficients_out_of_line(&self, raw: Coefficients) -> Coefficients {
+        self.coefficients(raw)
+    }
+
     /// Bounds of σa and σs from the bounds of colour and mean free path: α grows with the
     /// colour and σt = 1/mfp falls with the mean free path, so the extremes are at corners.
     pub(crate) fn bounds(&self, raw: &FieldBounds) -> FieldBounds {

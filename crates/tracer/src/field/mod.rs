@@ -511,11 +511,14 @@ impl MediumField {
         }
     }
 
+    /// σa and σs of the two fields' values: the values themselves for a σ medium (one
+    /// predictable branch; the artist path is kept out of line so that it does not weigh on
+    /// the σ path's inlining).
     #[inline]
     fn to_sigma(&self, raw: Coefficients) -> Coefficients {
         match &self.artist {
             None => raw,
-            Some(map) => map.coefficients(raw),
+            Some(map) => map.coefficients_out_of_line(raw),
         }
     }
 
@@ -638,10 +641,11 @@ impl CoefficientField<Hit> for MediumField {
     /// otherwise.
     #[inline]
     fn averaged(&self, p: &Hit) -> Coefficients {
-        if self.inverts_after() {
-            self.raw_at_surface(p.p, p.uv)
-        } else {
-            self.at_surface(p.p, p.uv)
+        let raw = self.raw_at_surface(p.p, p.uv);
+        match &self.artist {
+            None => raw,
+            Some(map) if map.invert() == InvertAt::After => raw,
+            Some(map) => map.coefficients_out_of_line(raw),
         }
     }
 
@@ -654,6 +658,7 @@ impl CoefficientField<Hit> for MediumField {
         }
     }
 
+    #[inline]
     fn averages_coefficients(&self) -> bool {
         !self.inverts_after()
     }
