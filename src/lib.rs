@@ -22,5 +22,11 @@ pub mod kernel {}
 /// `docs/reciprocity.md`).
 #[doc = include_str!("../docs/reciprocity.md")]
 pub mod reciprocity {}
+
+/// Artist parameters (`subsurface_color`, `subsurface_radius`): the colour-to-albedo inversion
+/// per profile, where the estimators invert, the limits and the before/after measurement (the
+/// repository's `docs/artist-parameters.md`).
+#[doc = include_str!("../docs/artist-parameters.md")]
+pub mod artist_parameters {}
 pub use het_estimate;
 pub use tracer;

@@ -72,3 +72,13 @@ pub fn profile() -> Choice<ProfileModel> {
 pub fn scattering() -> Choice<Scattering> {
     by_name(Scattering::ALL.iter().map(|m| m.name()).collect())
 }
+
+/// Where estimators invert artist materials (`before`, `after`).
+pub fn invert() -> Choice<tracer::field::InvertAt> {
+    by_name(
+        tracer::field::InvertAt::ALL
+            .iter()
+            .map(|i| i.name())
+            .collect(),
+    )
+}

@@ -56,6 +56,11 @@ pub struct Args {
     /// has them and the surface is flat, sampling elsewhere) or `monte-carlo` (always sample).
     #[arg(long, value_parser = crate::choices::averaging())]
     averaging: Option<het_estimate::Averaging>,
+    /// Where the estimators invert artist materials' colours and radii: `before` averaging
+    /// (per point) or `after` (default: each material's `invert`; see
+    /// docs/artist-parameters.md).
+    #[arg(long, value_parser = crate::choices::invert())]
+    invert: Option<tracer::field::InvertAt>,
     /// Samples per pixel (default: the scene's `render.spp`).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     spp: Option<u64>,
@@ -101,6 +106,10 @@ pub struct Args {
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = Scene::load(&args.scene)?;
+    let scene = match args.invert {
+        Some(at) => scene.with_invert(at),
+        None => scene,
+    };
     let method = match args.method {
         Some(m) => m,
         None => Method::Bssrdf {

@@ -277,6 +277,11 @@ pub fn write_render(
         "profile": profile,
         "estimator_parameters": estimator,
         "averaging": job.method.averaging().map(|a| a.name()),
+        "artist_invert": scene
+            .artist_inversions()
+            .into_iter()
+            .map(|(name, at)| (name, serde_json::Value::from(at.name())))
+            .collect::<serde_json::Map<_, _>>(),
         "scattering": job.scattering.name(),
         "spp": outcome.spp,
         "time_budget_seconds": match job.budget {

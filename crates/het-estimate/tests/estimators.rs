@@ -1089,3 +1089,128 @@ fn averaging_estimators_are_reciprocal_on_a_curved_surface() {
         "the test field never distinguishes the two points"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// The optional averaging space (`CoefficientField::averaged` / `coefficients_of_mean`).
+
+/// A stripe field whose coefficients are twice the stored values, stated in two ways: `Direct`
+/// returns 2·v as coefficients; `Halved` averages v and maps each mean m to 2·m. Doubling is
+/// exact in floating point, so every estimator must give bit-identical results for the two
+/// if and only if it maps every mean it uses (widths, weights, fallbacks, the result) through
+/// `coefficients_of_mean` and nothing else.
+struct Doubled {
+    stripes: StripeField,
+    averaging_space: bool,
+}
+
+impl Doubled {
+    fn double(c: Coefficients) -> Coefficients {
+        Coefficients {
+            sigma_a: c.sigma_a * 2.0,
+            sigma_s: c.sigma_s * 2.0,
+        }
+    }
+}
+
+impl CoefficientField<PlanePoint> for Doubled {
+    fn coefficients(&self, p: &PlanePoint) -> Coefficients {
+        Self::double(self.stripes.coefficients(p))
+    }
+    fn bounds(&self) -> Option<het_estimate::FieldBounds> {
+        let b = self.stripes.bounds()?;
+        Some(if self.averaging_space {
+            b
+        } else {
+            het_estimate::FieldBounds {
+                min: Self::double(b.min),
+                max: Self::double(b.max),
+            }
+        })
+    }
+    fn ellipse_average(&self, e: &het_estimate::PlanarEllipse) -> Option<Coefficients> {
+        let m = self.stripes.ellipse_average(e)?;
+        Some(if self.averaging_space {
+            m
+        } else {
+            Self::double(m)
+        })
+    }
+    fn has_ellipse_average(&self) -> bool {
+        true
+    }
+    fn averaged(&self, p: &PlanePoint) -> Coefficients {
+        if self.averaging_space {
+            self.stripes.coefficients(p)
+        } else {
+            self.coefficients(p)
+        }
+    }
+    fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
+        if self.averaging_space {
+            Self::double(mean)
+        } else {
+            mean
+        }
+    }
+    fn averages_coefficients(&self) -> bool {
+        !self.averaging_space
+    }
+}
+
+#[test]
+fn averaging_space_means_are_mapped_back_everywhere() {
+    let stripes = StripeField {
+        pattern: Stripe {
+            width: 1.5,
+            angle: 0.4,
+        },
+        values: [
+            Coefficients {
+                sigma_a: Rgb::new(0.01, 0.02, 0.03),
+                sigma_s: Rgb::new(1.0, 0.5, 2.0),
+            },
+            Coefficients {
+                sigma_a: Rgb::new(0.2, 0.1, 0.05),
+                sigma_s: Rgb::new(0.3, 1.5, 0.7),
+            },
+        ],
+    };
+    let direct = Doubled {
+        stripes,
+        averaging_space: false,
+    };
+    let mapped = Doubled {
+        stripes,
+        averaging_space: true,
+    };
+    // The kernel's power mean is specific to σa: fields with their own averaging space get
+    // arithmetic means, so compare with exponent 1.
+    let mut estimators: Vec<Estimator> = <Estimator as Named>::ALL
+        .iter()
+        .copied()
+        .filter(|e| !matches!(e, Estimator::Kernel(_)))
+        .collect();
+    estimators.push(Estimator::Kernel(KernelParams::new().with_exponent(1.0)));
+    estimators.push(Estimator::Sone(
+        SoneParams::paper().with_averaging(Averaging::MonteCarlo),
+    ));
+    for est in estimators {
+        let prepared = est.prepare(0.2, 1.3).unwrap();
+        for (k, (a, b)) in [
+            ((0.1, 0.2), (1.9, -0.7)),
+            ((0.0, 0.0), (0.3, 0.1)),
+            ((-2.0, 1.0), (-2.0, 1.0)),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let (x_i, x_o) = (PlanePoint::new(a.0, a.1), PlanePoint::new(b.0, b.1));
+            let one =
+                prepared.estimate(&Plane, &direct, &x_i, &x_o, &mut SplitMix64::new(k as u64));
+            let two =
+                prepared.estimate(&Plane, &mapped, &x_i, &x_o, &mut SplitMix64::new(k as u64));
+            assert_eq!(one.coefficients, two.coefficients, "{est:?} pair {k}");
+            assert!(one.coefficients.is_valid());
+        }
+    }
+}

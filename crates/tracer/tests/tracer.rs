@@ -2,6 +2,8 @@
 // Channel loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
+#[path = "tracer/artist.rs"]
+mod artist;
 #[path = "tracer/common.rs"]
 mod common;
 #[path = "tracer/direct_lighting.rs"]

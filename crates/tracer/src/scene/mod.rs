@@ -18,8 +18,13 @@
 //! * `[[material]]`: `type = "translucent"` with `name`, `sigma_a`, `sigma_s` (fields, see
 //!   below), `g` (default 0, |g| < 1), `eta` (default 1, ≥ 1), optional `profile`
 //!   (`dipole | pbd | better-dipole | tabulated`; default tabulated where η ≤ 1.6, else pbd), `unit_scale` (default 1: file coefficients × unit_scale =
-//!   1/scene-unit); or `type = "diffuse"` with `name`, `albedo`. Unused materials are validated
-//!   but their textures are not decoded.
+//!   1/scene-unit). Instead of `sigma_a` and `sigma_s`, a translucent material may give the
+//!   artist parameters `subsurface_color` (field, in [0, 1]) and `subsurface_radius` (field,
+//!   mean free path per channel in file units), with optional `radius_scale` (RGB, default 1)
+//!   and `invert = "before" | "after"`; `anisotropy` is another name for `g`
+//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). Or `type =
+//!   "diffuse"` with `name`, `albedo`. Unused materials are validated but their textures are
+//!   not decoded.
 //! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
 //!   `constant` (`value`); `stripe` (`width`, `angle` in degrees, `values = [v0, v1]`, `axis`,
 //!   `origin`); `check` (`width`, `values`, `axis`, `origin`); `image` (`texture`, `mapping =
@@ -258,6 +263,31 @@ impl Scene {
         Ok(self)
     }
 
+    /// The same scene with every artist material's estimators inverting at `invert`
+    /// (overriding the materials' `invert` keys; σ materials are unchanged).
+    pub fn with_invert(mut self, invert: crate::field::InvertAt) -> Self {
+        for o in &mut self.objects {
+            if let Material::Translucent(t) = &mut o.material {
+                t.medium = t.medium.clone().with_invert(invert);
+            }
+        }
+        self
+    }
+
+    /// Where each artist material's estimators invert, by material name (empty when the scene
+    /// has no artist material), for provenance.
+    pub fn artist_inversions(&self) -> Vec<(String, crate::field::InvertAt)> {
+        let mut out: Vec<(String, crate::field::InvertAt)> = Vec::new();
+        for (_, t) in self.translucent_objects() {
+            if let Some(map) = t.medium.artist_map()
+                && !out.iter().any(|(n, _)| *n == t.name)
+            {
+                out.push((t.name.clone(), map.invert()));
+            }
+        }
+        out
+    }
+
     /// The files read while loading besides the scene file itself: every mesh, and every
     /// texture of a used material (for cache keys and provenance).
     pub fn input_files(&self) -> &[PathBuf] {
@@ -328,10 +358,7 @@ impl Scene {
     /// surface (a UV-mapped image): a volumetric render needs coefficients in the volume.
     pub fn require_volumetric(&self) -> Result<(), SceneError> {
         for (_, t) in self.translucent_objects() {
-            for (which, f) in [
-                ("sigma_a", t.medium.sigma_a()),
-                ("sigma_s", t.medium.sigma_s()),
-            ] {
+            for (which, f) in t.medium.named_fields() {
                 if !f.is_volumetric() {
                     return Err(self.invalid(
                         format!("{}.{which}", t.key),

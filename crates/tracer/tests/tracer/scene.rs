@@ -294,7 +294,7 @@ fn full_scene_loads() {
 }
 
 /// Loads `text` as `bad.toml` in a directory holding the full scene's assets.
-fn load_err(text: &str) -> SceneError {
+pub(crate) fn load_err(text: &str) -> SceneError {
     let dir = tempfile::tempdir().unwrap();
     write_assets(dir.path());
     let p = dir.path().join("bad.toml");
@@ -307,7 +307,7 @@ fn load_err(text: &str) -> SceneError {
 
 /// Asserts the error names bad.toml and `key`, and its cause chain contains `words` (the
 /// message itself does not repeat its source, which `source()` returns).
-fn check(e: &SceneError, key: &str, words: &[&str]) {
+pub(crate) fn check(e: &SceneError, key: &str, words: &[&str]) {
     let mut msg = e.to_string();
     let mut cause = std::error::Error::source(e);
     while let Some(c) = cause {
@@ -322,7 +322,7 @@ fn check(e: &SceneError, key: &str, words: &[&str]) {
     }
 }
 
-const MINIMAL: &str = r#"
+pub(crate) const MINIMAL: &str = r#"
 [render]
 width = 8
 height = 8
