@@ -1,0 +1,140 @@
+//! Reading glTF materials: the translucent-volume extensions of `examples/models/jade.gltf`
+//! (written by `scripts/make_gltf_jade.py`), the split by material, the base-colour image,
+//! and the errors for out-of-range values.
+
+use std::path::PathBuf;
+
+use tracer::field::Wrap;
+use tracer::geometry::gltf::load_gltf_parts;
+
+fn jade() -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/models/jade.gltf")
+}
+
+#[test]
+fn jade_reads_its_volume_extensions_per_material() {
+    let model = load_gltf_parts(&jade()).unwrap();
+    assert_eq!(model.parts.len(), 2);
+    let (jade, stand) = (&model.parts[0], &model.parts[1]);
+    // The script's sphere: 16 stacks × 32 slices, two triangles a quad except at the poles.
+    assert_eq!(jade.mesh.triangles.len(), 2 * 32 * 15);
+    assert_eq!(stand.mesh.triangles.len(), 2);
+    let m = &jade.material;
+    assert_eq!(m.name, "jade");
+    let v = m.volume.expect("KHR_materials_volume");
+    assert_eq!(v.thickness, 1.0);
+    assert!((v.attenuation_distance - 0.25).abs() < 1e-12);
+    assert_eq!(v.attenuation_color, [0.5, 0.8, 0.6]);
+    assert_eq!(m.diffuse_transmission.map(|d| d.factor), Some(1.0));
+    assert!((m.ior - 1.3).abs() < 1e-12);
+    assert!(m.volume_scatter.is_none());
+    let tex = m.base_color_texture.as_ref().expect("baseColorTexture");
+    // wrapS repeat, wrapT clamp: anything but clamp in both reads as repeat.
+    assert_eq!(tex.wrap, Wrap::Repeat);
+    // roughnessFactor is not read, but a non-default roughness is not an error either.
+    assert!(m.ignored.is_empty(), "{:?}", m.ignored);
+    let s = &stand.material;
+    assert_eq!(s.base_color, [0.5, 0.5, 0.5]);
+    assert!(s.volume.is_none() && s.base_color_texture.is_none());
+}
+
+#[test]
+fn jade_base_colour_image_decodes_from_srgb() {
+    let model = load_gltf_parts(&jade()).unwrap();
+    let t = model.decode_image(0).unwrap();
+    assert_eq!((t.width, t.height), (64, 32));
+    // The script's vein formula, evaluated here independently: linear colour, then the
+    // 8-bit sRGB round trip of the PNG (tolerance: half a code value, through sRGB's slope).
+    let expect = |i: u32, j: u32| {
+        let (u, v) = (i as f64 / 64.0, j as f64 / 32.0);
+        let tau = std::f64::consts::TAU;
+        let s = (tau * (2.0 * u + 0.35 * (tau * v).sin())).sin().abs();
+        let t = (s / 0.25).min(1.0);
+        let (green, dark) = ([0.45, 0.80, 0.55], [0.12, 0.25, 0.15]);
+        [0, 1, 2].map(|k| dark[k] + (green[k] - dark[k]) * t)
+    };
+    for (i, j) in [(0, 0), (5, 3), (17, 20), (40, 31), (63, 16)] {
+        let got = t.texel(i, j);
+        let want = expect(i, j);
+        for c in 0..3 {
+            let tol = 0.5 / 255.0 * 12.92f64.max(1.0) * want[c].max(0.05) + 1e-3;
+            assert!(
+                (got[c] as f64 - want[c]).abs() < tol,
+                "texel ({i}, {j}) channel {c}: {} vs {}",
+                got[c],
+                want[c]
+            );
+        }
+    }
+    // A missing image is an error naming the file.
+    let e = model.decode_image(7).unwrap_err().to_string();
+    assert!(e.contains("jade.gltf") && e.contains("image 7"), "{e}");
+}
+
+/// jade.gltf with `from` replaced by `to` (once), written to a temporary directory.
+fn edited(from: &str, to: &str) -> (tempfile::TempDir, PathBuf) {
+    let text = std::fs::read_to_string(jade()).unwrap();
+    assert!(text.contains(from), "jade.gltf no longer contains {from:?}");
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("edited.gltf");
+    std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
+    (dir, p)
+}
+
+#[test]
+fn out_of_range_material_values_name_the_field() {
+    for (from, to, field) in [
+        (
+            "\"attenuationDistance\": 0.25",
+            "\"attenuationDistance\": -1",
+            "KHR_materials_volume.attenuationDistance",
+        ),
+        ("\"ior\": 1.3", "\"ior\": 0.5", "KHR_materials_ior.ior"),
+        (
+            "\"attenuationColor\": [\n      0.5,",
+            "\"attenuationColor\": [\n      1.5,",
+            "KHR_materials_volume.attenuationColor",
+        ),
+        (
+            "\"diffuseTransmissionFactor\": 1.0",
+            "\"diffuseTransmissionFactor\": \"a lot\"",
+            "diffuseTransmissionFactor",
+        ),
+    ] {
+        let (_dir, p) = edited(from, to);
+        let e = load_gltf_parts(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("edited.gltf") && e.contains(field) && e.contains("jade"),
+            "{field}: {e}"
+        );
+    }
+}
+
+#[test]
+fn unread_extensions_and_textures_are_listed_and_scatter_drafts_read() {
+    let (_dir, p) = edited(
+        "\"KHR_materials_ior\": {",
+        "\"KHR_materials_clearcoat\": {\"clearcoatFactor\": 1},
+        \"KHR_materials_scatter\": {\"multiscatterColorFactor\": [0.9, 0.6, 0.3],
+            \"scatterStrengthFactor\": 0.5, \"scatterAnisotropy\": 0.4,
+            \"multiscatterColorTexture\": {\"index\": 0}},
+        \"KHR_materials_ior\": {",
+    );
+    let model = load_gltf_parts(&p).unwrap();
+    let m = &model.parts[0].material;
+    assert!(
+        m.ignored.iter().any(|s| s == "KHR_materials_clearcoat"),
+        "{:?}",
+        m.ignored
+    );
+    assert!(
+        m.ignored
+            .iter()
+            .any(|s| s == "KHR_materials_scatter.multiscatterColorTexture"),
+        "{:?}",
+        m.ignored
+    );
+    let s = m.volume_scatter.expect("KHR_materials_scatter");
+    assert_eq!(s.multiscatter_color, [0.45, 0.3, 0.15]);
+    assert_eq!(s.anisotropy, 0.4);
+}
