@@ -338,3 +338,173 @@ fn ignore_textures(v: &Value, keys: &[&str], ext: &str, ignored: &mut Vec<String
         }
     }
 }
+
+/// Where a translucent glTF material's colour comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum GltfColour {
+    /// A constant linear RGB colour.
+    Constant([f64; 3]),
+    /// `factor` times the image of `texture`, read through texture coordinate set 0.
+    Texture {
+        /// The base colour factor.
+        factor: [f64; 3],
+        /// The base colour texture.
+        texture: GltfTextureRef,
+    },
+}
+
+/// What the project renders for a glTF material ([`GltfMaterial::interpret`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum GltfInterpretation {
+    /// A translucent volume in artist parameters: `colour` is the multiple-scattering
+    /// albedo (`subsurface_color`), `mean_free_path` the per-channel 1/σt in file units
+    /// (`subsurface_radius`), `anisotropy` the HG g, `eta` the relative index.
+    Translucent {
+        /// `subsurface_color`.
+        colour: GltfColour,
+        /// `subsurface_radius` (file units).
+        mean_free_path: [f64; 3],
+        /// HG g.
+        anisotropy: f64,
+        /// Relative index of refraction.
+        eta: f64,
+    },
+    /// A clear absorbing volume (no scattering): σa per file unit, index `eta`.
+    Absorbing {
+        /// σa (1/file unit).
+        sigma_a: [f64; 3],
+        /// Relative index of refraction.
+        eta: f64,
+    },
+    /// An opaque diffuse surface of this albedo.
+    Diffuse {
+        /// Lambertian albedo.
+        albedo: [f64; 3],
+    },
+}
+
+/// The longest mean free path a channel gets, in attenuation distances, when its
+/// attenuation colour is white (σt = 0 would make the channel transparent, which an artist
+/// medium cannot express).
+pub const MAX_MEAN_FREE_PATH_IN_DISTANCES: f64 = 1e6;
+
+impl GltfMaterial {
+    /// How the project reads this material, and notes on what it does not use (for the
+    /// loader's warnings). The rules (`docs/gltf.md`):
+    ///
+    /// * A volume (`KHR_materials_volume` with `thicknessFactor` > 0 and a finite
+    ///   `attenuationDistance` d) is translucent when it also scatters: with a scattering
+    ///   draft its colour is the draft's multi-scatter colour, with
+    ///   `KHR_materials_diffuse_transmission` it is the base colour (factor × texture). Its
+    ///   extinction follows the scattering drafts: σt = −ln(attenuationColor)/d per channel,
+    ///   so the mean free path is d / −ln(attenuationColor).
+    /// * A volume without either is a clear absorbing dielectric: σa = −ln(attenuationColor)/d,
+    ///   σs = 0 (the path tracer renders it; BSSRDF methods see no subsurface light).
+    /// * Anything else, thin-walled volumes included, is an opaque diffuse surface of the base
+    ///   colour factor.
+    pub fn interpret(&self) -> (GltfInterpretation, Vec<String>) {
+        let mut notes: Vec<String> = self
+            .ignored
+            .iter()
+            .map(|s| format!("`{s}` is not read"))
+            .collect();
+        let eta = self.ior;
+        let volume = self
+            .volume
+            .filter(|v| v.thickness > 0.0 && v.attenuation_distance.is_finite());
+        let base_colour = || match &self.base_color_texture {
+            Some(t) => GltfColour::Texture {
+                factor: self.base_color,
+                texture: t.clone(),
+            },
+            None => GltfColour::Constant(self.base_color),
+        };
+        let diffuse = |notes: &mut Vec<String>| {
+            if self.base_color_texture.is_some() {
+                notes.push(
+                    "baseColorTexture is not read on an opaque surface (diffuse surfaces take \
+                     a constant albedo; the base colour factor is used)"
+                        .to_string(),
+                );
+            }
+            GltfInterpretation::Diffuse {
+                albedo: self.base_color,
+            }
+        };
+        let Some(v) = volume else {
+            if let Some(v) = self.volume {
+                notes.push(if v.thickness <= 0.0 {
+                    "KHR_materials_volume with thicknessFactor 0 is thin-walled: rendered as \
+                     an opaque diffuse surface"
+                        .to_string()
+                } else {
+                    "KHR_materials_volume without a finite attenuationDistance gives no \
+                     scattering scale: rendered as an opaque diffuse surface"
+                        .to_string()
+                });
+            }
+            if self.diffuse_transmission.is_some() || self.volume_scatter.is_some() {
+                notes.push(
+                    "diffuse transmission and scattering need a volume (KHR_materials_volume \
+                     with thicknessFactor > 0 and a finite attenuationDistance): not rendered"
+                        .to_string(),
+                );
+            }
+            return (diffuse(&mut notes), notes);
+        };
+        let d = v.attenuation_distance;
+        // −ln(c) per channel, with white channels capped (see MAX_MEAN_FREE_PATH_IN_DISTANCES)
+        // and black ones floored at the smallest positive colour.
+        let optical = v
+            .attenuation_color
+            .map(|c| (-(c.max(f64::MIN_POSITIVE)).ln()).max(1.0 / MAX_MEAN_FREE_PATH_IN_DISTANCES));
+        if v.attenuation_color.contains(&1.0) {
+            notes.push(format!(
+                "attenuationColor is white in some channel: that channel's mean free path is \
+                 capped at {MAX_MEAN_FREE_PATH_IN_DISTANCES:e} attenuation distances"
+            ));
+        }
+        let mean_free_path = optical.map(|o| d / o);
+        let interpretation = if let Some(s) = self.volume_scatter {
+            if self.base_color_texture.is_some() {
+                notes.push(
+                    "baseColorTexture is not read: with a scattering extension the volume's \
+                     colour is its multi-scatter colour"
+                        .to_string(),
+                );
+            }
+            GltfInterpretation::Translucent {
+                colour: GltfColour::Constant(s.multiscatter_color),
+                mean_free_path,
+                anisotropy: s.anisotropy,
+                eta,
+            }
+        } else if self.diffuse_transmission.is_some_and(|t| t.factor > 0.0) {
+            let t = self.diffuse_transmission.unwrap_or(DiffuseTransmissionExt {
+                factor: 0.0,
+                color: [1.0; 3],
+            });
+            if t.factor < 1.0 || t.color != [1.0; 3] {
+                notes.push(format!(
+                    "diffuseTransmissionFactor {} and diffuseTransmissionColorFactor {:?} are \
+                     not read: the whole surface is the boundary of the scattering volume",
+                    t.factor, t.color
+                ));
+            }
+            GltfInterpretation::Translucent {
+                colour: base_colour(),
+                mean_free_path,
+                anisotropy: 0.0,
+                eta,
+            }
+        } else {
+            GltfInterpretation::Absorbing {
+                sigma_a: v
+                    .attenuation_color
+                    .map(|c| (-(c.max(f64::MIN_POSITIVE)).ln()).max(0.0) / d),
+                eta,
+            }
+        };
+        (interpretation, notes)
+    }
+}

@@ -138,3 +138,59 @@ fn unread_extensions_and_textures_are_listed_and_scatter_drafts_read() {
     assert_eq!(s.multiscatter_color, [0.45, 0.3, 0.15]);
     assert_eq!(s.anisotropy, 0.4);
 }
+
+#[test]
+fn materials_are_interpreted_as_translucent_absorbing_or_diffuse() {
+    use tracer::geometry::gltf_material::{GltfColour, GltfInterpretation};
+    let model = load_gltf_parts(&jade()).unwrap();
+    // jade: volume + diffuse transmission → translucent, base colour texture as its colour,
+    // mean free path d / −ln(attenuationColor).
+    let (jade, notes) = model.parts[0].material.interpret();
+    let GltfInterpretation::Translucent {
+        colour,
+        mean_free_path,
+        anisotropy,
+        eta,
+    } = jade
+    else {
+        panic!("jade: {jade:?}");
+    };
+    assert!(matches!(
+        colour,
+        GltfColour::Texture {
+            factor: [1.0, 1.0, 1.0],
+            ..
+        }
+    ));
+    for (got, c) in mean_free_path.iter().zip([0.5f64, 0.8, 0.6]) {
+        assert!((got - 0.25 / -c.ln()).abs() < 1e-12, "{mean_free_path:?}");
+    }
+    assert_eq!((anisotropy, eta), (0.0, 1.3));
+    assert!(notes.is_empty(), "{notes:?}");
+    // stand: no volume → diffuse of its base colour factor.
+    let (stand, _) = model.parts[1].material.interpret();
+    assert_eq!(stand, GltfInterpretation::Diffuse { albedo: [0.5; 3] });
+
+    // Thin-walled (thickness 0) → diffuse, with a note saying why.
+    let (_d, p) = edited("\"thicknessFactor\": 1.0", "\"thicknessFactor\": 0.0");
+    let (m, notes) = load_gltf_parts(&p).unwrap().parts[0].material.interpret();
+    assert!(matches!(m, GltfInterpretation::Diffuse { .. }), "{m:?}");
+    assert!(notes.iter().any(|n| n.contains("thin-walled")), "{notes:?}");
+
+    // Without diffuse transmission: a clear absorbing volume, σa = −ln(c)/d.
+    let (_d, p) = edited(
+        "\"KHR_materials_diffuse_transmission\": {",
+        "\"KHR_materials_not_diffuse_transmission\": {",
+    );
+    let (m, notes) = load_gltf_parts(&p).unwrap().parts[0].material.interpret();
+    let GltfInterpretation::Absorbing { sigma_a, eta } = m else {
+        panic!("{m:?}");
+    };
+    assert!((sigma_a[1] - -0.8f64.ln() / 0.25).abs() < 1e-12 && eta == 1.3);
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("KHR_materials_not_diffuse_transmission")),
+        "{notes:?}"
+    );
+}
