@@ -150,6 +150,11 @@ pub fn load_gltf_parts(path: &Path) -> Result<GltfModel, MeshError> {
 }
 
 impl GltfModel {
+    /// The file it was read from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
     /// Decodes image `index` of the file (8- and 16-bit images from sRGB, as glTF specifies
     /// for base colour; float images linear). The texture is named `file#image[index]`.
     pub fn decode_image(&self, index: usize) -> Result<Texture, TextureError> {
