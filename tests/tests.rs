@@ -1,5 +1,6 @@
 //! Workspace integration tests: one binary, one module per theme.
 
+mod artist;
 mod common;
 mod fuzz_regressions;
 mod image_prefilter;

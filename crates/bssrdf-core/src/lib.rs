@@ -68,6 +68,7 @@
 //! sections as `docs/physics.md#section`.
 #![deny(missing_docs)]
 
+pub mod albedo_inversion;
 pub mod beam_diffusion;
 pub mod better_dipole;
 pub mod chi_square;
@@ -88,6 +89,7 @@ pub mod single_scattering;
 pub mod table;
 pub mod tabulated;
 
+pub use albedo_inversion::AlbedoInversion;
 pub use error::ParamError;
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
 pub use fresnel::{DiffuseFresnel, FresnelMoments};

@@ -168,7 +168,9 @@ impl PreparedEstimator {
     /// Never allocates, never panics on valid input; the coefficients are always finite and
     /// ≥ 0. If `field.bounds()` says the field is constant, the constant is returned without
     /// any lookup or projection ([`crate::Diagnostics::short_circuit`]); components that the
-    /// bounds show to be constant are not averaged.
+    /// bounds show to be constant are not averaged. Fields with their own averaging space
+    /// ([`CoefficientField::averaged`]) are averaged there and each mean is mapped back with
+    /// [`CoefficientField::from_average`].
     #[inline]
     pub fn estimate<S, F, U>(
         &self,
@@ -190,7 +192,7 @@ impl PreparedEstimator {
             probe.diag.region = Region::Constant;
             probe.diag.constant_components = 6;
             return Estimate {
-                coefficients: c,
+                coefficients: probe.to_coefficients(c),
                 diagnostics: probe.diag,
             };
         }
@@ -210,7 +212,7 @@ impl PreparedEstimator {
             },
         };
         Estimate {
-            coefficients: known.finish(raw),
+            coefficients: probe.to_coefficients(known.finish(raw)),
             diagnostics: probe.diag,
         }
     }

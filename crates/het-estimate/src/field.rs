@@ -107,6 +107,36 @@ pub trait CoefficientField<P> {
     fn has_ellipse_average(&self) -> bool {
         false
     }
+
+    /// Optional averaging space: the values the estimators average at `p`, in the two slots
+    /// of a [`Coefficients`]. The default is [`CoefficientField::coefficients`] itself (σa and
+    /// σs are averaged). A field whose coefficients are a nonlinear function of other
+    /// quantities may average those instead (e.g. an artist's colour and mean free path,
+    /// inverted to σa, σs only after averaging: `docs/artist-parameters.md`); it then
+    /// overrides [`CoefficientField::from_average`] to map a mean back to coefficients, and
+    /// returns [`CoefficientField::bounds`] and [`CoefficientField::ellipse_average`] in the
+    /// averaging space too. Values must be finite and non-negative.
+    #[inline]
+    fn averaged(&self, p: &P) -> Coefficients {
+        self.coefficients(p)
+    }
+
+    /// The coefficients of a mean of [`CoefficientField::averaged`] values (default: the
+    /// mean itself). Every estimator maps each mean it uses (the widths of Sone's ellipse, the
+    /// kernel's weights, the final estimate) through this. Must return finite, non-negative
+    /// coefficients for finite, non-negative input.
+    #[inline]
+    fn from_average(&self, mean: Coefficients) -> Coefficients {
+        mean
+    }
+
+    /// False when [`CoefficientField::averaged`] is not σa, σs: estimators then take plain
+    /// arithmetic means (the kernel estimator's power mean of σa is specific to σa). Default:
+    /// true.
+    #[inline]
+    fn averages_coefficients(&self) -> bool {
+        true
+    }
 }
 
 impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
@@ -121,5 +151,16 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn has_ellipse_average(&self) -> bool {
         (**self).has_ellipse_average()
+    }
+    #[inline]
+    fn averaged(&self, p: &P) -> Coefficients {
+        (**self).averaged(p)
+    }
+    #[inline]
+    fn from_average(&self, mean: Coefficients) -> Coefficients {
+        (**self).from_average(mean)
+    }
+    fn averages_coefficients(&self) -> bool {
+        (**self).averages_coefficients()
     }
 }

@@ -253,7 +253,14 @@ where
         return probe.endpoints();
     };
     probe.diag.region = Region::Kernel;
+    // Means live in the field's averaging space; the kernel's weights need coefficients.
     let start = known.finish(probe.endpoints());
+    let start_sigma = probe.to_coefficients(start);
+    let exponent = if probe.field.averages_coefficients() {
+        params.exponent
+    } else {
+        1.0
+    };
     let d = chord.length();
     let wanted: [bool; 3] = std::array::from_fn(|c| !known.channel_constant(c));
     let reduced = |a: f64, s: f64| a + (1.0 - g) * s;
@@ -261,7 +268,7 @@ where
     // Step 2: the points, projected and looked up once.
     let mut longest_mfp: f64 = 0.0;
     for c in (0..3).filter(|&c| wanted[c]) {
-        let st = reduced(start.sigma_a[c], start.sigma_s[c]);
+        let st = reduced(start_sigma.sigma_a[c], start_sigma.sigma_s[c]);
         if st > 0.0 {
             longest_mfp = longest_mfp.max(1.0 / st);
         }
@@ -297,7 +304,7 @@ where
         } else {
             0.0
         };
-        let a_p = power(c.sigma_a.0, params.exponent);
+        let a_p = power(c.sigma_a.0, exponent);
         store[len].write(Sample {
             rho,
             inv_q,
@@ -317,6 +324,7 @@ where
     let mut fell_back = false;
     for _ in 0..params.iterations {
         let mut next = est;
+        let sigma = probe.to_coefficients(est);
         fell_back = false;
         let mut done = [false; 3];
         for c in (0..3).filter(|&c| wanted[c]) {
@@ -328,12 +336,12 @@ where
             let group: [bool; 3] = std::array::from_fn(|k| {
                 wanted[k]
                     && !done[k]
-                    && est.sigma_a[k] == est.sigma_a[c]
-                    && est.sigma_s[k] == est.sigma_s[c]
+                    && sigma.sigma_a[k] == sigma.sigma_a[c]
+                    && sigma.sigma_s[k] == sigma.sigma_s[c]
             });
             (0..3).for_each(|k| done[k] |= group[k]);
-            let medium = (est.sigma_a[c], est.sigma_s[c], g);
-            match weighted_means(samples, group, medium, d, table, params.exponent) {
+            let medium = (sigma.sigma_a[c], sigma.sigma_s[c], g);
+            match weighted_means(samples, group, medium, d, table, exponent) {
                 Some(means) => {
                     for k in (0..3).filter(|&k| group[k]) {
                         next.sigma_a[k] = means[k].0;

@@ -217,11 +217,18 @@ where
         }
     }
 
-    /// One counted, sanitised lookup.
+    /// One counted, sanitised lookup, in the field's averaging space
+    /// ([`CoefficientField::averaged`]: σa and σs unless the field says otherwise).
     #[inline]
     pub fn lookup(&mut self, p: &S::Point) -> Coefficients {
         self.diag.lookups += 1;
-        sanitise(self.field.coefficients(p))
+        sanitise(self.field.averaged(p))
+    }
+
+    /// The coefficients of a mean in the averaging space ([`CoefficientField::from_average`]).
+    #[inline]
+    pub fn to_coefficients(&self, mean: Coefficients) -> Coefficients {
+        sanitise(self.field.from_average(mean))
     }
 
     /// The chord x_i → x_o and its averaging-plane normal, recording the normal fallback in the
@@ -241,7 +248,7 @@ where
         }
     }
 
-    /// ½(σ(x_i) + σ(x_o)), looked up once per pair (the d'Eon–Irving endpoint reading and the
+    /// ½(σ(x_i) + σ(x_o)) (in the averaging space), looked up once per pair (the d'Eon–Irving endpoint reading and the
     /// fallback of the region estimators).
     pub fn endpoints(&mut self) -> Coefficients {
         if let Some(c) = self.endpoints {

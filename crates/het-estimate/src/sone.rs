@@ -264,7 +264,7 @@ where
             mean
         }
     };
-    let disk_mean = known.finish(disk_mean);
+    let disk_mean = probe.to_coefficients(known.finish(disk_mean));
 
     // Step 2: the width of Eq. (2) per channel, and the semi-minor axis.
     let d = chord.length();

@@ -1,5 +1,7 @@
 //! Coefficient fields: σa or σs as linear RGB over an object (1/scene-unit), and
-//! [`MediumField`], the pair a translucent material is made of.
+//! [`MediumField`], the pair a translucent material is made of: σa and σs, or an artist's
+//! colour and mean free path inverted to σa and σs ([`MediumField::artist`], [`InvertAt`],
+//! `docs/artist-parameters.md`).
 //!
 //! A [`Field`] is one of a closed set, matched once per lookup (a predictable branch):
 //! * constant (grey or RGB);
@@ -16,9 +18,11 @@
 //! coordinates, `(u, v)` with `v` up (OBJ convention) reads the image at `(u, 1 − v)`.
 
 pub mod area_table;
+mod artist;
 mod texture;
 mod texture_mapping;
 
+pub use artist::{ArtistMap, InvertAt};
 pub use texture::{Filter, Texture, Wrap};
 pub use texture_mapping::{Axis, PlanarProjection};
 
@@ -265,6 +269,26 @@ impl Field {
         }
     }
 
+    /// The field multiplied channel-wise by `k ≥ 0` (an artist's radius scale).
+    pub fn scaled_rgb(self, k: Rgb) -> Field {
+        match self {
+            Field::Constant(v) => Field::Constant(v * k),
+            Field::Pattern {
+                pattern,
+                values,
+                projection,
+            } => Field::Pattern {
+                pattern,
+                values: [values[0] * k, values[1] * k],
+                projection,
+            },
+            Field::Image(mut f) => {
+                f.scale *= k;
+                Field::Image(f)
+            }
+        }
+    }
+
     /// The value at a surface point `p` with texture coordinates `uv`.
     #[inline]
     pub fn eval(&self, p: DVec3, uv: DVec2) -> Rgb {
@@ -368,12 +392,21 @@ impl Field {
     }
 }
 
-/// The medium of a translucent material: σa and σs fields, with cached bounds.
+/// The medium of a translucent material: σa and σs fields, or an artist's colour and mean
+/// free path with the inversion that turns them into σa and σs ([`MediumField::artist`]), with
+/// cached bounds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MediumField {
+    /// σa, or the artist's colour.
     sigma_a: Field,
+    /// σs, or the artist's mean free path (scene units).
     sigma_s: Field,
+    /// Present for an artist medium.
+    artist: Option<ArtistMap>,
+    /// Bounds of σa and σs.
     bounds: FieldBounds,
+    /// Bounds of the two fields as given (`bounds` for a σ medium).
+    raw_bounds: FieldBounds,
     majorant: Rgb,
     grey: bool,
     volumetric: bool,
@@ -382,27 +415,44 @@ pub struct MediumField {
 impl MediumField {
     /// The medium with absorption `sigma_a` and scattering `sigma_s`.
     pub fn new(sigma_a: Field, sigma_s: Field) -> Self {
-        let min = Coefficients {
-            sigma_a: sigma_a.min(),
-            sigma_s: sigma_s.min(),
-        };
-        let max = Coefficients {
-            sigma_a: sigma_a.max(),
-            sigma_s: sigma_s.max(),
-        };
-        let bounds = if min == max {
-            FieldBounds::constant(min)
-        } else {
-            FieldBounds { min, max }
-        };
+        let bounds = bounds_of(&sigma_a, &sigma_s);
         Self {
-            majorant: max.sigma_a + max.sigma_s,
+            majorant: bounds.max.sigma_a + bounds.max.sigma_s,
             grey: sigma_a.is_grey() && sigma_s.is_grey(),
             volumetric: sigma_a.is_volumetric() && sigma_s.is_volumetric(),
             bounds,
+            raw_bounds: bounds,
+            artist: None,
             sigma_a,
             sigma_s,
         }
+    }
+
+    /// An artist's medium: `colour` (the diffuse colour of a thick flat slab, in [0, 1]) and
+    /// `mfp` (mean free path, scene units, > 0 somewhere; σt = 1/mfp), turned into σa and σs
+    /// by `map` at each point (see [`ArtistMap`] for the floor on zero mean free paths and
+    /// [`InvertAt`] for where estimators invert). Errors: a colour above 1, or a mean free
+    /// path that is 0 everywhere (the loader turns that into a diffuse surface instead).
+    pub fn artist(colour: Field, mfp: Field, map: ArtistMap) -> Result<Self, FieldError> {
+        if colour.max().max_component() > 1.0 {
+            return Err(FieldError::BadValue {
+                what: "subsurface_color (at most 1)".into(),
+                value: colour.max().0,
+            });
+        }
+        let raw_bounds = bounds_of(&colour, &mfp);
+        let map = map.with_floor(mfp.max())?;
+        let bounds = map.bounds(&raw_bounds);
+        Ok(Self {
+            majorant: bounds.max.sigma_a + bounds.max.sigma_s,
+            grey: colour.is_grey() && mfp.is_grey(),
+            volumetric: colour.is_volumetric() && mfp.is_volumetric(),
+            bounds,
+            raw_bounds,
+            artist: Some(map),
+            sigma_a: colour,
+            sigma_s: mfp,
+        })
     }
 
     /// A homogeneous medium.
@@ -413,38 +463,83 @@ impl MediumField {
         ))
     }
 
-    /// The absorption field.
+    /// The absorption field (for an artist medium: the colour field).
     pub fn sigma_a(&self) -> &Field {
         &self.sigma_a
     }
-    /// The scattering field.
+    /// The scattering field (for an artist medium: the mean free path field).
     pub fn sigma_s(&self) -> &Field {
         &self.sigma_s
     }
-
-    /// The medium multiplied by `k` (unit conversion: coefficients per file unit ×
-    /// `unit_scale` = per scene unit).
-    pub fn scaled(self, k: f64) -> Self {
-        Self::new(self.sigma_a.scaled(k), self.sigma_s.scaled(k))
+    /// The two fields with their scene-file names (`sigma_a`, `sigma_s`, or
+    /// `subsurface_color`, `subsurface_radius`), for messages.
+    pub fn named_fields(&self) -> [(&'static str, &Field); 2] {
+        match self.artist {
+            None => [("sigma_a", &self.sigma_a), ("sigma_s", &self.sigma_s)],
+            Some(_) => [
+                ("subsurface_color", &self.sigma_a),
+                ("subsurface_radius", &self.sigma_s),
+            ],
+        }
+    }
+    /// The artist parametrisation, if this medium has one.
+    pub fn artist_map(&self) -> Option<&ArtistMap> {
+        self.artist.as_ref()
     }
 
-    /// Coefficients at a point of the volume (for the path tracer): cheap, no allocation.
-    /// Meaningful only when [`MediumField::is_volumetric`].
+    /// The medium multiplied by `k` (unit conversion: coefficients per file unit ×
+    /// `unit_scale` = per scene unit; an artist's mean free path is divided by `k`).
+    pub fn scaled(self, k: f64) -> Self {
+        match self.artist {
+            None => Self::new(self.sigma_a.scaled(k), self.sigma_s.scaled(k)),
+            Some(map) => {
+                let colour = self.sigma_a;
+                let mfp = self.sigma_s.scaled(1.0 / k);
+                // Valid before, so valid scaled (k > 0 is checked by the loader).
+                Self::artist(colour, mfp, map.without_floor())
+                    .expect("a valid artist medium stays valid when scaled")
+            }
+        }
+    }
+
+    #[inline]
+    fn to_sigma(&self, raw: Coefficients) -> Coefficients {
+        match &self.artist {
+            None => raw,
+            Some(map) => map.coefficients(raw),
+        }
+    }
+
+    /// Coefficients at a point of the volume (for the path tracer): cheap, no allocation (an
+    /// artist medium costs three table lookups more). Meaningful only when
+    /// [`MediumField::is_volumetric`].
     #[inline]
     pub fn at_point(&self, p: DVec3) -> Coefficients {
-        Coefficients {
+        self.to_sigma(Coefficients {
             sigma_a: self.sigma_a.at_point(p),
             sigma_s: self.sigma_s.at_point(p),
-        }
+        })
     }
 
     /// Coefficients at a surface point with texture coordinates `uv`.
     #[inline]
     pub fn at_surface(&self, p: DVec3, uv: DVec2) -> Coefficients {
+        self.to_sigma(self.raw_at_surface(p, uv))
+    }
+
+    #[inline]
+    fn raw_at_surface(&self, p: DVec3, uv: DVec2) -> Coefficients {
         Coefficients {
             sigma_a: self.sigma_a.eval(p, uv),
             sigma_s: self.sigma_s.eval(p, uv),
         }
+    }
+
+    /// True when the estimators average an artist's colour and mean free path and invert the
+    /// means ([`InvertAt::After`]).
+    #[inline]
+    fn inverts_after(&self) -> bool {
+        matches!(&self.artist, Some(m) if m.invert() == InvertAt::After)
     }
 
     /// False when either field is a UV-mapped image (surface only).
@@ -463,14 +558,32 @@ impl MediumField {
         self.bounds.is_constant()
     }
 
-    /// Per-channel majorant of σt = σa + σs over the whole medium.
+    /// Per-channel majorant of σt = σa + σs over the whole medium (for an artist medium,
+    /// 1 / the smallest mean free path after its floor).
     pub fn majorant(&self) -> Rgb {
         self.majorant
     }
 
-    /// Channel-wise bounds of both coefficients.
+    /// Channel-wise bounds of both coefficients (σa and σs, for every parametrisation).
     pub fn field_bounds(&self) -> FieldBounds {
         self.bounds
+    }
+}
+
+/// Channel-wise bounds of two fields.
+fn bounds_of(a: &Field, s: &Field) -> FieldBounds {
+    let min = Coefficients {
+        sigma_a: a.min(),
+        sigma_s: s.min(),
+    };
+    let max = Coefficients {
+        sigma_a: a.max(),
+        sigma_s: s.max(),
+    };
+    if min == max {
+        FieldBounds::constant(min)
+    } else {
+        FieldBounds { min, max }
     }
 }
 
@@ -480,22 +593,60 @@ impl CoefficientField<Hit> for MediumField {
         self.at_surface(p.p, p.uv)
     }
 
-    /// Always `Some`; `FieldBounds::constant` for a homogeneous medium.
+    /// Always `Some`; `FieldBounds::constant` for a homogeneous medium. In the averaging space
+    /// ([`CoefficientField::averaged`]): the colour and mean free path for an artist medium
+    /// inverted after averaging.
     fn bounds(&self) -> Option<FieldBounds> {
-        Some(self.bounds)
+        Some(if self.inverts_after() {
+            self.raw_bounds
+        } else {
+            self.bounds
+        })
     }
 
-    /// Both fields' [`Field::ellipse_average`]; `None` if either declines.
+    /// Both fields' [`Field::ellipse_average`]; `None` if either declines, and always for an
+    /// artist medium inverted before averaging (the mean of a nonlinear function of the
+    /// textures has no summed-area table).
     fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
+        if self.artist.is_some() && !self.inverts_after() {
+            return None;
+        }
         Some(Coefficients {
             sigma_a: self.sigma_a.ellipse_average(e)?,
             sigma_s: self.sigma_s.ellipse_average(e)?,
         })
     }
 
-    /// True when neither field is a UV-mapped image.
+    /// True when neither field is a UV-mapped image (and the medium is not an artist medium
+    /// inverted before averaging).
     fn has_ellipse_average(&self) -> bool {
-        self.sigma_a.has_ellipse_average() && self.sigma_s.has_ellipse_average()
+        (self.artist.is_none() || self.inverts_after())
+            && self.sigma_a.has_ellipse_average()
+            && self.sigma_s.has_ellipse_average()
+    }
+
+    /// The colour and mean free path for an artist medium inverted after averaging; σa and σs
+    /// otherwise.
+    #[inline]
+    fn averaged(&self, p: &Hit) -> Coefficients {
+        if self.inverts_after() {
+            self.raw_at_surface(p.p, p.uv)
+        } else {
+            self.at_surface(p.p, p.uv)
+        }
+    }
+
+    #[inline]
+    fn from_average(&self, mean: Coefficients) -> Coefficients {
+        if self.inverts_after() {
+            self.to_sigma(mean)
+        } else {
+            mean
+        }
+    }
+
+    fn averages_coefficients(&self) -> bool {
+        !self.inverts_after()
     }
 }
 

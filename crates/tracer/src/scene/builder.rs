@@ -233,19 +233,40 @@ pub(crate) fn validate_translucent_scalars(t: &Translucent) -> Result<(), (Strin
 }
 
 /// Checks σa and σs everywhere (after `unit_scale`) against the bounds every profile accepts:
-/// finite, ≥ 0 and ≤ 1e12 per scene unit (`bssrdf_core::error::check_sigma`).
+/// finite, ≥ 0 and ≤ 1e12 per scene unit (`bssrdf_core::error::check_sigma`). For an artist
+/// medium, checks the bounds of the inverted σa and σs, and that its inversion was built for
+/// the material's g and η.
 pub(crate) fn validate_medium(t: &Translucent) -> Result<(), (String, String)> {
-    for (k, f) in [
-        ("sigma_a", t.medium.sigma_a()),
-        ("sigma_s", t.medium.sigma_s()),
+    let b = t.medium.field_bounds();
+    let [(ka, _), (ks, _)] = t.medium.named_fields();
+    for (k, name, lo, hi) in [
+        (ka, "sigma_a", b.min.sigma_a, b.max.sigma_a),
+        (ks, "sigma_s", b.min.sigma_s, b.max.sigma_s),
     ] {
-        for v in f.min().0.into_iter().chain(f.max().0) {
-            check_sigma(k, v).map_err(|e| {
+        for v in lo.0.into_iter().chain(hi.0) {
+            check_sigma(name, v).map_err(|e| {
                 (
                     k.to_string(),
                     format!("{e} (per scene unit, after unit_scale)"),
                 )
             })?;
+        }
+    }
+    if let Some(map) = t.medium.artist_map() {
+        let inv = map.inversion();
+        let g =
+            t.g.clamp(-bssrdf_core::family::G_MAX, bssrdf_core::family::G_MAX);
+        if inv.eta() != t.eta || inv.g() != g {
+            return Err((
+                "subsurface_color".into(),
+                format!(
+                    "the colour inversion was built for g = {}, eta = {} but the material has g = {}, eta = {}",
+                    inv.g(),
+                    inv.eta(),
+                    t.g,
+                    t.eta
+                ),
+            ));
         }
     }
     Ok(())

@@ -279,7 +279,8 @@ pub struct TextureDesc {
     pub linear: bool,
 }
 
-/// `[[material]]` with `type = "translucent"`.
+/// `[[material]]` with `type = "translucent"`: `sigma_a` and `sigma_s`, or the artist
+/// parameters `subsurface_color` and `subsurface_radius` (not both).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TranslucentDesc {
@@ -288,19 +289,29 @@ pub struct TranslucentDesc {
     /// Name used by shapes.
     pub name: String,
     /// Absorption coefficient field (per file unit, see `unit_scale`).
-    pub sigma_a: FieldDesc,
+    pub sigma_a: Option<FieldDesc>,
     /// Scattering coefficient field (per file unit).
-    pub sigma_s: FieldDesc,
+    pub sigma_s: Option<FieldDesc>,
+    /// Artist colour (the diffuse colour of a thick flat slab under uniform light), in [0, 1].
+    pub subsurface_color: Option<FieldDesc>,
+    /// Artist mean free path per channel (file units; σt = 1/(radius · radius_scale)).
+    pub subsurface_radius: Option<FieldDesc>,
+    /// Per-channel multiplier of `subsurface_radius` (default 1).
+    pub radius_scale: Option<RgbDesc>,
+    /// Where the estimators invert an artist medium: `"before"` or `"after"` averaging.
+    pub invert: Option<String>,
     /// HG asymmetry (default 0), |g| < 1.
-    #[serde(default)]
-    pub g: f64,
+    pub g: Option<f64>,
+    /// Another name for `g` (OpenPBR's `subsurface_scatter_anisotropy`).
+    pub anisotropy: Option<f64>,
     /// Relative index of refraction ≥ 1 (default 1).
     #[serde(default = "one")]
     pub eta: f64,
-    /// Profile model name (dipole | pbd | better-dipole).
+    /// Profile model name (dipole | pbd | better-dipole | tabulated).
     pub profile: Option<String>,
     /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.
-    /// 1000 for coefficients per mm in a scene modelled in metres.
+    /// 1000 for coefficients per mm in a scene modelled in metres. An artist radius is
+    /// divided by it.
     #[serde(default = "one")]
     pub unit_scale: f64,
 }

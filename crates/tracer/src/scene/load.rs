@@ -5,7 +5,7 @@ use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use bssrdf_core::{ProfileModel, Rgb, Scattering};
+use bssrdf_core::{AlbedoInversion, ProfileModel, Rgb, Scattering};
 use glam::{DQuat, DVec3};
 use serde::Deserialize;
 use toml::Spanned;
@@ -21,7 +21,8 @@ use super::{Material, RenderSettings, Scene, Translucent};
 use crate::camera::{Camera, CameraError};
 use crate::error::{FieldError, SceneError};
 use crate::field::{
-    Axis, Field, Filter, ImageMapping, MediumField, PlanarProjection, Texture, Wrap,
+    ArtistMap, Axis, Field, Filter, ImageMapping, InvertAt, MediumField, PlanarProjection, Texture,
+    Wrap,
 };
 use crate::geometry::{Transform, TriangleMesh, primitives};
 use crate::light::{Light, LightError};
@@ -420,42 +421,7 @@ impl Cx {
             let plan = match self.type_of(v, &key, KINDS)? {
                 "translucent" => {
                     let d: TranslucentDesc = self.de(v, &key)?;
-                    let profile =
-                        match &d.profile {
-                            None => None,
-                            Some(p) => Some(p.parse::<ProfileModel>().map_err(|e| {
-                                self.invalid(&format!("{key}.profile"), e.to_string())
-                            })?),
-                        };
-                    let sigma_a =
-                        self.field_spec(&d.sigma_a, &format!("{key}.sigma_a"), textures)?;
-                    let sigma_s =
-                        self.field_spec(&d.sigma_s, &format!("{key}.sigma_s"), textures)?;
-                    // Validate the scalar values now with placeholder constant fields (so that
-                    // unused materials are checked too).
-                    let probe = Translucent {
-                        name: d.name.clone(),
-                        medium: MediumField::new(
-                            Field::Constant(Rgb::ZERO),
-                            Field::Constant(Rgb::ZERO),
-                        ),
-                        g: d.g,
-                        eta: d.eta,
-                        profile,
-                        unit_scale: d.unit_scale,
-                        key: key.clone(),
-                        line: self.loc.line_of_key(&key),
-                    };
-                    validate_translucent_scalars(&probe)
-                        .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
-                    (
-                        d.name.clone(),
-                        MaterialPlan::Translucent {
-                            base: probe,
-                            sigma_a,
-                            sigma_s,
-                        },
-                    )
+                    self.translucent_plan(&d, &key, textures)?
                 }
                 "diffuse" => {
                     let d: DiffuseDesc = self.de(v, &key)?;
@@ -638,6 +604,122 @@ impl Cx {
         }
     }
 
+    /// A translucent material's plan: σa and σs, or the artist parameters (a constant zero
+    /// radius with a constant colour becomes a diffuse surface of that colour).
+    fn translucent_plan(
+        &self,
+        d: &TranslucentDesc,
+        key: &str,
+        textures: &HashMap<String, (String, TextureDesc)>,
+    ) -> Result<(String, MaterialPlan), SceneError> {
+        let profile = match &d.profile {
+            None => None,
+            Some(p) => Some(
+                p.parse::<ProfileModel>()
+                    .map_err(|e| self.invalid(&format!("{key}.profile"), e.to_string()))?,
+            ),
+        };
+        let g = match (d.g, d.anisotropy) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    &format!("{key}.anisotropy"),
+                    "give `g` or `anisotropy` (the same parameter), not both",
+                ));
+            }
+            (g, a) => g.or(a).unwrap_or(0.0),
+        };
+        // Validate the scalar values now with placeholder constant fields (so that unused
+        // materials are checked too).
+        let probe = Translucent {
+            name: d.name.clone(),
+            medium: MediumField::new(Field::Constant(Rgb::ZERO), Field::Constant(Rgb::ZERO)),
+            g,
+            eta: d.eta,
+            profile,
+            unit_scale: d.unit_scale,
+            key: key.to_string(),
+            line: self.loc.line_of_key(key),
+        };
+        validate_translucent_scalars(&probe)
+            .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+        let field =
+            |f: &FieldDesc, name: &str| self.field_spec(f, &format!("{key}.{name}"), textures);
+        let artist_keys = d.subsurface_color.is_some()
+            || d.subsurface_radius.is_some()
+            || d.radius_scale.is_some()
+            || d.invert.is_some();
+        let plan = match (
+            &d.sigma_a,
+            &d.sigma_s,
+            &d.subsurface_color,
+            &d.subsurface_radius,
+        ) {
+            (Some(a), Some(s), None, None) if !artist_keys => MaterialPlan::Translucent {
+                base: probe,
+                sigma_a: field(a, "sigma_a")?,
+                sigma_s: field(s, "sigma_s")?,
+                artist: None,
+            },
+            (None, None, Some(c), Some(r)) => {
+                let scale = Rgb(d.radius_scale.map_or([1.0; 3], |s| s.0));
+                if !(scale.is_finite() && scale.min_component() >= 0.0) {
+                    return Err(self.invalid(
+                        &format!("{key}.radius_scale"),
+                        format!(
+                            "radius_scale must be finite and non-negative, got {:?}",
+                            scale.0
+                        ),
+                    ));
+                }
+                let invert = match &d.invert {
+                    None => InvertAt::DEFAULT,
+                    Some(s) => s.parse().map_err(|e: bssrdf_core::UnknownName| {
+                        self.invalid(&format!("{key}.invert"), e.to_string())
+                    })?,
+                };
+                let colour = field(c, "subsurface_color")?;
+                let radius = field(r, "subsurface_radius")?;
+                if let FieldSpec::Ready(Field::Constant(cv)) = &colour
+                    && cv.max_component() > 1.0
+                {
+                    return Err(self.invalid(
+                        &format!("{key}.subsurface_color"),
+                        format!("subsurface_color must lie in [0, 1], got {:?}", cv.0),
+                    ));
+                }
+                if let FieldSpec::Ready(Field::Constant(rv)) = &radius
+                    && (*rv * scale).is_zero()
+                {
+                    // No distance to travel: a diffuse surface of the colour.
+                    let FieldSpec::Ready(Field::Constant(cv)) = colour else {
+                        return Err(self.invalid(
+                            &format!("{key}.subsurface_radius"),
+                            "a zero subsurface_radius makes a diffuse surface, which needs a constant subsurface_color",
+                        ));
+                    };
+                    MaterialPlan::Ready(Material::Diffuse { albedo: cv })
+                } else {
+                    MaterialPlan::Translucent {
+                        base: probe,
+                        sigma_a: colour,
+                        sigma_s: radius,
+                        artist: Some((scale, invert)),
+                    }
+                }
+            }
+            _ => {
+                return Err(self.invalid(
+                    key,
+                    format!(
+                        "material `{}`: give either `sigma_a` and `sigma_s`, or `subsurface_color` and `subsurface_radius` (with optional `radius_scale`, `invert`), not a mix",
+                        d.name
+                    ),
+                ));
+            }
+        };
+        Ok((d.name.clone(), plan))
+    }
+
     /// Builds a material, decoding the textures it uses (once per texture).
     fn realize(
         &self,
@@ -651,11 +733,29 @@ impl Cx {
                 base,
                 sigma_a,
                 sigma_s,
+                artist,
             } => {
                 let a = self.realize_field(sigma_a, textures, decoded)?;
                 let s = self.realize_field(sigma_s, textures, decoded)?;
                 let mut t = base.clone();
-                t.medium = MediumField::new(a, s).scaled(base.unit_scale);
+                t.medium = match artist {
+                    None => MediumField::new(a, s).scaled(base.unit_scale),
+                    Some((scale, invert)) => {
+                        let model = t.profile.unwrap_or(ProfileModel::default_for(t.eta));
+                        let inversion =
+                            AlbedoInversion::shared(model, t.g, t.eta).map_err(|e| {
+                                self.invalid(&format!("{}.profile", t.key), e.to_string())
+                            })?;
+                        MediumField::artist(
+                            a,
+                            s.scaled_rgb(*scale * (1.0 / base.unit_scale)),
+                            ArtistMap::new(inversion, *invert),
+                        )
+                        .map_err(|e| {
+                            self.invalid(&format!("{}.subsurface_color", t.key), e.to_string())
+                        })?
+                    }
+                };
                 validate_medium(&t).map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
                 Ok(Material::Translucent(t))
             }
@@ -1066,8 +1166,12 @@ enum MaterialPlan {
     Ready(Material),
     Translucent {
         base: Translucent,
+        /// σa, or the artist colour.
         sigma_a: FieldSpec,
+        /// σs, or the artist radius.
         sigma_s: FieldSpec,
+        /// For artist parameters: the radius scale and where estimators invert.
+        artist: Option<(Rgb, InvertAt)>,
     },
 }
 

@@ -336,10 +336,7 @@ impl Scene {
     /// surface (a UV-mapped image): a volumetric render needs coefficients in the volume.
     pub fn require_volumetric(&self) -> Result<(), SceneError> {
         for (_, t) in self.translucent_objects() {
-            for (which, f) in [
-                ("sigma_a", t.medium.sigma_a()),
-                ("sigma_s", t.medium.sigma_s()),
-            ] {
+            for (which, f) in t.medium.named_fields() {
                 if !f.is_volumetric() {
                     return Err(self.invalid(
                         format!("{}.{which}", t.key),
