@@ -1070,10 +1070,44 @@ impl Cx {
                 .map_err(|e| invalid(e.to_string()))?;
                 Material::Translucent(Translucent::new(name, medium, 0.0, eta))
             }
-            I::Translucent { .. } => {
-                return Err(invalid(
-                    "translucent glTF materials are not wired yet".into(),
-                ));
+            I::Translucent {
+                colour,
+                mean_free_path,
+                anisotropy,
+                eta,
+            } => {
+                use crate::geometry::gltf_material::GltfColour;
+                let colour = match colour {
+                    GltfColour::Constant(c) => Field::constant(Rgb(c)),
+                    GltfColour::Texture { factor, texture } => {
+                        let tex = model.decode_image(texture.image).map_err(|source| {
+                            SceneError::Texture {
+                                file: self.file.clone(),
+                                line: self.loc.line_of_key(&field_key),
+                                key: field_key.clone(),
+                                source: Box::new(source),
+                            }
+                        })?;
+                        Field::image(
+                            Arc::new(tex),
+                            ImageMapping::Uv,
+                            texture.wrap,
+                            Filter::Bilinear,
+                            Rgb(factor),
+                        )
+                    }
+                }
+                .map_err(|e| invalid(e.to_string()))?;
+                let mfp =
+                    Field::constant(Rgb(mean_free_path) * s).map_err(|e| invalid(e.to_string()))?;
+                // The material's profile, as for a scene material without a `profile` key.
+                let inversion =
+                    AlbedoInversion::shared(ProfileModel::default_for(eta), anisotropy, eta)
+                        .map_err(|e| invalid(e.to_string()))?;
+                let medium =
+                    MediumField::artist(colour, mfp, ArtistMap::new(inversion, InvertAt::DEFAULT))
+                        .map_err(|e| invalid(e.to_string()))?;
+                Material::Translucent(Translucent::new(name, medium, anisotropy, eta))
             }
         };
         validate_material(&material).map_err(|(k, msg)| invalid(format!("{k}: {msg}")))?;

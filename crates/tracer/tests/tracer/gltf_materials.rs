@@ -194,3 +194,142 @@ fn materials_are_interpreted_as_translucent_absorbing_or_diffuse() {
         "{notes:?}"
     );
 }
+
+/// `examples/scenes/gltf-jade.toml` with `extra` appended to its shape table, loaded from
+/// the examples directory (so that its relative model path resolves).
+fn jade_scene(extra: &str) -> Result<tracer::scene::Scene, tracer::error::SceneError> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let text = std::fs::read_to_string(dir.join("gltf-jade.toml")).unwrap();
+    tracer::scene::Scene::from_toml_str(&format!("{text}{extra}"), &dir, "gltf-jade.toml")
+}
+
+#[test]
+fn gltf_scene_takes_one_object_per_file_material() {
+    use bssrdf_core::{AlbedoInversion, ProfileModel, Rgb};
+    use glam::{DVec2, DVec3};
+    use std::sync::Arc;
+    use tracer::field::{ArtistMap, Field, Filter, ImageMapping, InvertAt, MediumField};
+    use tracer::scene::Material;
+    let scene = jade_scene("").unwrap();
+    let names: Vec<&str> = scene.objects().iter().map(|o| o.name.as_str()).collect();
+    assert!(names.starts_with(&["jade/jade", "jade/stand"]), "{names:?}");
+    assert!(scene.load_notes().is_empty(), "{:?}", scene.load_notes());
+    let Material::Translucent(t) = &scene.objects()[0].material else {
+        panic!("jade is not translucent");
+    };
+    assert_eq!((t.eta, t.g), (1.3, 0.0));
+    let Material::Diffuse { albedo } = scene.objects()[1].material else {
+        panic!("the stand is not diffuse");
+    };
+    assert_eq!(albedo, Rgb([0.5; 3]));
+    // The same medium built by hand from the file's values (docs/gltf.md): colour = the base
+    // colour image through UVs, mean free path = d / −ln(attenuationColor), the default
+    // profile's inversion at η 1.3.
+    let model = load_gltf_parts(&jade()).unwrap();
+    let image = Field::image(
+        Arc::new(model.decode_image(0).unwrap()),
+        ImageMapping::Uv,
+        Wrap::Repeat,
+        Filter::Bilinear,
+        Rgb([1.0; 3]),
+    )
+    .unwrap();
+    let mfp = Field::constant(Rgb([0.5f64, 0.8, 0.6].map(|c| 0.25 / -c.ln()))).unwrap();
+    let inversion = AlbedoInversion::shared(ProfileModel::default_for(1.3), 0.0, 1.3).unwrap();
+    let want =
+        MediumField::artist(image, mfp, ArtistMap::new(inversion, InvertAt::DEFAULT)).unwrap();
+    for (p, uv) in [
+        (DVec3::new(0.0, 2.0, 0.0), DVec2::new(0.3, 0.9)),
+        (DVec3::new(1.0, 1.0, 0.0), DVec2::new(0.71, 0.5)),
+        (DVec3::new(0.0, 1.0, -1.0), DVec2::new(0.05, 0.25)),
+    ] {
+        assert_eq!(
+            t.medium.at_surface(p, uv),
+            want.at_surface(p, uv),
+            "at uv {uv}"
+        );
+    }
+
+    // A scaled shape scales the mean free path with it (a mean free path of 1/σt: twice the
+    // size, half the extinction).
+    let big = jade_scene("transform = { scale = 2.0 }\n").unwrap();
+    let Material::Translucent(b) = &big.objects()[0].material else {
+        panic!()
+    };
+    let uv = DVec2::new(0.3, 0.9);
+    let (small, large) = (
+        t.medium.at_surface(DVec3::ZERO, uv),
+        b.medium.at_surface(DVec3::ZERO, uv),
+    );
+    for c in 0..3 {
+        let (s, l) = (
+            small.sigma_a[c] + small.sigma_s[c],
+            large.sigma_a[c] + large.sigma_s[c],
+        );
+        assert!((l - 0.5 * s).abs() < 1e-12 * s, "channel {c}: {l} vs {s}");
+    }
+
+    // A `material` key covers the whole file with that material, as for OBJ.
+    let one = jade_scene("material = \"plain\"\n[[material]]\nname = \"plain\"\ntype = \"diffuse\"\nalbedo = [0.2, 0.2, 0.2]\n").unwrap();
+    assert_eq!(one.objects()[0].name, "jade");
+    assert_eq!(
+        one.objects()[0].report.triangles,
+        2 * 32 * 15 + 2,
+        "one object holds the whole file"
+    );
+}
+
+#[test]
+fn gltf_scene_warns_about_what_it_does_not_read_and_other_meshes_need_a_material() {
+    use tracer::integrator::{Method, warnings::scene_warnings};
+    // The scene with a clearcoat layer on the jade: the render's warnings name it.
+    let text = std::fs::read_to_string(jade()).unwrap().replacen(
+        "\"KHR_materials_ior\": {",
+        "\"KHR_materials_clearcoat\": {\"clearcoatFactor\": 1}, \"KHR_materials_ior\": {",
+        1,
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("jade.gltf"), text).unwrap();
+    let scene_text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../examples/scenes/gltf-jade.toml"),
+    )
+    .unwrap()
+    .replace("../models/jade.gltf", "jade.gltf");
+    let scene =
+        tracer::scene::Scene::from_toml_str(&scene_text, dir.path(), "clearcoat.toml").unwrap();
+    for method in [
+        Method::PathTraced,
+        Method::Bssrdf {
+            estimator: het_estimate::Estimator::Sone(Default::default()),
+            profile: None,
+        },
+    ] {
+        let w = scene_warnings(&scene, method);
+        assert!(
+            w.iter().any(|m| m.contains("jade.gltf")
+                && m.contains("`jade`")
+                && m.contains("KHR_materials_clearcoat")),
+            "{w:?}"
+        );
+    }
+    // Only glTF shapes may leave out `material`.
+    std::fs::write(
+        dir.path().join("x.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let e = tracer::scene::Scene::from_toml_str(
+        &scene_text
+            .replace("type = \"gltf\"", "type = \"obj\"")
+            .replace("jade.gltf", "x.obj"),
+        dir.path(),
+        "obj.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("shape[0].material") && e.contains("missing `material`"),
+        "{e}"
+    );
+}
