@@ -3,7 +3,7 @@
 as data URIs) with two materials, for the glTF material import (docs/gltf.md):
 
 * `jade`: a UV sphere of radius 1 (scene units: cm) whose material is a translucent volume:
-  KHR_materials_volume (thicknessFactor 1, attenuationDistance 0.25, a green attenuation
+  KHR_materials_volume (thicknessFactor 1, attenuationDistance 0.01, a green attenuation
   colour), KHR_materials_diffuse_transmission, KHR_materials_ior (1.3), and a base-colour
   texture of dark veins on green (64 x 32 PNG, sRGB);
 * `stand`: a 6 x 6 floor quad under it, plain base colour (read as a diffuse surface).
@@ -132,7 +132,7 @@ def main():
                                       "metallicFactor": 0, "roughnessFactor": 0.3},
              "extensions": {
                  "KHR_materials_volume": {"thicknessFactor": 1.0,
-                                          "attenuationDistance": 0.25,
+                                          "attenuationDistance": 0.01,
                                           "attenuationColor": [0.5, 0.8, 0.6]},
                  "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0},
                  "KHR_materials_ior": {"ior": 1.3}}},
