@@ -233,31 +233,7 @@ fn scenes_with_nothing_to_render_warn() {
     ] {
         let file = format!("{name}.toml");
         s.write(&file, &scene);
-        // A scene whose texture exists on the surface only (UV mapping) says so; the path
-        // tracer must then refuse it with a message naming the reason.
-        let methods: &[&str] = if text.contains("# pt: refused") {
-            let r = s.run(&[
-                "render",
-                path.to_str().unwrap(),
-                "--method",
-                "pt",
-                "--spp",
-                "1",
-                "--out",
-                "refused.exr",
-            ]);
-            assert_ne!(r.code, Some(0), "{}: pt was not refused", path.display());
-            assert!(
-                r.stderr.contains("UV-mapped"),
-                "{}: {}",
-                path.display(),
-                r.stderr
-            );
-            &["sone"]
-        } else {
-            &["pt", "sone"]
-        };
-        for &method in methods {
+        for method in ["pt", "sone"] {
             let out = format!("{name}-{method}.exr");
             let r = s.run(&["render", &file, "--method", method, "--out", &out]);
             assert_eq!(r.code, Some(0), "{name}: {}", r.stderr);
