@@ -16,10 +16,24 @@ pub trait BinaryPattern {
     fn select(&self, x: f64, y: f64) -> usize;
 }
 
+/// Parity (0 or 1) of ⌊x⌋ + ⌊y⌋, for the values of a pattern's cell coordinates.
+///
+/// Through `i64` rather than `floor` and `rem_euclid`, which are library calls on the
+/// baseline x86-64 target and cost as much as the rest of a lookup. Beyond 2⁵² every `f64` is
+/// an integer (and beyond 2⁵³ an even one), so `⌊x⌋ = x` there; such coordinates, and NaN,
+/// take the slow exact path.
 #[inline]
-fn parity(k: f64) -> usize {
-    // rem_euclid keeps the parity in {0, 1} for negative k.
-    (k.rem_euclid(2.0) as usize) & 1
+fn parity_of_floors(x: f64, y: f64) -> usize {
+    const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
+    if x.abs() < EXACT && y.abs() < EXACT {
+        let floor = |v: f64| {
+            let i = v as i64;
+            if (i as f64) > v { i - 1 } else { i }
+        };
+        ((floor(x) + floor(y)) & 1) as usize
+    } else {
+        ((x.floor() + y.floor()).rem_euclid(2.0) as usize) & 1
+    }
 }
 
 /// Parallel bands of width `width`, running along the direction `angle + 90°`.
@@ -42,7 +56,7 @@ impl Stripe {
 impl BinaryPattern for Stripe {
     #[inline]
     fn select(&self, x: f64, y: f64) -> usize {
-        parity((self.u(x, y) / self.width + 0.5).floor())
+        parity_of_floors(self.u(x, y) / self.width + 0.5, 0.0)
     }
 }
 
@@ -56,7 +70,7 @@ pub struct Check {
 impl BinaryPattern for Check {
     #[inline]
     fn select(&self, x: f64, y: f64) -> usize {
-        parity((x / self.width + 0.5).floor() + (y / self.width + 0.5).floor())
+        parity_of_floors(x / self.width + 0.5, y / self.width + 0.5)
     }
 }
 
@@ -99,5 +113,37 @@ mod tests {
         assert_eq!(c.select(2.5, 2.5), 0);
         assert_eq!(c.select(-2.5, 0.0), 1);
         assert_eq!(c.select(-2.5, -2.5), 0);
+    }
+
+    #[test]
+    fn fast_parity_equals_floor_parity() {
+        // Against the definition through `floor` and `rem_euclid`: exact integers, values a
+        // hair either side of them, negatives, large magnitudes, the 2^52 boundary and NaN.
+        let reference = |x: f64, y: f64| ((x.floor() + y.floor()).rem_euclid(2.0) as usize) & 1;
+        let mut values = vec![0.0, -0.0, 0.5, -0.5, 1e300, -1e300, f64::NAN];
+        for k in [
+            -3i64,
+            -2,
+            -1,
+            1,
+            2,
+            3,
+            1 << 40,
+            -(1 << 40),
+            (1 << 52) - 1,
+            1 << 52,
+        ] {
+            let v = k as f64;
+            values.extend([v, v.next_up(), v.next_down(), v + 0.25, v - 0.75]);
+        }
+        for &x in &values {
+            for &y in &values {
+                if x.is_nan() || y.is_nan() {
+                    assert!(parity_of_floors(x, y) <= 1);
+                    continue;
+                }
+                assert_eq!(parity_of_floors(x, y), reference(x, y), "x {x}, y {y}");
+            }
+        }
     }
 }

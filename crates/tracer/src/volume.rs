@@ -7,11 +7,15 @@
 //!   path weight never changes, which keeps the estimators simple and lets the caller count
 //!   scattering orders exactly. For a constant field the majorant equals σt, so null collisions
 //!   never happen and the method reduces to exact exponential free-flight sampling.
-//! * [`transmittance`]: ratio tracking (Novák, Selle & Jarosz 2014, "NSJ14"), the unbiased
-//!   transmittance estimator `Π (1 − σt(x_k)/σ̄)` over tentative collisions, with an unbiased
-//!   Russian roulette once the running product falls below [`RR_THRESHOLD`], so that shadow
-//!   rays through stiff media cost O(1) expected steps beyond that point. For a constant field
-//!   the exact `exp(−σt d)` is returned instead.
+//! * [`transmittance`]: residual ratio tracking (Novák, Selle & Jarosz 2014, "NSJ14", §5):
+//!   with a control extinction σc ≤ σt(x) everywhere ([`ChannelMedium::control`], the field's
+//!   smallest σt), the estimate is `exp(−σc d) · Π (1 − (σt(x_k) − σc)/(σ̄ − σc))` over
+//!   tentative collisions drawn at the residual rate σ̄ − σc. It is unbiased for any σc in
+//!   [0, min σt]; σc = 0 is plain ratio tracking. A larger σc draws fewer collisions (on the
+//!   checker slab, σ̄ = 1.1 and σc = 1.005: about 12× fewer) and lowers the variance. An
+//!   unbiased Russian roulette starts once the running product falls below [`RR_THRESHOLD`],
+//!   so that shadow rays through stiff media cost O(1) expected steps beyond that point. For a
+//!   constant field the exact `exp(−σt d)` is returned instead.
 //!
 //! Units: distances in scene units, coefficients in 1/scene unit. Directions must be unit
 //! vectors so that `t` is a distance.
@@ -32,6 +36,19 @@ pub trait ChannelMedium {
     fn majorant(&self) -> f64;
     /// `Some((σa, σs))` when the channel is constant over the whole medium.
     fn constant(&self) -> Option<(f64, f64)>;
+    /// A control extinction σc ≤ σa(x) + σs(x) for every point of the medium, used by
+    /// [`transmittance`] (residual ratio tracking). The default, 0, is always valid.
+    fn control(&self) -> f64 {
+        0.0
+    }
+}
+
+/// An exponential variate of rate 1, −ln(1 − u) with u uniform in [0, 1): finite and ≥ 0.
+/// (`ln` of 1 − u rather than `ln_1p` of −u: the same numbers to within rounding, where it
+/// cannot matter for a free-flight distance, at less than half the cost.)
+#[inline]
+fn unit_exponential(rng: &mut Rng) -> f64 {
+    -(1.0 - rng.uniform()).ln()
 }
 
 /// Outcome of free-flight sampling along a segment `origin + t·dir`, `0 < t < t_max`.
@@ -76,8 +93,7 @@ pub fn sample_interaction<M: ChannelMedium + ?Sized>(
     }
     let mut t = 0.0;
     loop {
-        // -ln(1 - u) with u in [0, 1) is finite and >= 0.
-        t += -(-rng.uniform()).ln_1p() / majorant;
+        t += unit_exponential(rng) / majorant;
         counters.delta_steps += 1;
         if t >= t_max {
             return Interaction::Pass;
@@ -111,16 +127,19 @@ pub fn transmittance<M: ChannelMedium + ?Sized>(
     if majorant.is_nan() || majorant <= 0.0 {
         return 1.0;
     }
-    let mut tr = 1.0;
+    // σc in [0, σ̄]: the control part is integrated exactly, the residual is ratio-tracked.
+    let control = medium.control().clamp(0.0, majorant);
+    let residual = majorant - control;
+    let mut tr = if control > 0.0 {
+        (-control * t_max).exp()
+    } else {
+        1.0
+    };
+    if residual <= 0.0 {
+        return tr;
+    }
     let mut t = 0.0;
     loop {
-        t += -(-rng.uniform()).ln_1p() / majorant;
-        counters.ratio_steps += 1;
-        if t >= t_max {
-            return tr;
-        }
-        let (sigma_a, sigma_s) = medium.coefficients(origin + t * dir);
-        tr *= (1.0 - (sigma_a + sigma_s) / majorant).max(0.0);
         if tr < RR_THRESHOLD {
             // Survive with probability tr / RR_THRESHOLD and continue with weight
             // RR_THRESHOLD: the expectation is unchanged.
@@ -129,6 +148,13 @@ pub fn transmittance<M: ChannelMedium + ?Sized>(
             }
             tr = RR_THRESHOLD;
         }
+        t += unit_exponential(rng) / residual;
+        counters.ratio_steps += 1;
+        if t >= t_max {
+            return tr;
+        }
+        let (sigma_a, sigma_s) = medium.coefficients(origin + t * dir);
+        tr *= (1.0 - (sigma_a + sigma_s - control).max(0.0) / residual).max(0.0);
     }
 }
 
@@ -155,6 +181,7 @@ pub struct ChannelView<'a> {
     field: &'a MediumField,
     channel: usize,
     majorant: f64,
+    control: f64,
     constant: Option<(f64, f64)>,
 }
 
@@ -166,10 +193,12 @@ impl<'a> ChannelView<'a> {
             let c = field.at_point(DVec3::ZERO);
             (c.sigma_a[channel], c.sigma_s[channel])
         });
+        let min = field.field_bounds().min;
         Self {
             field,
             channel,
             majorant,
+            control: min.sigma_a[channel] + min.sigma_s[channel],
             constant,
         }
     }
@@ -190,6 +219,9 @@ impl ChannelMedium for ChannelView<'_> {
     fn constant(&self) -> Option<(f64, f64)> {
         self.constant
     }
+    fn control(&self) -> f64 {
+        self.control
+    }
 }
 
 #[cfg(test)]
@@ -201,6 +233,23 @@ mod tests {
         split: f64,
         left: (f64, f64),
         right: (f64, f64),
+    }
+
+    /// [`TwoLayer`] that reports its smallest σt as the control extinction.
+    struct Controlled(TwoLayer);
+    impl ChannelMedium for Controlled {
+        fn coefficients(&self, p: DVec3) -> (f64, f64) {
+            self.0.coefficients(p)
+        }
+        fn majorant(&self) -> f64 {
+            self.0.majorant()
+        }
+        fn constant(&self) -> Option<(f64, f64)> {
+            None
+        }
+        fn control(&self) -> f64 {
+            (self.0.left.0 + self.0.left.1).min(self.0.right.0 + self.0.right.1)
+        }
     }
 
     impl ChannelMedium for TwoLayer {
@@ -320,30 +369,52 @@ mod tests {
         assert!((p - 0.2).abs() < 4.0 * se, "absorbed fraction {p}");
     }
 
-    #[test]
-    fn ratio_tracking_is_unbiased_and_exact_for_constant_media() {
-        let m = TwoLayer {
-            split: 1.0,
-            left: (0.1, 0.4),
-            right: (1.5, 0.5),
-        };
-        let exact = (-(0.5 * 1.0 + 2.0 * 1.5f64)).exp(); // t_max = 2.5
-        let mut rng = Rng::from_keys(13, &[]);
+    /// Mean and standard error of `n` transmittance estimates through `m` along +x to 2.5.
+    fn mean_transmittance(m: &dyn ChannelMedium, seed: u64, n: usize) -> (f64, f64, u64) {
+        let mut rng = Rng::from_keys(seed, &[]);
         let mut c = TrackingCounters::default();
-        let n = 400_000;
         let (mut s, mut s2) = (0.0, 0.0);
         for _ in 0..n {
-            let t = transmittance(&m, DVec3::ZERO, DVec3::X, 2.5, &mut rng, &mut c);
+            let t = transmittance(m, DVec3::ZERO, DVec3::X, 2.5, &mut rng, &mut c);
             assert!((0.0..=1.0).contains(&t));
             s += t;
             s2 += t * t;
         }
         let mean = s / n as f64;
-        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+        (
+            mean,
+            ((s2 / n as f64 - mean * mean) / n as f64).sqrt(),
+            c.ratio_steps,
+        )
+    }
+
+    #[test]
+    fn ratio_tracking_is_unbiased_and_exact_for_constant_media() {
+        let layers = || TwoLayer {
+            split: 1.0,
+            left: (0.1, 0.4),
+            right: (1.5, 0.5),
+        };
+        let exact = (-(0.5 * 1.0 + 2.0 * 1.5f64)).exp(); // t_max = 2.5
+        let n = 400_000;
+        // Plain ratio tracking (control 0) and residual ratio tracking (control = the smaller
+        // σt, 0.5): both unbiased within 4 standard errors.
+        let (plain, plain_se, plain_steps) = mean_transmittance(&layers(), 13, n);
         assert!(
-            (mean - exact).abs() < 4.0 * se,
-            "{mean} vs {exact} (se {se})"
+            (plain - exact).abs() < 4.0 * plain_se,
+            "ratio tracking: {plain} vs {exact} (se {plain_se})"
         );
+        let (res, res_se, res_steps) = mean_transmittance(&Controlled(layers()), 13, n);
+        assert!(
+            (res - exact).abs() < 4.0 * res_se,
+            "residual ratio tracking: {res} vs {exact} (se {res_se})"
+        );
+        // The residual rate is 1.5 instead of 2: fewer tentative collisions (and, the
+        // control part being exact, a smaller spread).
+        assert!(res_steps < plain_steps, "{res_steps} vs {plain_steps}");
+        assert!(res_se < plain_se, "{res_se} vs {plain_se}");
+        let mut rng = Rng::from_keys(13, &[]);
+        let mut c = TrackingCounters::default();
         let k = Constant(0.3, 0.7);
         let t = transmittance(&k, DVec3::ZERO, DVec3::Y, 2.0, &mut rng, &mut c);
         assert_eq!(t, (-2.0f64).exp());
@@ -351,6 +422,16 @@ mod tests {
             transmittance(&k, DVec3::ZERO, DVec3::Y, f64::INFINITY, &mut rng, &mut c),
             0.0
         );
+        // An infinite segment through a varying medium with a positive control: 0, not NaN.
+        let t = transmittance(
+            &Controlled(layers()),
+            DVec3::ZERO,
+            DVec3::X,
+            f64::INFINITY,
+            &mut rng,
+            &mut c,
+        );
+        assert_eq!(t, 0.0);
     }
 
     #[test]

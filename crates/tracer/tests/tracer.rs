@@ -10,6 +10,9 @@ mod common;
 mod direct_lighting;
 #[path = "tracer/geometry.rs"]
 mod geometry;
+#[cfg(feature = "gltf")]
+#[path = "tracer/gltf_materials.rs"]
+mod gltf_materials;
 #[path = "tracer/lights.rs"]
 mod lights;
 #[path = "tracer/meshes.rs"]

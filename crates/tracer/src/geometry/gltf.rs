@@ -1,11 +1,67 @@
 //! glTF 2.0 loading (`.gltf` with external or embedded buffers, `.glb`; feature `gltf`).
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 use glam::{DAffine3, DMat4, DVec3, Vec2, Vec3};
 
 use super::TriangleMesh;
-use crate::error::MeshError;
+use super::gltf_material::GltfMaterial;
+use crate::error::{MeshError, TextureError};
+use crate::field::Texture;
+
+/// Receives each triangle primitive, transformed to world space, with its material index.
+type Sink<'s> = dyn FnMut(Option<usize>, &TriangleMesh) + 's;
+
+/// An opened glTF file: its document and buffers, read once.
+struct Opened {
+    document: gltf::Document,
+    buffers: Vec<gltf::buffer::Data>,
+}
+
+fn open(path: &Path, err: &dyn Fn(String) -> MeshError) -> Result<Opened, MeshError> {
+    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| err(e.to_string()))?;
+    check_buffer_uris(&document, path, err)?;
+    let buffers =
+        gltf::import_buffers(&document, path.parent(), blob).map_err(|e| err(e.to_string()))?;
+    check_buffer_lengths(&document, &buffers, err)?;
+    Ok(Opened { document, buffers })
+}
+
+/// Walks the nodes of the default scene (or the first scene; with no scene at all, every
+/// mesh once, untransformed), handing every triangle primitive to `sink`.
+fn walk(
+    o: &Opened,
+    sink: &mut Sink<'_>,
+    err: &dyn Fn(String) -> MeshError,
+) -> Result<(), MeshError> {
+    let scene = o
+        .document
+        .default_scene()
+        .or_else(|| o.document.scenes().next());
+    match scene {
+        Some(scene) => {
+            let mut path = Vec::new();
+            for node in scene.nodes() {
+                visit(&node, DMat4::IDENTITY, &o.buffers, sink, &mut path, err)?;
+            }
+        }
+        None => {
+            for m in o.document.meshes() {
+                add_mesh(&m, &DAffine3::IDENTITY, &o.buffers, sink, err)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn load_error(path: &Path) -> impl Fn(String) -> MeshError {
+    let file = path.display().to_string();
+    move |message: String| MeshError::Load {
+        file: file.clone(),
+        message,
+    }
+}
 
 /// Loads every triangle primitive of every mesh instanced by the nodes of the default scene
 /// (or the first scene; with no scene at all, every mesh once, untransformed) into one mesh,
@@ -14,34 +70,160 @@ use crate::error::MeshError;
 /// converted to the OBJ convention `v ↦ 1 − v`. Images are not decoded. The mesh is not
 /// validated here: call [`TriangleMesh::prepare`].
 pub fn load_gltf(path: &Path) -> Result<TriangleMesh, MeshError> {
-    let file = path.display().to_string();
-    let err = |message: String| MeshError::Load {
-        file: file.clone(),
-        message,
-    };
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| err(e.to_string()))?;
-    check_buffer_uris(&document, path, &err)?;
-    let buffers =
-        gltf::import_buffers(&document, path.parent(), blob).map_err(|e| err(e.to_string()))?;
-    check_buffer_lengths(&document, &buffers, &err)?;
+    let err = load_error(path);
+    let opened = open(path, &err)?;
     let mut mesh = TriangleMesh::default();
-    let scene = document
-        .default_scene()
-        .or_else(|| document.scenes().next());
-    match scene {
-        Some(scene) => {
-            let mut path = Vec::new();
-            for node in scene.nodes() {
-                visit(&node, DMat4::IDENTITY, &buffers, &mut mesh, &mut path, &err)?;
-            }
-        }
-        None => {
-            for m in document.meshes() {
-                add_mesh(&m, &DAffine3::IDENTITY, &buffers, &mut mesh, &err)?;
-            }
+    walk(&opened, &mut |_, part| mesh.append(part), &err)?;
+    Ok(mesh)
+}
+
+/// One material's share of a glTF file: its triangles (world space) and what the material
+/// says about a translucent volume.
+#[derive(Debug, Clone)]
+pub struct GltfPart {
+    /// The material, as written in the file.
+    pub material: GltfMaterial,
+    /// Every triangle that uses it.
+    pub mesh: TriangleMesh,
+}
+
+/// A glTF file split by material, for scenes that take their materials from the file.
+pub struct GltfModel {
+    file: PathBuf,
+    opened: Opened,
+    /// One part per material used by a triangle primitive, in material order (glTF's default
+    /// material last).
+    pub parts: Vec<GltfPart>,
+}
+
+impl std::fmt::Debug for GltfModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GltfModel")
+            .field("file", &self.file)
+            .field("parts", &self.parts)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Loads `path` split by material (see [`load_gltf`] for what is read from the meshes, and
+/// [`GltfMaterial`] for what is read from the materials). Images are not decoded here:
+/// [`GltfModel::decode_image`] decodes the ones a scene uses.
+pub fn load_gltf_parts(path: &Path) -> Result<GltfModel, MeshError> {
+    let err = load_error(path);
+    let opened = open(path, &err)?;
+    // Material index → triangles; `None` (glTF's default material) sorts first in a BTreeMap,
+    // and is moved last below.
+    let mut by_material: BTreeMap<Option<usize>, TriangleMesh> = BTreeMap::new();
+    walk(
+        &opened,
+        &mut |m, part| by_material.entry(m).or_default().append(part),
+        &err,
+    )?;
+    let mut parts = Vec::with_capacity(by_material.len());
+    let mut default = None;
+    for (index, mesh) in by_material {
+        let material = match index.and_then(|i| opened.document.materials().nth(i)) {
+            Some(m) => GltfMaterial::read(&m).map_err(|e| {
+                err(format!(
+                    "material {} (`{}`): {}: {}",
+                    m.index().unwrap_or(0),
+                    m.name().unwrap_or(""),
+                    e.field,
+                    e.message
+                ))
+            })?,
+            None => GltfMaterial::default_material(),
+        };
+        let part = GltfPart { material, mesh };
+        if index.is_none() {
+            default = Some(part);
+        } else {
+            parts.push(part);
         }
     }
-    Ok(mesh)
+    parts.extend(default);
+    Ok(GltfModel {
+        file: path.to_path_buf(),
+        opened,
+        parts,
+    })
+}
+
+impl GltfModel {
+    /// The file it was read from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// Decodes image `index` of the file (8- and 16-bit images from sRGB, as glTF specifies
+    /// for base colour; float images linear). The texture is named `file#image[index]`.
+    pub fn decode_image(&self, index: usize) -> Result<Texture, TextureError> {
+        let name = format!("{}#image[{index}]", self.file.display());
+        let decode = |message: String| TextureError::Decode {
+            file: name.clone(),
+            message,
+        };
+        let image = self
+            .opened
+            .document
+            .images()
+            .nth(index)
+            .ok_or_else(|| decode(format!("the file has no image {index}")))?;
+        let data = gltf::image::Data::from_source(
+            image.source(),
+            self.file.parent(),
+            &self.opened.buffers,
+        )
+        .map_err(|e| decode(e.to_string()))?;
+        let texels = image_texels(&data).map_err(decode)?;
+        Texture::from_texels(&name, data.width, data.height, texels)
+    }
+}
+
+/// Linear RGB texels of a decoded glTF image (grey and grey-alpha images are spread to RGB,
+/// alpha is dropped).
+fn image_texels(d: &gltf::image::Data) -> Result<Vec<[f32; 3]>, String> {
+    use gltf::image::Format;
+    let srgb8: Vec<f32> = (0..256)
+        .map(|i| crate::output::srgb_decode(i as f64 / 255.0) as f32)
+        .collect();
+    let srgb16 = |x: u16| crate::output::srgb_decode(x as f64 / 65535.0) as f32;
+    let (channels, bytes_per) = match d.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let stride = channels * bytes_per;
+    let n = d.width as usize * d.height as usize;
+    if d.pixels.len() < n * stride {
+        return Err(format!(
+            "{}×{} image holds {} bytes, fewer than its size needs",
+            d.width,
+            d.height,
+            d.pixels.len()
+        ));
+    }
+    let value = |px: &[u8], c: usize| -> f32 {
+        // Grey (1 or 2 channels): every colour channel reads channel 0.
+        let c = if channels < 3 { 0 } else { c };
+        let at = c * bytes_per;
+        match bytes_per {
+            1 => srgb8[px[at] as usize],
+            2 => srgb16(u16::from_le_bytes([px[at], px[at + 1]])),
+            _ => f32::from_le_bytes([px[at], px[at + 1], px[at + 2], px[at + 3]]),
+        }
+    };
+    Ok(d.pixels[..n * stride]
+        .chunks_exact(stride)
+        .map(|px| [value(px, 0), value(px, 1), value(px, 2)])
+        .collect())
 }
 
 /// Most nested nodes (the glTF node hierarchy must be a forest; deeper chains are refused
@@ -55,7 +237,7 @@ fn visit(
     node: &gltf::Node<'_>,
     parent: DMat4,
     buffers: &[gltf::buffer::Data],
-    out: &mut TriangleMesh,
+    out: &mut Sink<'_>,
     path: &mut Vec<usize>,
     err: &dyn Fn(String) -> MeshError,
 ) -> Result<(), MeshError> {
@@ -185,7 +367,7 @@ fn add_mesh(
     m: &gltf::Mesh<'_>,
     xf: &DAffine3,
     buffers: &[gltf::buffer::Data],
-    out: &mut TriangleMesh,
+    out: &mut Sink<'_>,
     err: &dyn Fn(String) -> MeshError,
 ) -> Result<(), MeshError> {
     use gltf::mesh::Mode;
@@ -244,7 +426,7 @@ fn add_mesh(
             triangles,
         };
         part.apply_affine(xf);
-        out.append(&part);
+        out(prim.material().index(), &part);
     }
     Ok(())
 }

@@ -25,6 +25,8 @@
 mod bvh;
 #[cfg(feature = "gltf")]
 pub mod gltf;
+#[cfg(feature = "gltf")]
+pub mod gltf_material;
 pub mod mesh;
 #[cfg(feature = "obj")]
 pub mod obj;

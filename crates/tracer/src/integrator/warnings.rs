@@ -1,7 +1,8 @@
 //! Things about a scene that make a render misleading: nothing to render, lights the path
 //! tracer cannot reach through a refractive boundary, opaque objects inside a translucent
 //! one that the BSSRDF methods do not see, and translucent objects too small for a half-space
-//! profile. Printed by the CLI and recorded in the sidecar.
+//! profile; and what the loader read but could not honour ([`Scene::load_notes`]). Printed by
+//! the CLI and recorded in the sidecar.
 
 use crate::integrator::Method;
 use crate::light::Light;
@@ -9,7 +10,7 @@ use crate::scene::Scene;
 
 /// The warnings for rendering `scene` with `method`.
 pub fn scene_warnings(scene: &Scene, method: Method) -> Vec<String> {
-    let mut warnings = Vec::new();
+    let mut warnings = scene.load_notes().to_vec();
     if !scene.objects().iter().any(|o| o.emitter.is_none()) {
         warnings.push("the scene has no shapes: only lights seen directly can appear".to_string());
     }

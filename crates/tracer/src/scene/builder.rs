@@ -128,6 +128,7 @@ impl SceneBuilder {
                 source_path: None,
                 locator: &Locator::empty(),
                 inputs: Vec::new(),
+                notes: Vec::new(),
             },
             self.settings,
             self.camera,
@@ -153,6 +154,8 @@ pub(crate) struct AssemblyInfo<'a> {
     pub source_path: Option<PathBuf>,
     pub locator: &'a Locator,
     pub inputs: Vec<PathBuf>,
+    /// What the loader read but could not honour (glTF material notes), for the warnings.
+    pub notes: Vec<String>,
 }
 
 /// Checks `[render]` values; `Err((key, message))`.
@@ -332,6 +335,7 @@ pub(crate) fn assemble(
         source_path: info.source_path,
         display_name: info.display_name,
         inputs: info.inputs,
+        notes: info.notes,
     };
     scene.require_disjoint_media()?;
     Ok(scene)

@@ -430,8 +430,9 @@ pub struct RotateDesc {
 /// Keys shared by every shape.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShapeCommon {
-    /// Material name.
-    pub material: String,
+    /// Material name (required, except on a glTF shape, which then takes its materials from
+    /// the file).
+    pub material: Option<String>,
     /// Optional object name (default `shape[i]`).
     pub name: Option<String>,
     /// Optional transform.
@@ -446,8 +447,8 @@ macro_rules! shape_desc {
         pub struct $name {
             #[serde(rename = "type")]
             _type: String,
-            /// Material name.
-            pub material: String,
+            /// Material name (required, except on a glTF shape: see [`ShapeCommon`]).
+            pub material: Option<String>,
             /// Optional object name.
             pub name: Option<String>,
             /// Optional transform.

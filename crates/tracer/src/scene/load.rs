@@ -71,6 +71,7 @@ impl Scene {
             base_dir: base_dir.to_path_buf(),
             loc,
             inputs: Default::default(),
+            notes: Default::default(),
         };
         cx.load(&root, display_name)
     }
@@ -83,6 +84,8 @@ struct Cx {
     loc: Locator,
     /// Every mesh and texture file found readable, in the order they were checked.
     inputs: std::cell::RefCell<Vec<PathBuf>>,
+    /// What was read but cannot be honoured (glTF material notes).
+    notes: std::cell::RefCell<Vec<String>>,
 }
 
 type Val<'i> = Spanned<DeValue<'i>>;
@@ -245,14 +248,17 @@ impl Cx {
         let mut built: HashMap<String, Material> = HashMap::new();
         let mut pending = Vec::with_capacity(shapes.len());
         for s in shapes {
-            let material = match built.get(&s.material) {
-                Some(m) => m.clone(),
-                None => {
-                    let plan = &materials[&s.material];
-                    let m = self.realize(plan, &textures, &mut decoded)?;
-                    built.insert(s.material.clone(), m.clone());
-                    m
-                }
+            let material = match &s.material {
+                ShapeMaterial::Built(m) => m.clone(),
+                ShapeMaterial::Named(name) => match built.get(name) {
+                    Some(m) => m.clone(),
+                    None => {
+                        let plan = &materials[name];
+                        let m = self.realize(plan, &textures, &mut decoded)?;
+                        built.insert(name.clone(), m.clone());
+                        m
+                    }
+                },
             };
             if let Material::Translucent(t) = &material
                 && !t.medium.is_volumetric()
@@ -262,7 +268,7 @@ impl Cx {
                     &s.key,
                     format!(
                         "object `{}` has no texture coordinates, but its material `{}` maps an image by `mapping = \"uv\"`; use a planar mapping or a mesh with UVs",
-                        s.name, s.material
+                        s.name, s.material.name(&s.name)
                     ),
                 ));
             }
@@ -282,6 +288,7 @@ impl Cx {
                 source_path: None,
                 locator: &self.loc,
                 inputs: self.inputs.take(),
+                notes: self.notes.take(),
             },
             settings,
             camera,
@@ -948,14 +955,41 @@ impl Cx {
                     let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
                     self.check_readable(&k("path"), &path)?;
-                    let mesh = self
-                        .load_mesh(kind, &path)
-                        .map_err(|source| SceneError::Mesh {
-                            file: self.file.clone(),
-                            key: k("path"),
-                            line: self.loc.line_of_key(&k("path")),
-                            source: Box::new(source),
-                        })?;
+                    let mesh_error = |source| SceneError::Mesh {
+                        file: self.file.clone(),
+                        key: k("path"),
+                        line: self.loc.line_of_key(&k("path")),
+                        source: Box::new(source),
+                    };
+                    #[cfg(feature = "gltf")]
+                    if kind == "gltf" && common.material.is_none() {
+                        let model =
+                            crate::geometry::gltf::load_gltf_parts(&path).map_err(mesh_error)?;
+                        let shape = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
+                        let scale = match &common.transform {
+                            Some(tf) => self.transform(tf, &k("transform"))?.scale,
+                            None => DVec3::ONE,
+                        };
+                        for part in &model.parts {
+                            let name = format!("{shape}/{}", part.material.name);
+                            let material =
+                                self.gltf_material(&model, &part.material, &name, &key, scale)?;
+                            self.add_shape(
+                                &mut out,
+                                &mut names,
+                                ShapePlan {
+                                    name,
+                                    key: key.clone(),
+                                    material: ShapeMaterial::Built(material),
+                                    mesh: part.mesh.clone(),
+                                    source: path.display().to_string(),
+                                },
+                                common.transform.as_ref(),
+                            )?;
+                        }
+                        continue;
+                    }
+                    let mesh = self.load_mesh(kind, &path).map_err(mesh_error)?;
                     (common, mesh, path.display().to_string())
                 }
                 other => {
@@ -965,35 +999,141 @@ impl Cx {
                     ));
                 }
             };
-            if !materials.contains_key(&common.material) {
+            let Some(material) = common.material else {
+                return Err(self.invalid(
+                    &k("material"),
+                    "missing `material` (only a glTF shape may leave it out, to use the \
+                     file's materials)",
+                ));
+            };
+            if !materials.contains_key(&material) {
                 let mut known: Vec<&String> = materials.keys().collect();
                 known.sort();
                 return Err(self.invalid(
                     &k("material"),
-                    format!(
-                        "unknown material `{}` (defined: {known:?})",
-                        common.material
-                    ),
+                    format!("unknown material `{material}` (defined: {known:?})"),
                 ));
             }
             let name = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
-            if !names.insert(name.clone()) {
-                return Err(self.invalid(&k("name"), format!("duplicate shape name `{name}`")));
-            }
-            let mut mesh = mesh;
-            if let Some(tf) = &common.transform {
-                let xf = self.transform(tf, &k("transform"))?;
-                mesh.transform(&xf);
-            }
-            out.push(ShapePlan {
-                name,
-                key,
-                material: common.material,
-                mesh,
-                source,
-            });
+            self.add_shape(
+                &mut out,
+                &mut names,
+                ShapePlan {
+                    name,
+                    key,
+                    material: ShapeMaterial::Named(material),
+                    mesh,
+                    source,
+                },
+                common.transform.as_ref(),
+            )?;
         }
         Ok(out)
+    }
+
+    /// The material of one glTF material's part (`docs/gltf.md`): the file's values read by
+    /// [`GltfMaterial::interpret`](crate::geometry::gltf_material::GltfMaterial::interpret),
+    /// lengths scaled by the shape's `scale`, checked like a scene material; what is not read
+    /// becomes a note for the render's warnings.
+    #[cfg(feature = "gltf")]
+    fn gltf_material(
+        &self,
+        model: &crate::geometry::gltf::GltfModel,
+        m: &crate::geometry::gltf_material::GltfMaterial,
+        name: &str,
+        key: &str,
+        scale: DVec3,
+    ) -> Result<Material, SceneError> {
+        use crate::geometry::gltf_material::GltfInterpretation as I;
+        let (interpretation, notes) = m.interpret();
+        let file = model.file().display().to_string();
+        for n in notes {
+            self.notes
+                .borrow_mut()
+                .push(format!("{file}: material `{}`: {n}", m.name));
+        }
+        let field_key = format!("{key}.path");
+        let invalid =
+            |msg: String| self.invalid(&field_key, format!("{file}: material `{}`: {msg}", m.name));
+        // Lengths in the file × s are lengths in the scene (a non-uniform scale: its
+        // geometric mean).
+        let s = (scale.x * scale.y * scale.z).abs().cbrt();
+        let material = match interpretation {
+            I::Diffuse { albedo } => Material::Diffuse {
+                albedo: Rgb(albedo),
+            },
+            I::Absorbing { sigma_a, eta } => {
+                let medium = MediumField::homogeneous(het_estimate::Coefficients {
+                    sigma_a: Rgb(sigma_a) * (1.0 / s),
+                    sigma_s: Rgb::ZERO,
+                })
+                .map_err(|e| invalid(e.to_string()))?;
+                Material::Translucent(Translucent::new(name, medium, 0.0, eta))
+            }
+            I::Translucent {
+                colour,
+                mean_free_path,
+                anisotropy,
+                eta,
+            } => {
+                use crate::geometry::gltf_material::GltfColour;
+                let colour = match colour {
+                    GltfColour::Constant(c) => Field::constant(Rgb(c)),
+                    GltfColour::Texture { factor, texture } => {
+                        let tex = model.decode_image(texture.image).map_err(|source| {
+                            SceneError::Texture {
+                                file: self.file.clone(),
+                                line: self.loc.line_of_key(&field_key),
+                                key: field_key.clone(),
+                                source: Box::new(source),
+                            }
+                        })?;
+                        Field::image(
+                            Arc::new(tex),
+                            ImageMapping::Uv,
+                            texture.wrap,
+                            Filter::Bilinear,
+                            Rgb(factor),
+                        )
+                    }
+                }
+                .map_err(|e| invalid(e.to_string()))?;
+                let mfp =
+                    Field::constant(Rgb(mean_free_path) * s).map_err(|e| invalid(e.to_string()))?;
+                // The material's profile, as for a scene material without a `profile` key.
+                let inversion =
+                    AlbedoInversion::shared(ProfileModel::default_for(eta), anisotropy, eta)
+                        .map_err(|e| invalid(e.to_string()))?;
+                let medium =
+                    MediumField::artist(colour, mfp, ArtistMap::new(inversion, InvertAt::DEFAULT))
+                        .map_err(|e| invalid(e.to_string()))?;
+                Material::Translucent(Translucent::new(name, medium, anisotropy, eta))
+            }
+        };
+        validate_material(&material).map_err(|(k, msg)| invalid(format!("{k}: {msg}")))?;
+        Ok(material)
+    }
+
+    /// Checks the shape's name is new, applies its transform and adds it to `out`.
+    fn add_shape(
+        &self,
+        out: &mut Vec<ShapePlan>,
+        names: &mut HashSet<String>,
+        mut plan: ShapePlan,
+        transform: Option<&TransformDesc>,
+    ) -> Result<(), SceneError> {
+        if !names.insert(plan.name.clone()) {
+            return Err(self.invalid(
+                &format!("{}.name", plan.key),
+                format!("duplicate shape name `{}`", plan.name),
+            ));
+        }
+        if let Some(tf) = transform {
+            let xf = self.transform(tf, &format!("{}.transform", plan.key))?;
+            plan.mesh.transform(&xf);
+        }
+        out.push(plan);
+        Ok(())
     }
 
     fn load_mesh(&self, kind: &str, path: &Path) -> Result<TriangleMesh, crate::error::MeshError> {
@@ -1082,10 +1222,26 @@ enum FieldSpec {
     },
 }
 
+/// A shape's material: named in the scene file, or read from the mesh file (glTF).
+enum ShapeMaterial {
+    Named(String),
+    Built(Material),
+}
+
+impl ShapeMaterial {
+    /// The material's name in messages (a built material carries its object's name).
+    fn name<'a>(&'a self, object: &'a str) -> &'a str {
+        match self {
+            ShapeMaterial::Named(n) => n,
+            ShapeMaterial::Built(_) => object,
+        }
+    }
+}
+
 struct ShapePlan {
     name: String,
     key: String,
-    material: String,
+    material: ShapeMaterial,
     mesh: TriangleMesh,
     source: String,
 }

@@ -224,9 +224,17 @@ pub struct Scene {
     source_path: Option<PathBuf>,
     display_name: String,
     inputs: Vec<PathBuf>,
+    notes: Vec<String>,
 }
 
 impl Scene {
+    /// What the loader read but could not honour, one sentence each (for example the parts of
+    /// a glTF material that are not read, `docs/gltf.md`). Renders list them among their
+    /// warnings.
+    pub fn load_notes(&self) -> &[String] {
+        &self.notes
+    }
+
     /// The camera. Its resolution is always `settings().width × settings().height`.
     pub fn camera(&self) -> &Camera {
         &self.camera
