@@ -1100,14 +1100,17 @@ impl Cx {
                 .map_err(|e| invalid(e.to_string()))?;
                 let mfp =
                     Field::constant(Rgb(mean_free_path) * s).map_err(|e| invalid(e.to_string()))?;
-                // The material's profile, as for a scene material without a `profile` key.
-                let inversion =
-                    AlbedoInversion::shared(ProfileModel::default_for(eta), anisotropy, eta)
-                        .map_err(|e| invalid(e.to_string()))?;
+                // The material's profile, as for a scene material without a `profile` key: it
+                // defines the medium through its inversion, and renders it by default.
+                let profile = ProfileModel::default_for(eta);
+                let inversion = AlbedoInversion::shared(profile, anisotropy, eta)
+                    .map_err(|e| invalid(e.to_string()))?;
                 let medium =
                     MediumField::artist(colour, mfp, ArtistMap::new(inversion, InvertAt::DEFAULT))
                         .map_err(|e| invalid(e.to_string()))?;
-                Material::Translucent(Translucent::new(name, medium, anisotropy, eta))
+                let mut t = Translucent::new(name, medium, anisotropy, eta);
+                t.profile = Some(profile);
+                Material::Translucent(t)
             }
         };
         validate_material(&material).map_err(|(k, msg)| invalid(format!("{k}: {msg}")))?;
