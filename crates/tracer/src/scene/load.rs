@@ -249,7 +249,7 @@ impl Cx {
         let mut pending = Vec::with_capacity(shapes.len());
         for s in shapes {
             let material = match &s.material {
-                ShapeMaterial::Built(m) => m.clone(),
+                ShapeMaterial::Built(m) => (**m).clone(),
                 ShapeMaterial::Named(name) => match built.get(name) {
                     Some(m) => m.clone(),
                     None => {
@@ -980,7 +980,7 @@ impl Cx {
                                 ShapePlan {
                                     name,
                                     key: key.clone(),
-                                    material: ShapeMaterial::Built(material),
+                                    material: ShapeMaterial::Built(Box::new(material)),
                                     mesh: part.mesh.clone(),
                                     source: path.display().to_string(),
                                 },
@@ -1228,7 +1228,7 @@ enum FieldSpec {
 /// A shape's material: named in the scene file, or read from the mesh file (glTF).
 enum ShapeMaterial {
     Named(String),
-    Built(Material),
+    Built(Box<Material>),
 }
 
 impl ShapeMaterial {
