@@ -4,7 +4,7 @@
 //! translucent volume is spread over several extensions; this module reads them as written,
 //! without interpreting them. The mapping to the project's artist parameters
 //! (`subsurface_color`, `subsurface_radius`, `anisotropy`, η) is
-//! [`GltfMaterial::translucent`]; it is documented in `docs/gltf.md`.
+//! [`GltfMaterial::interpret`]; it is documented in `docs/gltf.md`.
 //!
 //! Read:
 //! * `pbrMetallicRoughness.baseColorFactor` and `baseColorTexture` (texture coordinate set 0);
