@@ -53,17 +53,28 @@ pub fn mean_and_se(
     spp: u32,
     seeds: u64,
 ) -> (f64, f64) {
-    let integrator = PathIntegrator::new(
-        scene,
-        method,
-        PathOptions {
-            scattering,
-            max_depth: 8,
-        },
-    )
-    .unwrap();
+    let options = PathOptions {
+        scattering,
+        max_depth: 8,
+    };
+    let (m, se, lost) = mean_and_se_rgb(scene, method, options, spp, seeds);
+    assert_eq!(lost, 0, "paths capped or leaked");
+    (m[0], se[0])
+}
+
+/// Per-channel image mean and its standard error from `seeds` independent renders (seeds
+/// 1000, 1001, …) of `spp` samples per pixel, with the number of paths capped or leaked.
+pub fn mean_and_se_rgb(
+    scene: &Scene,
+    method: Method,
+    options: PathOptions,
+    spp: u32,
+    seeds: u64,
+) -> (Rgb, Rgb, u64) {
+    let integrator = PathIntegrator::new(scene, method, options).unwrap();
     let (w, h) = scene.camera().resolution();
-    let means: Vec<f64> = (0..seeds)
+    let mut lost = 0;
+    let means: Vec<Rgb> = (0..seeds)
         .map(|seed| {
             let r = render(
                 w,
@@ -75,11 +86,12 @@ pub fn mean_and_se(
                     shard: Shard::WHOLE,
                 },
             );
-            assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);
-            r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
+            lost += r.counters.capped + r.counters.leaks;
+            r.pixels.iter().fold(Rgb::ZERO, |a, &p| a + p) * (1.0 / r.pixels.len() as f64)
         })
         .collect();
-    let m = means.iter().sum::<f64>() / seeds as f64;
-    let var = means.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (seeds - 1) as f64;
-    (m, (var / seeds as f64).sqrt())
+    let m = means.iter().fold(Rgb::ZERO, |a, &x| a + x) * (1.0 / seeds as f64);
+    let var = means.iter().fold(Rgb::ZERO, |a, &x| a + (x - m) * (x - m));
+    let se = (var * (1.0 / ((seeds - 1) * seeds) as f64)).map(f64::sqrt);
+    (m, se, lost)
 }

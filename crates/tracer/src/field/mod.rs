@@ -251,22 +251,7 @@ impl Field {
 
     /// The field multiplied by `k ≥ 0` (unit conversion).
     pub fn scaled(self, k: f64) -> Field {
-        match self {
-            Field::Constant(v) => Field::Constant(v * k),
-            Field::Pattern {
-                pattern,
-                values,
-                projection,
-            } => Field::Pattern {
-                pattern,
-                values: [values[0] * k, values[1] * k],
-                projection,
-            },
-            Field::Image(mut f) => {
-                f.scale *= k;
-                Field::Image(f)
-            }
-        }
+        self.scaled_rgb(Rgb::splat(k))
     }
 
     /// The field multiplied channel-wise by `k ≥ 0` (an artist's radius scale).
