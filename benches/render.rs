@@ -12,7 +12,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use het_bssrdf::bssrdf_core::Scattering;
 use het_bssrdf::experiments::scenes::CHECKER_SLAB;
 use het_bssrdf::tracer::integrator::{Method, PathIntegrator, PathOptions};
-use het_bssrdf::tracer::render::{Budget, RenderOptions, Shard, render};
+use het_bssrdf::tracer::render::{RenderOptions, render};
 use het_bssrdf::tracer::scene::Scene;
 
 fn renders(c: &mut Criterion) {
@@ -45,18 +45,7 @@ fn renders(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 seed += 1;
-                pool.install(|| {
-                    render(
-                        32,
-                        32,
-                        &integrator,
-                        &RenderOptions {
-                            budget: Budget::Samples(1),
-                            seed,
-                            shard: Shard::WHOLE,
-                        },
-                    )
-                })
+                pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))
             })
         });
     }

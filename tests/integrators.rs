@@ -10,7 +10,7 @@ use tracer::camera::Camera;
 use tracer::field::{Field, MediumField, PlanarProjection};
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
@@ -111,18 +111,7 @@ fn renders_are_identical_whatever_the_thread_count() {
             },
         )
         .unwrap();
-        pool.install(|| {
-            render(
-                128,
-                128,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(2),
-                    seed: 9,
-                    shard: Shard::WHOLE,
-                },
-            )
-        })
+        pool.install(|| render(128, 128, &integrator, &RenderOptions::samples(2, 9)))
     };
     for method in [Method::PathTraced, "sone".parse().unwrap()] {
         let a = small(1, method);

@@ -14,7 +14,7 @@ use tracer::integrator::{
     LightTraceOptions, LightTracer, Method, PathIntegrator, PathOptions, Roles,
 };
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::rng::Rng;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
@@ -393,11 +393,7 @@ fn camera_traced_seeds(scene: &Scene, estimator: Estimator, spp: u32, first: u64
     let integrator = PathIntegrator::new(scene, method, OPTIONS).unwrap();
     let images: Vec<Vec<Rgb>> = (0..SEEDS)
         .map(|s| {
-            let opts = RenderOptions {
-                budget: Budget::Samples(spp),
-                seed: first + s,
-                shard: Shard::WHOLE,
-            };
+            let opts = RenderOptions::samples(spp, first + s);
             render(N, N, &integrator, &opts).pixels
         })
         .collect();

@@ -9,7 +9,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// A huge half-space (top z = 0, η = `eta`, isotropic) seen from above over a 0.5 × 0.5 patch
@@ -76,16 +76,7 @@ pub fn mean_and_se_rgb(
     let mut lost = 0;
     let means: Vec<Rgb> = (0..seeds)
         .map(|seed| {
-            let r = render(
-                w,
-                h,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(spp),
-                    seed: 1000 + seed,
-                    shard: Shard::WHOLE,
-                },
-            );
+            let r = render(w, h, &integrator, &RenderOptions::samples(spp, 1000 + seed));
             lost += r.counters.capped + r.counters.leaks;
             r.pixels.iter().fold(Rgb::ZERO, |a, &p| a + p) * (1.0 / r.pixels.len() as f64)
         })

@@ -3,7 +3,7 @@
 use bssrdf_core::Scattering;
 use het_estimate::Averaging;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions};
-use tracer::render::{Budget, RenderOptions, Rendered, Shard, render};
+use tracer::render::{RenderOptions, Rendered, render};
 use tracer::scene::Scene;
 
 /// `method` on `scene` at `n × n` pixels, `spp` samples per pixel and `seed`, multiple
@@ -24,16 +24,7 @@ pub fn render_multiple(
         },
     )
     .unwrap();
-    render(
-        n,
-        n,
-        &integrator,
-        &RenderOptions {
-            budget: Budget::Samples(spp),
-            seed,
-            shard: Shard::WHOLE,
-        },
-    )
+    render(n, n, &integrator, &RenderOptions::samples(spp, seed))
 }
 
 /// Sone with `samples` per averaging stage and the given averaging.

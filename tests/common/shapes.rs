@@ -20,7 +20,7 @@ use tracer::field::MediumField;
 use tracer::geometry::{Ray, TriangleMesh, primitives};
 use tracer::integrator::{Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// A test shape: its mesh and the orthographic view of it.
@@ -258,16 +258,7 @@ pub fn measure(
     let (w, h) = scene.camera().resolution();
     seeds
         .map(|seed| {
-            let r = render(
-                w,
-                h,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(spp),
-                    seed,
-                    shard: Shard::WHOLE,
-                },
-            );
+            let r = render(w, h, &integrator, &RenderOptions::samples(spp, seed));
             let c = r.counters;
             assert!(c.capped == 0 && c.leaks * 10_000 <= c.paths, "{c:?}");
             let mean = r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64;

@@ -17,7 +17,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// Environment radiance.
@@ -191,11 +191,7 @@ pub fn measure(case: &Case) -> Measurement {
         case.resolution,
         case.resolution,
         &integrator,
-        &RenderOptions {
-            budget: Budget::Samples(case.spp),
-            seed: case.seed,
-            shard: Shard::WHOLE,
-        },
+        &RenderOptions::samples(case.spp, case.seed),
     );
     let seconds = start.elapsed().as_secs_f64();
     let values: Vec<f64> = img.pixels.iter().map(|p| p[0]).collect();

@@ -80,6 +80,17 @@ pub struct RenderOptions {
     pub shard: Shard,
 }
 
+impl RenderOptions {
+    /// The whole image at `spp` samples per pixel with `seed`.
+    pub fn samples(spp: u32, seed: u64) -> Self {
+        Self {
+            budget: Budget::Samples(spp),
+            seed,
+            shard: Shard::WHOLE,
+        }
+    }
+}
+
 /// Shard `index` of `count` of an image: the rows `y` with `y mod count = index` (interleaved
 /// rows). Interleaving balances the load, since every shard samples every band of the image
 /// (a bright object in one band costs every shard alike), and any image height works: shards

@@ -22,7 +22,7 @@ use tracer::field::MediumField;
 use tracer::geometry::primitives;
 use tracer::integrator::{LightStrategy, Method, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{Budget, RenderOptions, Shard, render};
+use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::lambert_irradiance;
@@ -124,16 +124,7 @@ fn image_mean(scene: &Scene, method: Method, strategy: LightStrategy, spp: u32) 
     let seeds = 8u64;
     let means: Vec<f64> = (0..seeds)
         .map(|seed| {
-            let r = render(
-                N,
-                N,
-                &integrator,
-                &RenderOptions {
-                    budget: Budget::Samples(spp),
-                    seed: 7000 + seed,
-                    shard: Shard::WHOLE,
-                },
-            );
+            let r = render(N, N, &integrator, &RenderOptions::samples(spp, 7000 + seed));
             assert_eq!(r.counters.capped + r.counters.leaks, 0, "{:?}", r.counters);
             r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
         })
