@@ -28,28 +28,9 @@ fn artist_medium(colour: Rgb, mfp: f64, model: ProfileModel, eta: f64) -> Medium
 /// A deep half-space (top z = 0) of `medium` seen straight down by an orthographic camera
 /// (4 × 4 pixels over 0.5 × 0.5), under a uniform environment of radiance 1.
 fn uniform_half_space(medium: MediumField, model: ProfileModel, eta: f64) -> Scene {
-    let n = 4;
-    let camera = Camera::orthographic(
-        DVec3::new(0.0, 0.0, 1.0),
-        DVec3::NEG_Z,
-        DVec3::Y,
-        0.5,
-        0.5,
-        n,
-        n,
-    )
-    .unwrap();
     let mut t = Translucent::new("m", medium, 0.0, eta);
     t.profile = Some(model);
-    SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
-        .light(Light::environment(Rgb::ONE).unwrap())
-        .object(
-            "half-space",
-            primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 8),
-            Material::Translucent(t),
-        )
-        .build()
-        .unwrap()
+    crate::common::half_space::half_space_lit(t, Light::environment(Rgb::ONE).unwrap())
 }
 
 /// Per-channel image mean and its standard error over `seeds` independent renders (all

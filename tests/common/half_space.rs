@@ -22,6 +22,12 @@ pub fn half_space_scene(sigma_a: f64, sigma_s: f64, light_to: DVec3, eta: f64) -
 
 /// [`half_space_scene`] with any medium field.
 pub fn half_space_scene_with(medium: MediumField, light_to: DVec3, eta: f64) -> Scene {
+    let light = Light::directional(-light_to.normalize(), Rgb::ONE).unwrap();
+    half_space_lit(Translucent::new("m", medium, 0.0, eta), light)
+}
+
+/// The half-space of [`half_space_scene`] made of `material`, lit by `light` alone.
+pub fn half_space_lit(material: Translucent, light: Light) -> Scene {
     let n = 4;
     let camera = Camera::orthographic(
         DVec3::new(0.0, 0.0, 1.0),
@@ -34,11 +40,11 @@ pub fn half_space_scene_with(medium: MediumField, light_to: DVec3, eta: f64) -> 
     )
     .unwrap();
     SceneBuilder::new(RenderSettings::new(n, n, 1), camera)
-        .light(Light::directional(-light_to.normalize(), Rgb::ONE).unwrap())
+        .light(light)
         .object(
             "half-space",
             primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
-            Material::Translucent(Translucent::new("m", medium, 0.0, eta)),
+            Material::Translucent(material),
         )
         .build()
         .unwrap()

@@ -479,11 +479,7 @@ impl GltfMaterial {
                 anisotropy: s.anisotropy,
                 eta,
             }
-        } else if self.diffuse_transmission.is_some_and(|t| t.factor > 0.0) {
-            let t = self.diffuse_transmission.unwrap_or(DiffuseTransmissionExt {
-                factor: 0.0,
-                color: [1.0; 3],
-            });
+        } else if let Some(t) = self.diffuse_transmission.filter(|t| t.factor > 0.0) {
             if t.factor < 1.0 || t.color != [1.0; 3] {
                 notes.push(format!(
                     "diffuseTransmissionFactor {} and diffuseTransmissionColorFactor {:?} are \

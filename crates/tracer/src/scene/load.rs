@@ -963,17 +963,23 @@ impl Cx {
                     };
                     #[cfg(feature = "gltf")]
                     if kind == "gltf" && common.material.is_none() {
-                        let model =
+                        let mut model =
                             crate::geometry::gltf::load_gltf_parts(&path).map_err(mesh_error)?;
                         let shape = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
-                        let scale = match &common.transform {
-                            Some(tf) => self.transform(tf, &k("transform"))?.scale,
-                            None => DVec3::ONE,
-                        };
-                        for part in &model.parts {
+                        let xf = self.shape_transform(&common, &key)?;
+                        let scale = xf.map_or(DVec3::ONE, |t| t.scale);
+                        // Materials that share an image decode it once.
+                        let mut images = HashMap::new();
+                        for part in std::mem::take(&mut model.parts) {
                             let name = format!("{shape}/{}", part.material.name);
-                            let material =
-                                self.gltf_material(&model, &part.material, &name, &key, scale)?;
+                            let material = self.gltf_material(
+                                &model,
+                                &part.material,
+                                &mut images,
+                                &name,
+                                &key,
+                                scale,
+                            )?;
                             self.add_shape(
                                 &mut out,
                                 &mut names,
@@ -981,10 +987,10 @@ impl Cx {
                                     name,
                                     key: key.clone(),
                                     material: ShapeMaterial::Built(Box::new(material)),
-                                    mesh: part.mesh.clone(),
+                                    mesh: part.mesh,
                                     source: path.display().to_string(),
                                 },
-                                common.transform.as_ref(),
+                                xf.as_ref(),
                             )?;
                         }
                         continue;
@@ -999,7 +1005,7 @@ impl Cx {
                     ));
                 }
             };
-            let Some(material) = common.material else {
+            let Some(material) = common.material.clone() else {
                 return Err(self.invalid(
                     &k("material"),
                     "missing `material` (only a glTF shape may leave it out, to use the \
@@ -1015,6 +1021,7 @@ impl Cx {
                 ));
             }
             let name = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
+            let xf = self.shape_transform(&common, &key)?;
             self.add_shape(
                 &mut out,
                 &mut names,
@@ -1025,7 +1032,7 @@ impl Cx {
                     mesh,
                     source,
                 },
-                common.transform.as_ref(),
+                xf.as_ref(),
             )?;
         }
         Ok(out)
@@ -1040,6 +1047,7 @@ impl Cx {
         &self,
         model: &crate::geometry::gltf::GltfModel,
         m: &crate::geometry::gltf_material::GltfMaterial,
+        images: &mut HashMap<usize, Arc<Texture>>,
         name: &str,
         key: &str,
         scale: DVec3,
@@ -1080,16 +1088,24 @@ impl Cx {
                 let colour = match colour {
                     GltfColour::Constant(c) => Field::constant(Rgb(c)),
                     GltfColour::Texture { factor, texture } => {
-                        let tex = model.decode_image(texture.image).map_err(|source| {
-                            SceneError::Texture {
-                                file: self.file.clone(),
-                                line: self.loc.line_of_key(&field_key),
-                                key: field_key.clone(),
-                                source: Box::new(source),
+                        let tex = match images.get(&texture.image) {
+                            Some(t) => t.clone(),
+                            None => {
+                                let t = model.decode_image(texture.image).map_err(|source| {
+                                    SceneError::Texture {
+                                        file: self.file.clone(),
+                                        line: self.loc.line_of_key(&field_key),
+                                        key: field_key.clone(),
+                                        source: Box::new(source),
+                                    }
+                                })?;
+                                let t = Arc::new(t);
+                                images.insert(texture.image, t.clone());
+                                t
                             }
-                        })?;
+                        };
                         Field::image(
-                            Arc::new(tex),
+                            tex,
                             ImageMapping::Uv,
                             texture.wrap,
                             Filter::Bilinear,
@@ -1117,13 +1133,26 @@ impl Cx {
         Ok(material)
     }
 
+    /// The shape's `transform`, checked (once per shape, however many objects it makes).
+    fn shape_transform(
+        &self,
+        common: &ShapeCommon,
+        key: &str,
+    ) -> Result<Option<Transform>, SceneError> {
+        common
+            .transform
+            .as_ref()
+            .map(|tf| self.transform(tf, &format!("{key}.transform")))
+            .transpose()
+    }
+
     /// Checks the shape's name is new, applies its transform and adds it to `out`.
     fn add_shape(
         &self,
         out: &mut Vec<ShapePlan>,
         names: &mut HashSet<String>,
         mut plan: ShapePlan,
-        transform: Option<&TransformDesc>,
+        transform: Option<&Transform>,
     ) -> Result<(), SceneError> {
         if !names.insert(plan.name.clone()) {
             return Err(self.invalid(
@@ -1131,9 +1160,8 @@ impl Cx {
                 format!("duplicate shape name `{}`", plan.name),
             ));
         }
-        if let Some(tf) = transform {
-            let xf = self.transform(tf, &format!("{}.transform", plan.key))?;
-            plan.mesh.transform(&xf);
+        if let Some(xf) = transform {
+            plan.mesh.transform(xf);
         }
         out.push(plan);
         Ok(())
