@@ -172,6 +172,11 @@ impl AreaTable {
         let i = (x.floor() as usize).min(self.width - 1);
         let j = (y.floor() as usize).min(self.height - 1);
         let (fx, fy) = (x - i as f64, y - j as f64);
+        if fy == 0.0 {
+            // On a table row (bands of level k ≥ 0 start and end on rows): half the reads.
+            let (a, b) = (self.s(i, j), self.s(i + 1, j));
+            return std::array::from_fn(|k| a[k] + fx * (b[k] - a[k]));
+        }
         let (a, b, c, d) = (
             self.s(i, j),
             self.s(i + 1, j),
@@ -293,9 +298,9 @@ impl AreaTable {
     /// non-finite or zero-area ellipse, or one taller than `2^40·MAX_ROWS` rows.
     pub fn ellipse_average(&self, e: &TexelEllipse, wrap: Wrap) -> Option<[f64; 3]> {
         let [mut cx, mut cy] = e.centre;
+        let (w, h) = (self.width as f64, self.height as f64);
         if wrap == Wrap::Repeat && cx.is_finite() && cy.is_finite() {
             // Whole periods do not change the average: keep the coordinates small.
-            let (w, h) = (self.width as f64, self.height as f64);
             cx -= (cx * self.inv_w).floor() * w;
             cy -= (cy * self.inv_h).floor() * h;
         }
@@ -343,13 +348,22 @@ impl AreaTable {
             }
             let half = 0.5 * area / (y1 - y0);
             let xc = cx + shear * (0.5 * (y0 + y1) - cy);
-            let i = match wrap {
-                Wrap::Repeat => {
-                    let band = self.repeat_band(y0, y1);
-                    let (r1, r0) = (band(xc + half), band(xc - half));
-                    std::array::from_fn(|k| r1[k] - r0[k] + self.mean[k] * area)
+            let (x0, x1) = (xc - half, xc + half);
+            let i = if y0 >= 0.0 && y1 <= h && x0 >= 0.0 && x1 <= w {
+                // Inside the table: no wrap to apply, and rows read directly (the common
+                // case once the centre is brought into the first period).
+                let f = |x: f64, y: f64| self.inside(x, y);
+                let (a, b, c, d) = (f(x1, y1), f(x0, y1), f(x1, y0), f(x0, y0));
+                std::array::from_fn(|k| a[k] - b[k] - c[k] + d[k] + self.mean[k] * area)
+            } else {
+                match wrap {
+                    Wrap::Repeat => {
+                        let band = self.repeat_band(y0, y1);
+                        let (r1, r0) = (band(xc + half), band(xc - half));
+                        std::array::from_fn(|k| r1[k] - r0[k] + self.mean[k] * area)
+                    }
+                    Wrap::Clamp => self.rect_integral(x0, x1, y0, y1, wrap),
                 }
-                Wrap::Clamp => self.rect_integral(xc - half, xc + half, y0, y1, wrap),
             };
             for c in 0..3 {
                 sum[c] += i[c];
