@@ -372,3 +372,98 @@ fn path_tracer_warns_when_delta_lights_hide_behind_a_refractive_boundary() {
     .unwrap();
     assert!(sone.warnings().is_empty());
 }
+
+#[test]
+fn deferring_unlit_carriers_weights_leaves_the_image_unchanged_in_expectation() {
+    // A BSSRDF box lit from straight above, seen from below: the camera sees its unlit bottom
+    // face, whose probe hits on the bottom (and sides) gather nothing, so their carriers'
+    // weights are deferred; the light then arrives through the floor below (lit outside the
+    // box's shadow) and through the top face (reached by the normal probe). Deferred and eager
+    // weights must give the same image mean within noise, and deferring must skip estimates.
+    let toml = r#"
+        [render]
+        width = 16
+        height = 16
+        spp = 1
+        seed = 1
+        scattering = "multiple"
+        [camera]
+        type = "orthographic"
+        centre = [0.0, 0.0, -1.0]
+        direction = [0.0, 0.0, 1.0]
+        up = [0.0, 1.0, 0.0]
+        width = 8.0
+        height = 8.0
+        [[material]]
+        name = "wax"
+        type = "translucent"
+        sigma_a = { type = "stripe", width = 3.0, angle = 30.0, values = [0.01, 0.05], axis = "z" }
+        sigma_s = 1.0
+        g = 0.0
+        eta = 1.0
+        profile = "dipole"
+        [[material]]
+        name = "floor"
+        type = "diffuse"
+        albedo = 0.8
+        [[light]]
+        type = "directional"
+        direction = [0.0, 0.0, -1.0]
+        irradiance = 1.0
+        [[shape]]
+        type = "box"
+        name = "box"
+        material = "wax"
+        min = [-5.0, -5.0, 0.0]
+        max = [5.0, 5.0, 4.0]
+        [[shape]]
+        type = "box"
+        name = "floor"
+        material = "floor"
+        min = [-60.0, -60.0, -3.0]
+        max = [60.0, 60.0, -2.0]
+    "#;
+    let scene = Scene::from_toml_str(toml, std::path::Path::new("."), "deferred").unwrap();
+    let options = PathOptions {
+        scattering: Scattering::Multiple,
+        max_depth: 8,
+    };
+    let method: Method = "sone".parse().unwrap();
+    let (spp, seeds) = (16, 12u64);
+    let run = |defer: bool| {
+        let integrator = PathIntegrator::new(&scene, method, options)
+            .unwrap()
+            .with_deferred_weights(defer);
+        let mut estimates = 0;
+        let means: Vec<f64> = (0..seeds)
+            .map(|seed| {
+                let r = render(
+                    16,
+                    16,
+                    &integrator,
+                    &RenderOptions::samples(spp, 500 + seed),
+                );
+                estimates += r.counters.estimates;
+                r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
+            })
+            .collect();
+        let m = means.iter().sum::<f64>() / seeds as f64;
+        let var = means.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (seeds - 1) as f64;
+        (m, (var / seeds as f64).sqrt(), estimates)
+    };
+    let (m_eager, se_eager, est_eager) = run(false);
+    let (m_defer, se_defer, est_defer) = run(true);
+    let se = (se_eager * se_eager + se_defer * se_defer).sqrt();
+    assert!(
+        m_eager > 0.0 && se < 0.03 * m_eager,
+        "test too weak: {m_eager} ± {se}"
+    );
+    assert!(
+        (m_defer - m_eager).abs() < 4.0 * se,
+        "deferred {m_defer} ± {se_defer}, eager {m_eager} ± {se_eager}"
+    );
+    assert!(
+        est_defer * 10 < est_eager * 9,
+        "deferring skipped too few estimates: {est_defer} of {est_eager}"
+    );
+}

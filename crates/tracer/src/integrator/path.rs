@@ -236,6 +236,8 @@ pub struct PathIntegrator<'s> {
     lights: LightSet,
     warnings: Vec<String>,
     strategy: LightStrategy,
+    /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
+    defer_weights: bool,
 }
 
 /// How light sources are found: the two strategies of multiple importance sampling (Veach
@@ -301,6 +303,27 @@ struct PathState {
     /// The translucent object the path is travelling in (path tracing).
     medium: Option<u32>,
     prev: Prev,
+    /// A factor of `beta` not evaluated yet: the BSSRDF profile weight of the point the path
+    /// continued from, deferred because that point gathered no light (see [`Deferred`]).
+    deferred: Option<Deferred>,
+}
+
+/// The profile weight `R(x_i, x_o)·scale` of a BSSRDF continuation, owed to `beta`.
+///
+/// At each BSSRDF vertex the path continues from one incident point x_i (the carrier). Its
+/// weight needs an estimate (averaging over a region: the costly part of a BSSRDF sample),
+/// which is wasted when nothing reaches the camera through the rest of the path: on a convex
+/// object lit from one side, carriers on the unlit faces continue into the void. When the
+/// carrier gathered no light itself, its weight is therefore evaluated only when the path
+/// first adds light ([`PathIntegrator::settle`]). The factor multiplies `beta`, so evaluating
+/// it later gives the same value in distribution (its random numbers come from the same
+/// stream, later): the image stays unbiased and deterministic for a seed. Russian roulette
+/// reads `beta` without it (any continuation probability keeps the estimate unbiased).
+struct Deferred {
+    object: u32,
+    x_i: Hit,
+    x_o: Hit,
+    scale: f64,
 }
 
 impl PathState {
@@ -382,6 +405,7 @@ impl<'s> PathIntegrator<'s> {
             lights: LightSet::new(scene.lights()),
             warnings,
             strategy: LightStrategy::Mis,
+            defer_weights: true,
         })
     }
 
@@ -389,6 +413,15 @@ impl<'s> PathIntegrator<'s> {
     /// diagnostics: see [`LightStrategy`]).
     pub fn with_light_strategy(mut self, strategy: LightStrategy) -> Self {
         self.strategy = strategy;
+        self
+    }
+
+    /// Evaluates every BSSRDF continuation's profile weight at once (`false`) instead of when
+    /// the path first adds light (`true`, the default; see [`Deferred`]). Both give the same
+    /// image in expectation; the switch exists to test that, and to measure what deferring
+    /// saves.
+    pub fn with_deferred_weights(mut self, defer: bool) -> Self {
+        self.defer_weights = defer;
         self
     }
 
@@ -413,6 +446,7 @@ impl<'s> PathIntegrator<'s> {
             entered: false,
             medium: None,
             prev: Prev::Specular,
+            deferred: None,
         };
         let mut ray = ray;
         let mut arrived = None;
@@ -427,7 +461,10 @@ impl<'s> PathIntegrator<'s> {
                     Some(hit) => hit,
                     None => {
                         let le = self.escaped(&ray, st.prev);
-                        st.add(st.beta * le, st.order, st.entered, filter);
+                        if !le.is_zero() {
+                            self.settle(&mut st, rng, counters);
+                            st.add(st.beta * le, st.order, st.entered, filter);
+                        }
                         break;
                     }
                 },
@@ -450,7 +487,10 @@ impl<'s> PathIntegrator<'s> {
                 ObjectKind::Opaque => match &self.scene.objects()[hit.object as usize].material {
                     Material::Emissive { .. } => {
                         let le = self.emitted(&hit, &ray, st.prev);
-                        st.add(st.beta * le, st.order, st.entered, filter);
+                        if !le.is_zero() {
+                            self.settle(&mut st, rng, counters);
+                            st.add(st.beta * le, st.order, st.entered, filter);
+                        }
                         Step::Stop
                     }
                     Material::Diffuse { albedo } => {
@@ -690,6 +730,9 @@ impl<'s> PathIntegrator<'s> {
             rng,
             counters,
         );
+        if !ld.l.is_zero() {
+            self.settle(st, rng, counters);
+        }
         // Light whose shadow ray crossed a medium has entered one, as the cosine-sampled path
         // through the same medium will have (`entered` set with no scattering added).
         st.add(
@@ -811,6 +854,7 @@ impl<'s> PathIntegrator<'s> {
         };
         let nee = interface.is_index_matched() && !self.lights.is_empty();
         let filter = self.options.scattering;
+        self.settle(st, rng, counters);
         let beta = st.beta;
         let mut added = Rgb::ZERO;
         let mut scattered = false;
@@ -949,20 +993,37 @@ impl<'s> PathIntegrator<'s> {
                 counters,
             );
             let ld = ld.l;
-            if ld.is_zero() && k != carrier {
-                continue; // nothing to gather: skip the (costly) estimate
+            if ld.is_zero() && (k != carrier || self.defer_weights) {
+                // Nothing to gather: skip the (costly) estimate, or owe it (the carrier).
+                if k == carrier {
+                    next = Some((x_i, Err(ph.weight * set.len() as f64)));
+                }
+                continue;
             }
             let rd = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
             let w = rd * ph.weight;
+            self.settle(st, rng, counters);
             st.l += st.beta * w * ld;
             if k == carrier {
-                next = Some((x_i, w * set.len() as f64));
+                next = Some((x_i, Ok(w * set.len() as f64)));
             }
         }
         let Some((x_i, w)) = next else {
             return Step::Stop;
         };
-        st.beta *= w;
+        match w {
+            Ok(w) => st.beta *= w,
+            Err(scale) => {
+                // One factor is owed at a time: settle an older one first.
+                self.settle(st, rng, counters);
+                st.deferred = Some(Deferred {
+                    object,
+                    x_i,
+                    x_o: *hit,
+                    scale,
+                });
+            }
+        }
         if st.beta.is_zero() {
             return Step::Stop;
         }
@@ -980,6 +1041,22 @@ impl<'s> PathIntegrator<'s> {
             pdf: cos / std::f64::consts::PI,
         };
         Step::Continue(x_i.spawn_ray(wi))
+    }
+
+    /// Evaluates the path's deferred profile weight, if any, into `beta` (see [`Deferred`]).
+    fn settle(&self, st: &mut PathState, rng: &mut Rng, counters: &mut PathCounters) {
+        let Some(d) = st.deferred.take() else {
+            return;
+        };
+        let Some((material, b)) = self.bssrdf_object(d.object) else {
+            unreachable!("a deferred weight belongs to a BSSRDF object");
+        };
+        let surface = ObjectSurface {
+            geometry: self.scene.geometry(),
+            object: d.object,
+        };
+        let rd = b.profile(&surface, &material.medium, &d.x_i, &d.x_o, rng, counters);
+        st.beta *= rd * d.scale;
     }
 
     /// The translucent material and BSSRDF data of `object`, when it is rendered with a
