@@ -169,8 +169,10 @@ impl AreaTable {
     /// `F(x, y)` of the mean-free texture for `0 ≤ x ≤ W`, `0 ≤ y ≤ H`: bilinear in the cell.
     #[inline]
     fn inside(&self, x: f64, y: f64) -> [f64; 3] {
-        let i = (x.floor() as usize).min(self.width - 1);
-        let j = (y.floor() as usize).min(self.height - 1);
+        // `v as usize` is `v.floor() as usize` for every v (the cast truncates toward zero and
+        // saturates negatives and NaN to 0), without a libm call: the hot path.
+        let i = (x as usize).min(self.width - 1);
+        let j = (y as usize).min(self.height - 1);
         let (fx, fy) = (x - i as f64, y - j as f64);
         if fy == 0.0 {
             // On a table row (bands of level k ≥ 0 start and end on rows): half the reads.
@@ -243,7 +245,7 @@ impl AreaTable {
     /// A row position `y ∈ [0, H]`: its cell row and fraction.
     #[inline]
     fn row(&self, y: f64) -> (usize, f64) {
-        let j = (y.floor() as usize).min(self.height - 1);
+        let j = (y as usize).min(self.height - 1);
         (j, y - j as f64)
     }
 
@@ -264,7 +266,7 @@ impl AreaTable {
         move |x: f64| {
             let qx = (x * self.inv_w).floor();
             let rx = (x - qx * w).clamp(0.0, w);
-            let i = (rx.floor() as usize).min(self.width - 1);
+            let i = (rx as usize).min(self.width - 1);
             let fx = rx - i as f64;
             let lerp = |j: usize, k: usize| {
                 let (p, q) = (self.s(i, j)[k], self.s(i + 1, j)[k]);
