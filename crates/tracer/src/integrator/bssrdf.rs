@@ -16,15 +16,24 @@
 //! not the point lookups `jensen-in`/`jensen-out`, see docs/reciprocity.md). Both cosines use
 //! the same rule ([`facing_normal`]), and the product of the two Fresnel factors is formed
 //! before it meets the profile, so the swap gives the same value bit for bit.
+//!
+//! Thin parts ([`BssrdfObject::profile`], docs/shapes.md "Thin parts: the slab profile"):
+//! with the tabulated profile and a material that is `thickness_aware` (the default), R is
+//! the slab profile of `bssrdf_core::slab_profile` at the object's local thickness d, the
+//! mean of the two points' thicknesses along their inward normals ([`thickness`]): the
+//! reflection R_slab(|x_i − x_o|; d) when the normals face the same way (n_i · n_o ≥ 0), the
+//! transmission T_slab(ρ; d) through the opposite face otherwise, ρ = √(|x_i − x_o|² − d²)
+//! the distance from x_i's inward normal line as the slab table measures it. Every choice is
+//! symmetric in the two points, so reciprocity holds as above.
 
 use std::f64::consts::PI;
 
-use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SlabFace};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
 
 use crate::field::MediumField;
-use crate::geometry::{Hit, ObjectSurface};
+use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::probe::ProbeSampler;
 use crate::rng::Rng;
@@ -45,6 +54,9 @@ pub(crate) struct BssrdfObject {
     /// The longest side of the object's bounding box: the extent the probe radii are drawn
     /// within ([`super::probe::probe_within`]).
     pub extent: f64,
+    /// Weigh pairs by the slab profile of the local thickness (see the module docs): the
+    /// material is `thickness_aware` and the family has a slab table (tabulated model).
+    thickness_aware: bool,
 }
 
 impl BssrdfObject {
@@ -59,7 +71,10 @@ impl BssrdfObject {
         extent: f64,
     ) -> Result<Self, (&'static str, bssrdf_core::ParamError)> {
         let (family, estimator) = material.prepare_bssrdf(profile, scattering, estimator)?;
+        let thickness_aware =
+            material.thickness_aware && family.model() == ProfileModel::Tabulated;
         Ok(Self {
+            thickness_aware,
             sampler: ProbeSampler::new(family, &material.medium),
             family,
             estimator,
@@ -84,7 +99,9 @@ impl BssrdfObject {
 
     /// R(|x_i − x_o|) (1/length², per channel) at the coefficients the estimator gives for
     /// the pair, `x_i` the incident point (where light enters) and `x_o` the exitant one;
-    /// the estimate and profile evaluation are recorded in `counters`.
+    /// for a thickness-aware object the slab profile's reflection or transmission at the
+    /// pair's thickness instead (module docs). The estimate and profile evaluation are
+    /// recorded in `counters`.
     pub fn profile(
         &self,
         surface: &ObjectSurface<'_>,
@@ -96,7 +113,24 @@ impl BssrdfObject {
     ) -> Rgb {
         let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
         counters.record_estimate(&est.diagnostics);
-        counters.eval_profile(&self.family, est.coefficients, (x_i.p - x_o.p).length())
+        let r = (x_i.p - x_o.p).length();
+        if !self.thickness_aware {
+            return counters.eval_profile(&self.family, est.coefficients, r);
+        }
+        let d = 0.5 * (thickness(surface, x_i) + thickness(surface, x_o));
+        let (face, dist) = if x_i.ns.dot(x_o.ns) >= 0.0 {
+            (SlabFace::Reflection, r)
+        } else {
+            (
+                SlabFace::Transmission,
+                if d.is_finite() {
+                    (r * r - d * d).max(0.0).sqrt()
+                } else {
+                    r
+                },
+            )
+        };
+        counters.eval_slab_profile(&self.family, est.coefficients, d, face, dist)
     }
 
     /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs); 0
@@ -134,4 +168,16 @@ pub(crate) fn facing_normal(hit: &Hit, w: DVec3) -> Option<DVec3> {
     } else {
         Some(hit.ng)
     }
+}
+
+/// The object's thickness at `hit` (length): the distance along the inward shading normal −n_s
+/// to the object's surface on the far side, +∞ when the ray leaves without meeting it (an
+/// open mesh). One ray against the object's own BVH.
+pub(crate) fn thickness(surface: &ObjectSurface<'_>, hit: &Hit) -> f64 {
+    let dir = -hit.ns;
+    let ray = Ray::new(hit.spawn_origin(dir), dir);
+    surface
+        .geometry
+        .intersect_object(surface.object, &ray)
+        .map_or(f64::INFINITY, |h| (h.p - hit.p).length())
 }
