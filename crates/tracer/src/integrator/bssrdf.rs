@@ -18,13 +18,14 @@
 //! before it meets the profile, so the swap gives the same value bit for bit.
 //!
 //! Thin parts ([`BssrdfObject::profile`], docs/shapes.md "Thin parts: the slab profile"):
-//! with the tabulated profile and a material that is `thickness_aware` (the default), R is
-//! the slab profile of `bssrdf_core::slab_profile` at the object's local thickness d, the
-//! mean of the two points' thicknesses along their inward normals ([`thickness`]): the
-//! reflection R_slab(|x_i − x_o|; d) when the normals face the same way (n_i · n_o ≥ 0), the
-//! transmission T_slab(ρ; d) through the opposite face otherwise, ρ = √(|x_i − x_o|² − d²)
-//! the distance from x_i's inward normal line as the slab table measures it. Every choice is
-//! symmetric in the two points, so reciprocity holds as above.
+//! with the tabulated profile and a material that is `thickness_aware` (the default), a pair
+//! that sits as on a slab ([`slab_pair`]) is weighed by the slab profile of
+//! `bssrdf_core::slab_profile` at the object's local thickness d, the mean of the two points'
+//! thicknesses along their inward normals ([`thickness`]): the reflection R_slab(|x_i − x_o|;
+//! d) for two points on one face, the transmission T_slab(ρ; d) for points on opposite faces,
+//! ρ the distance from the beam's axis as the slab table measures it. Other pairs keep the
+//! half-space profile. Every choice is symmetric in the two points, so reciprocity holds as
+//! above.
 
 use std::f64::consts::PI;
 
@@ -118,19 +119,12 @@ impl BssrdfObject {
             return counters.eval_profile(&self.family, est.coefficients, r);
         }
         let d = 0.5 * (thickness(surface, x_i) + thickness(surface, x_o));
-        let (face, dist) = if x_i.ns.dot(x_o.ns) >= 0.0 {
-            (SlabFace::Reflection, r)
-        } else {
-            (
-                SlabFace::Transmission,
-                if d.is_finite() {
-                    (r * r - d * d).max(0.0).sqrt()
-                } else {
-                    r
-                },
-            )
-        };
-        counters.eval_slab_profile(&self.family, est.coefficients, d, face, dist)
+        match slab_pair(x_i, x_o, d) {
+            Some((face, dist)) => {
+                counters.eval_slab_profile(&self.family, est.coefficients, d, face, dist)
+            }
+            None => counters.eval_profile(&self.family, est.coefficients, r),
+        }
     }
 
     /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs); 0
@@ -180,4 +174,39 @@ pub(crate) fn thickness(surface: &ObjectSurface<'_>, hit: &Hit) -> f64 {
         .geometry
         .intersect_object(surface.object, &ray)
         .map_or(f64::INFINITY, |h| (h.p - hit.p).length())
+}
+
+/// How far (as a fraction of the thickness) a pair may depart from a slab's geometry and still
+/// be weighed by the slab profile ([`slab_pair`]; docs/shapes.md).
+pub const SLAB_TOLERANCE: f64 = 0.25;
+
+/// Whether the pair (x_i, x_o) sits as on a slab of thickness `d` (finite), and if so on which
+/// face and at which distance the slab profile weighs it. With Δ = x_i − x_o, the depths of
+/// each point below the other's tangent plane, a = −Δ·n_o and b = Δ·n_i, are 0 for two
+/// points on one face of a slab and d for points on opposite faces. The pair is
+/// * a reflection pair when n_i · n_o ≥ 0 and |a|, |b| ≤ [`SLAB_TOLERANCE`]·d: R_slab(|Δ|);
+/// * a transmission pair when n_i · n_o < 0 and |a − d|, |b − d| ≤ [`SLAB_TOLERANCE`]·d:
+///   T_slab(ρ), ρ² = |Δ|² − a·b (the distance from the beam's axis; exactly the slab table's
+///   on a slab, clamped at 0);
+/// * otherwise `None`: the half-space profile at |Δ| (curved bodies, corners: where the
+///   thickness along the normal does not describe the path between the points).
+///
+/// Symmetric under x_i ↔ x_o (a and b swap), so the BSSRDF stays reciprocal.
+pub(crate) fn slab_pair(x_i: &Hit, x_o: &Hit, d: f64) -> Option<(SlabFace, f64)> {
+    if !d.is_finite() {
+        return None;
+    }
+    let delta = x_i.p - x_o.p;
+    let (a, b) = (-delta.dot(x_o.ns), delta.dot(x_i.ns));
+    let tol = SLAB_TOLERANCE * d;
+    if x_i.ns.dot(x_o.ns) >= 0.0 {
+        (a.abs() <= tol && b.abs() <= tol).then(|| (SlabFace::Reflection, delta.length()))
+    } else {
+        ((a - d).abs() <= tol && (b - d).abs() <= tol).then(|| {
+            (
+                SlabFace::Transmission,
+                (delta.length_squared() - a * b).max(0.0).sqrt(),
+            )
+        })
+    }
 }
