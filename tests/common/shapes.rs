@@ -178,7 +178,12 @@ pub fn shape_scene(shape: Shape, medium: Medium, bunny: &Path) -> Scene {
 
 /// [`shape_scene`] with the material's `thickness_aware` set (false: the half-space profile
 /// everywhere, `examples/shapes.rs -- --half-space`).
-pub fn shape_scene_with(shape: Shape, medium: Medium, bunny: &Path, thickness_aware: bool) -> Scene {
+pub fn shape_scene_with(
+    shape: Shape,
+    medium: Medium,
+    bunny: &Path,
+    thickness_aware: bool,
+) -> Scene {
     let (mesh, camera) = shape.mesh_and_camera(bunny);
     let (w, h) = camera.resolution();
     let field =

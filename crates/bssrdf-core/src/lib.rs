@@ -104,8 +104,8 @@ pub use profile::RadialProfile;
 pub use rgb::Rgb;
 pub use rgb_profile::RgbProfile;
 pub use slab_profile::SlabProfile;
-pub use tabulated::SlabFace;
 pub use table::{ProfileTable, TableSampler};
+pub use tabulated::SlabFace;
 
 #[cfg(test)]
 mod known_answers;

@@ -118,7 +118,11 @@ mod tests {
             // With single scattering the half-space term interpolates the sum of both orders
             // log–log between bin centres, the slab profile each order alone: equal at the
             // centres, within 0.1 % between them; the totals are linear and equal.
-            let tol = if scattering == Scattering::All { 1e-3 } else { 1e-12 };
+            let tol = if scattering == Scattering::All {
+                1e-3
+            } else {
+                1e-12
+            };
             for r in [0.0, 0.01, 0.3, 2.0, 30.0] {
                 let (a, b) = (hs.eval(r), slab.eval(SlabFace::Reflection, r));
                 assert!((a - b).abs() <= tol * a.max(1e-300), "{r}: {a} {b}");

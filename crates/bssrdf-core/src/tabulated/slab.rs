@@ -60,8 +60,7 @@ static DATA: &[u8] = include_bytes!("../../data/slab-profile-v1.bin");
 pub fn slab_table() -> &'static SlabData {
     static TABLE: OnceLock<SlabData> = OnceLock::new();
     TABLE.get_or_init(|| {
-        let mut t =
-            SlabData::from_bytes(DATA).expect("the built-in slab table is valid (tested)");
+        let mut t = SlabData::from_bytes(DATA).expect("the built-in slab table is valid (tested)");
         for p in &mut t.planes {
             p.pool_sparse_bins(POOL_REL_SE);
         }

@@ -6,16 +6,20 @@
 //! every exit is tallied by face (the entry face z = 0: reflection; the opposite face z = −d:
 //! transmission), by radius from the beam's axis, and weighted by α^n for each albedo row (n
 //! the number of scattering events; exact, see [`super::simulate`]). Only multiple scattering
-//! (n ≥ 2) is tabulated per bin; unscattered light (n = 0, which leaves along the beam's axis)
-//! is counted per face as a total only, for the closed-form check of the geometry and the
-//! Fresnel boundaries. Photon `i` of plane `p` draws from its own stream keyed by (seed,
+//! (n ≥ 2) is tabulated per bin; single scattering (n = 1) per face and row as a total only,
+//! and unscattered light (n = 0, which leaves along the beam's axis) per face as a total only:
+//! with the mean number of scattering events per photon, they are what the closed-form
+//! checks of the geometry, the Fresnel boundaries and the energy balance need
+//! (`tests/slab_table.rs`). Photon `i` of plane `p` draws from its own stream keyed by (seed,
 //! `SLAB_KEY` + p, i), chunks are merged in order: the file is bit-identical for a seed and a
 //! photon count whatever the number of threads.
 //!
 //! Layout (version 1), little-endian: the magic `HBSSRDFS`, u32 version, u64 seed, u64 photons
 //! per plane, u32 thicknesses, u32 η planes, u32 albedo rows, u32 radial bins; the thicknesses
 //! and the η values (f64 each); then per plane (thickness-major, η-minor): u64 photons dropped
-//! at the event cap, for each face the unscattered fraction and its standard error (f64), then
+//! at the event cap, the mean number of scattering events per photon (f64), for each face the
+//! unscattered fraction and its standard error (f64), for face × row the single-scattering
+//! total and its standard error (f64), then
 //! for face × row × bin the multiple-scattering exitance density (f32, per unit area in
 //! mfp², per unit entering power) and its standard error (f32), then for face × row the
 //! total (f64) and its standard error (f64), totals counting every exit, also beyond the last
@@ -45,6 +49,9 @@ struct SlabTally {
     total: Vec<f64>,
     total2: Vec<f64>,
     ballistic: [u64; 2],
+    single: Vec<f64>,
+    single2: Vec<f64>,
+    events: u64,
     capped: u64,
 }
 
@@ -57,6 +64,9 @@ impl SlabTally {
             total: vec![0.0; 2 * SLAB_ROWS],
             total2: vec![0.0; 2 * SLAB_ROWS],
             ballistic: [0; 2],
+            single: vec![0.0; 2 * SLAB_ROWS],
+            single2: vec![0.0; 2 * SLAB_ROWS],
+            events: 0,
             capped: 0,
         }
     }
@@ -64,6 +74,7 @@ impl SlabTally {
     fn merge(&mut self, o: &SlabTally) {
         self.photons += o.photons;
         self.capped += o.capped;
+        self.events += o.events;
         for f in 0..2 {
             self.ballistic[f] += o.ballistic[f];
         }
@@ -72,6 +83,8 @@ impl SlabTally {
             (&mut self.sum2, &o.sum2),
             (&mut self.total, &o.total),
             (&mut self.total2, &o.total2),
+            (&mut self.single, &o.single),
+            (&mut self.single2, &o.single2),
         ] {
             for (x, y) in a.iter_mut().zip(b) {
                 *x += y;
@@ -94,11 +107,17 @@ fn slab_chunk(
         let mut rng = Stream::new(seed, key, i);
         let ok = trace(eta, thickness, &mut rng, |n, x, face| {
             let f = usize::from(face == Face::Opposite);
+            t.events += u64::from(n);
             if n == 0 {
                 t.ballistic[f] += 1;
                 return;
             }
-            if n < 2 {
+            if n == 1 {
+                for (row, la) in ln_alpha.iter().enumerate() {
+                    let w = la.exp();
+                    t.single[f * SLAB_ROWS + row] += w;
+                    t.single2[f * SLAB_ROWS + row] += w * w;
+                }
                 return;
             }
             let bin = bin_of(x);
@@ -131,6 +150,8 @@ pub struct SlabPlane {
     pub eta: f64,
     /// Photons dropped at the event cap.
     pub capped: u64,
+    /// Mean number of scattering events per photon (of the photons that left).
+    pub mean_events: f64,
     /// Per face (entry, opposite): the fraction of entering power that leaves unscattered.
     pub ballistic: [f64; 2],
     /// Its standard error.
@@ -139,6 +160,10 @@ pub struct SlabPlane {
     pub density: Vec<f32>,
     /// Its standard error.
     pub density_se: Vec<f32>,
+    /// `[face][row]` total single-scattering exitance.
+    pub single: Vec<f64>,
+    /// Its standard error.
+    pub single_se: Vec<f64>,
     /// `[face][row]` total multiple-scattering exitance.
     pub total: Vec<f64>,
     /// Its standard error.
@@ -159,6 +184,9 @@ impl SlabPlane {
         let (total, total_se) = (0..2 * SLAB_ROWS)
             .map(|k| mean_se(t.total[k], t.total2[k], n))
             .unzip();
+        let (single, single_se) = (0..2 * SLAB_ROWS)
+            .map(|k| mean_se(t.single[k], t.single2[k], n))
+            .unzip();
         let b = |f: usize| {
             let c = t.ballistic[f] as f64;
             mean_se(c, c, n)
@@ -167,8 +195,11 @@ impl SlabPlane {
             thickness,
             eta,
             capped: t.capped,
+            mean_events: t.events as f64 / (t.photons - t.capped).max(1) as f64,
             ballistic: [b(0).0, b(1).0],
             ballistic_se: [b(0).1, b(1).1],
+            single,
+            single_se,
             density,
             density_se,
             total,
@@ -219,7 +250,11 @@ impl SlabData {
         }
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
+            b.extend_from_slice(&p.mean_events.to_le_bytes());
             for v in p.ballistic.iter().chain(&p.ballistic_se) {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            for v in p.single.iter().chain(&p.single_se) {
                 b.extend_from_slice(&v.to_le_bytes());
             }
             for v in p.density.iter().chain(&p.density_se) {
@@ -257,10 +292,15 @@ impl SlabData {
         for &thickness in &SLAB_THICKNESSES {
             for &eta in &SLAB_ETAS {
                 let capped = r.u64()?;
+                let mean_events = r.f64()?;
                 let ballistic = [r.f64()?, r.f64()?];
                 let ballistic_se = [r.f64()?, r.f64()?];
-                let f32s = |r: &mut Reader, n| (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>();
-                let f64s = |r: &mut Reader, n| (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>();
+                let f32s =
+                    |r: &mut Reader, n| (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>();
+                let f64s =
+                    |r: &mut Reader, n| (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>();
+                let single = f64s(&mut r, 2 * SLAB_ROWS)?;
+                let single_se = f64s(&mut r, 2 * SLAB_ROWS)?;
                 let density = f32s(&mut r, PER_PLANE)?;
                 let density_se = f32s(&mut r, PER_PLANE)?;
                 let total = f64s(&mut r, 2 * SLAB_ROWS)?;
@@ -273,6 +313,9 @@ impl SlabData {
                         .chain(&total_se)
                         .chain(&ballistic)
                         .chain(&ballistic_se)
+                        .chain(&single)
+                        .chain(&single_se)
+                        .chain([&mean_events])
                         .all(ok64);
                 if !finite {
                     return Err(TableFileError("negative or non-finite value"));
@@ -281,8 +324,11 @@ impl SlabData {
                     thickness,
                     eta,
                     capped,
+                    mean_events,
                     ballistic,
                     ballistic_se,
+                    single,
+                    single_se,
                     density,
                     density_se,
                     total,
