@@ -220,3 +220,56 @@ pub(crate) fn slab_pair(x_i: &Hit, x_o: &Hit, d: f64) -> Option<(SlabFace, f64)>
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec2;
+
+    fn hit(p: DVec3, n: DVec3) -> Hit {
+        Hit {
+            t: 1.0,
+            p,
+            ng: n,
+            ns: n,
+            uv: DVec2::ZERO,
+            object: 0,
+            prim: 0,
+            bary: DVec2::ZERO,
+            p_error: 0.0,
+        }
+    }
+
+    #[test]
+    fn slab_pairs_are_classified_as_on_a_slab_and_symmetrically() {
+        let d = 2.0;
+        let top = |x: f64| hit(DVec3::new(x, 0.0, 0.0), DVec3::Z);
+        let bottom = |x: f64| hit(DVec3::new(x, 0.0, -d), DVec3::NEG_Z);
+        // Same face: reflection at the distance; opposite faces: transmission at the lateral
+        // distance from the axis.
+        assert_eq!(
+            slab_pair(&top(3.0), &top(0.0), d),
+            Some((SlabFace::Reflection, 3.0))
+        );
+        let (face, rho) = slab_pair(&bottom(1.5), &top(0.0), d).unwrap();
+        assert_eq!(face, SlabFace::Transmission);
+        assert!((rho - 1.5).abs() < 1e-12);
+        // Symmetric in the pair.
+        for (a, b) in [(bottom(1.5), top(0.0)), (top(0.7), top(-2.0))] {
+            assert_eq!(slab_pair(&a, &b, d), slab_pair(&b, &a, d));
+        }
+        // On a sphere of radius 1 (thickness 2 along every normal) the back hemisphere away
+        // from the antipode and far points of the front one are not slab pairs.
+        let on_sphere = |th: f64| {
+            let n = DVec3::new(th.sin(), 0.0, th.cos());
+            hit(n, n)
+        };
+        let north = on_sphere(0.0);
+        assert!(slab_pair(&on_sphere(2.0), &north, 2.0).is_none()); // 115°
+        assert!(slab_pair(&on_sphere(1.2), &north, 2.0).is_none()); // 69°
+        assert!(slab_pair(&on_sphere(3.1), &north, 2.0).is_some()); // near the antipode
+        assert!(slab_pair(&on_sphere(0.3), &north, 2.0).is_some()); // near x_o
+        // An open mesh (no far side) keeps the half-space profile.
+        assert!(slab_pair(&top(1.0), &top(0.0), f64::INFINITY).is_none());
+    }
+}
