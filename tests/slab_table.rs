@@ -60,14 +60,13 @@ fn unscattered_light_matches_the_closed_form_through_both_boundaries() {
         let (e1, e2) = ((-p.thickness).exp(), (-2.0 * p.thickness).exp());
         let den = 1.0 - f * f * e2;
         let want = [f * (1.0 - f) * e2 / den, (1.0 - f) * e1 / den];
-        for face in 0..2 {
+        for (face, want) in want.into_iter().enumerate() {
             let (got, se) = (p.ballistic[face], p.ballistic_se[face]);
             assert!(
-                (got - want[face]).abs() <= 4.0 * se + floor,
-                "d {} η {} face {face}: {got} ± {se}, exact {}",
+                (got - want).abs() <= 4.0 * se + floor,
+                "d {} η {} face {face}: {got} ± {se}, exact {want}",
                 p.thickness,
                 p.eta,
-                want[face]
             );
         }
     }
