@@ -3,7 +3,7 @@
 //! seed and photon count whatever the thread count; the built-in table is
 //! `crates/bssrdf-core/data/halfspace-profile-v1.bin`, made with the defaults below; `--slab`
 //! writes the slab table instead (`crates/bssrdf-core/data/slab-profile-v1.bin`, made with
-//! `--slab --photons 200000`).
+//! `--slab --photons 4000000`).
 
 use std::path::PathBuf;
 
