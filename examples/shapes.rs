@@ -4,9 +4,11 @@
 //! the same ratio on a half-space, with standard errors over seeds; and the fraction of BSSRDF
 //! shading points whose probes found nothing.
 //!
-//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8] [-- --oblique]
+//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8] [-- --oblique] [-- --half-space]
 //!
 //! `--oblique` replaces the shapes by the half-space seen at μ = 0.58 and 0.3 from its normal.
+//! `--half-space` turns the materials' `thickness_aware` off: the tabulated profile is the
+//! half-space one everywhere, as before the slab profile (docs/shapes.md).
 //!
 //! The set-up is in `tests/common/shapes.rs` (shared with the `shapes` tests). The bunny is
 //! read from `../shared/assets/bunny.obj` relative to the repository's root and skipped when
@@ -20,7 +22,7 @@ use std::path::PathBuf;
 
 use bssrdf_core::ProfileModel;
 use het_bssrdf::{bssrdf_core, tracer};
-use shapes::{Medium, Shape, bssrdf, mean_se, measure, outside_light, ratio, shape_scene};
+use shapes::{Medium, Shape, bssrdf, mean_se, measure, outside_light, ratio, shape_scene_with};
 use tracer::integrator::Method;
 
 /// Samples per pixel and seeds: per shape (pixel counts differ) and per method.
@@ -40,6 +42,7 @@ fn budget(shape: Shape, quick: bool) -> (u32, u32, u64) {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
+    let thickness_aware = !args.iter().any(|a| a == "--half-space");
     let g = args
         .iter()
         .position(|a| a == "--g")
@@ -68,7 +71,7 @@ fn main() {
         let mut row = Vec::new();
         let mut miss_row = Vec::new();
         for (ci, &m) in columns.iter().enumerate() {
-            let scene = shape_scene(shape, m, &bunny);
+            let scene = shape_scene_with(shape, m, &bunny, thickness_aware);
             let outside = outside_light(&scene, m.eta, 32);
             let t0 = std::time::Instant::now();
             let seed0 = 1000 * ci as u64;

@@ -10,6 +10,7 @@ mod precision;
 mod readme;
 mod reciprocity;
 mod shapes;
+mod slab_table;
 mod stability;
 mod stiff;
 mod tabulated;

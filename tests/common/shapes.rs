@@ -173,6 +173,17 @@ impl Medium {
 
 /// `shape` filled with `medium` under a uniform environment of radiance 1.
 pub fn shape_scene(shape: Shape, medium: Medium, bunny: &Path) -> Scene {
+    shape_scene_with(shape, medium, bunny, true)
+}
+
+/// [`shape_scene`] with the material's `thickness_aware` set (false: the half-space profile
+/// everywhere, `examples/shapes.rs -- --half-space`).
+pub fn shape_scene_with(
+    shape: Shape,
+    medium: Medium,
+    bunny: &Path,
+    thickness_aware: bool,
+) -> Scene {
     let (mesh, camera) = shape.mesh_and_camera(bunny);
     let (w, h) = camera.resolution();
     let field =
@@ -182,7 +193,10 @@ pub fn shape_scene(shape: Shape, medium: Medium, bunny: &Path) -> Scene {
         .object(
             "shape",
             mesh,
-            Material::Translucent(Translucent::new("m", field, medium.g, medium.eta)),
+            Material::Translucent(Translucent {
+                thickness_aware,
+                ..Translucent::new("m", field, medium.g, medium.eta)
+            }),
         )
         .build()
         .unwrap()

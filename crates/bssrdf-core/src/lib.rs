@@ -24,6 +24,7 @@
 //! | [`single_scattering`] | single scattering (any model, via [`Scattering`]) | HCJ13 / pbrt | exponential proposal |
 //! | [`directional_dipole`] | directional dipole `S_d(x_i, ω_i, n_i; x_o, n_o)` | FHK14 sample code | — |
 //! | [`tabulated`] | the exact half-space profile, single and multiple, by photon simulation | this project (`docs/tabulated-profile.md`) | exact, binned density |
+//! | [`slab_profile`] | slab reflection and transmission at a local thickness, multiple scattering, by photon simulation | this project (`docs/tabulated-profile.md`, "The slab table") | — |
 //!
 //! [`fresnel`] provides the exact Fresnel moments `C₁`, `C₂` (quadrature, valid for η ∈ [1, 3]
 //! and beyond) and the optional Egan–Hilgeman fit ([`DiffuseFresnel`]); [`family`] prepares a
@@ -86,6 +87,7 @@ mod quadrature;
 pub mod rgb;
 pub mod rgb_profile;
 pub mod single_scattering;
+pub mod slab_profile;
 pub mod table;
 pub mod tabulated;
 
@@ -101,7 +103,9 @@ pub use model::{ProfileModel, Scattering, UnknownName};
 pub use profile::RadialProfile;
 pub use rgb::Rgb;
 pub use rgb_profile::RgbProfile;
+pub use slab_profile::SlabProfile;
 pub use table::{ProfileTable, TableSampler};
+pub use tabulated::SlabFace;
 
 #[cfg(test)]
 mod known_answers;

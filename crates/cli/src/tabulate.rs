@@ -1,13 +1,17 @@
 //! `het-bssrdf tabulate`: regenerate the tabulated half-space profile's data file
 //! (`bssrdf_core::tabulated`) by photon simulation. The file is bit-identical for a given
 //! seed and photon count whatever the thread count; the built-in table is
-//! `crates/bssrdf-core/data/halfspace-profile-v1.bin`, made with the defaults below.
+//! `crates/bssrdf-core/data/halfspace-profile-v1.bin`, made with the defaults below; `--slab`
+//! writes the slab table instead (`crates/bssrdf-core/data/slab-profile-v1.bin`, made with
+//! `--slab --photons 4000000`).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use bssrdf_core::tabulated::file::tabulate;
 use bssrdf_core::tabulated::grid::ETAS;
+use bssrdf_core::tabulated::slab::{SLAB_ETAS, SLAB_THICKNESSES};
+use bssrdf_core::tabulated::slab_file::tabulate_slab;
 
 use crate::common::{check_writable, parse_positive};
 
@@ -23,6 +27,10 @@ pub struct Args {
     /// Seed of the simulation.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Simulate the slab table (`bssrdf_core::tabulated::slab`, built in as
+    /// `crates/bssrdf-core/data/slab-profile-v1.bin`) instead of the half-space one.
+    #[arg(long)]
+    slab: bool,
     /// Worker threads (default: every core); the file does not depend on it.
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     threads: Option<u64>,
@@ -34,6 +42,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let threads = args
         .threads
         .map_or_else(rayon::current_num_threads, |t| t as usize);
+    if args.slab {
+        return run_slab(&args, threads);
+    }
     let bar = experiments::progress::bar(ETAS.len() as u64, "tabulate", "planes");
     let start = std::time::Instant::now();
     let data = tabulate(args.seed, args.photons, threads, |_| bar.inc(1));
@@ -43,6 +54,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let capped: u64 = data.planes.iter().map(|p| p.capped).sum();
     println!(
         "wrote {} ({} planes x {} photons, seed {}, {} paths cut at the event cap) in {:.1} s",
+        args.out.display(),
+        data.planes.len(),
+        data.photons,
+        data.seed,
+        capped,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// `--slab`: the slab table, one plane per (thickness, η).
+fn run_slab(args: &Args, threads: usize) -> anyhow::Result<()> {
+    let planes = SLAB_THICKNESSES.len() * SLAB_ETAS.len();
+    let bar = experiments::progress::bar(planes as u64, "tabulate", "planes");
+    let start = std::time::Instant::now();
+    let data = tabulate_slab(args.seed, args.photons, threads, |_| bar.inc(1));
+    bar.finish_and_clear();
+    tracer::output::write_atomic(&args.out, &data.to_bytes())
+        .with_context(|| format!("cannot write `{}`", args.out.display()))?;
+    let capped: u64 = data.planes.iter().map(|p| p.capped).sum();
+    println!(
+        "wrote {} ({} slab planes x {} photons, seed {}, {} paths cut at the event cap) in {:.1} s",
         args.out.display(),
         data.planes.len(),
         data.photons,

@@ -51,10 +51,7 @@ impl Plane {
     /// Mean and standard error per bin and total from a tally of `eta`.
     pub fn from_tally(eta: f64, t: &Tally) -> Self {
         let n = t.photons as f64;
-        let mean_se = |s: f64, s2: f64| {
-            let m = s / n;
-            (m, ((s2 / n - m * m).max(0.0) / n).sqrt())
-        };
+        let mean_se = |s: f64, s2: f64| mean_se(s, s2, n);
         let mut density = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
         let mut density_se = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
         for (i, (d, se)) in density.iter_mut().zip(density_se.iter_mut()).enumerate() {
@@ -85,32 +82,44 @@ impl Plane {
     /// run's energy is unchanged). Bins with a small enough error are left as they are. This
     /// removes the zeros and spikes of pure counting noise without moving energy between runs.
     pub fn pool_sparse_bins(&mut self, max_rel_se: f64) {
-        for series in 0..2 * N_ALBEDO {
-            let base = series * N_BINS;
-            let mut j = 0;
-            while j < N_BINS {
-                let (mut e, mut var, mut area) = (0.0, 0.0, 0.0);
-                let mut k = j;
-                while k < N_BINS {
-                    let a = annulus_area(k);
-                    e += f64::from(self.density[base + k]) * a;
-                    var += (f64::from(self.density_se[base + k]) * a).powi(2);
-                    area += a;
-                    k += 1;
-                    if e > 0.0 && var.sqrt() <= max_rel_se * e {
-                        break;
-                    }
+        pool_sparse_bins(&mut self.density, &mut self.density_se, max_rel_se);
+    }
+}
+
+/// [`Plane::pool_sparse_bins`] on any series of [`N_BINS`] radial bins laid end to end
+/// (`density.len()` a multiple of `N_BINS`), densities and their standard errors.
+pub(crate) fn pool_sparse_bins(density: &mut [f32], density_se: &mut [f32], max_rel_se: f64) {
+    for series in 0..density.len() / N_BINS {
+        let base = series * N_BINS;
+        let mut j = 0;
+        while j < N_BINS {
+            let (mut e, mut var, mut area) = (0.0, 0.0, 0.0);
+            let mut k = j;
+            while k < N_BINS {
+                let a = annulus_area(k);
+                e += f64::from(density[base + k]) * a;
+                var += (f64::from(density_se[base + k]) * a).powi(2);
+                area += a;
+                k += 1;
+                if e > 0.0 && var.sqrt() <= max_rel_se * e {
+                    break;
                 }
-                if k - j > 1 {
-                    for b in j..k {
-                        self.density[base + b] = (e / area) as f32;
-                        self.density_se[base + b] = (var.sqrt() / area) as f32;
-                    }
-                }
-                j = k;
             }
+            if k - j > 1 {
+                for b in j..k {
+                    density[base + b] = (e / area) as f32;
+                    density_se[base + b] = (var.sqrt() / area) as f32;
+                }
+            }
+            j = k;
         }
     }
+}
+
+/// Mean and standard error of the mean from a sum and a sum of squares over `n` samples.
+pub(crate) fn mean_se(s: f64, s2: f64, n: f64) -> (f64, f64) {
+    let m = s / n;
+    (m, ((s2 / n - m * m).max(0.0) / n).sqrt())
 }
 
 impl TableData {
@@ -202,10 +211,10 @@ impl TableData {
     }
 }
 
-struct Reader<'a>(&'a [u8]);
+pub(crate) struct Reader<'a>(pub(crate) &'a [u8]);
 
 impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], TableFileError> {
+    pub(crate) fn take(&mut self, n: usize) -> Result<&'a [u8], TableFileError> {
         if self.0.len() < n {
             return Err(TableFileError("truncated"));
         }
@@ -213,22 +222,22 @@ impl<'a> Reader<'a> {
         self.0 = b;
         Ok(a)
     }
-    fn u32(&mut self) -> Result<u32, TableFileError> {
+    pub(crate) fn u32(&mut self) -> Result<u32, TableFileError> {
         Ok(u32::from_le_bytes(
             self.take(4)?.try_into().expect("4 bytes"),
         ))
     }
-    fn u64(&mut self) -> Result<u64, TableFileError> {
+    pub(crate) fn u64(&mut self) -> Result<u64, TableFileError> {
         Ok(u64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
     }
-    fn f32(&mut self) -> Result<f32, TableFileError> {
+    pub(crate) fn f32(&mut self) -> Result<f32, TableFileError> {
         Ok(f32::from_le_bytes(
             self.take(4)?.try_into().expect("4 bytes"),
         ))
     }
-    fn f64(&mut self) -> Result<f64, TableFileError> {
+    pub(crate) fn f64(&mut self) -> Result<f64, TableFileError> {
         Ok(f64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))

@@ -56,41 +56,8 @@ impl TabulatedTerm {
     /// The profile for extinction `sigma_t` (> 0), albedo `alpha` ∈ [0, 1] and `eta` ∈ [1,
     /// [`ETA_MAX`]] (clamped), counting single and/or multiple scattering.
     pub fn new(sigma_t: f64, alpha: f64, eta: f64, single: bool, multiple: bool) -> Self {
-        // Cubic Lagrange interpolation in η through the four planes around η (quadratic in the
-        // first and last interval): exact at the planes and continuous between them. Linear
-        // interpolation between planes 0.15 apart would miss the totals' curvature by several
-        // times the table's noise near α = 1 (measured; see docs/tabulated-profile.md).
-        let last = (ETAS.len() - 1) as f64;
-        let pe = ((eta - ETAS[0]) / (ETAS[1] - ETAS[0])).clamp(0.0, last);
-        let i = (pe.floor() as usize).min(ETAS.len() - 2);
-        let (first, we) = if i == 0 || i == ETAS.len() - 2 {
-            // Quadratic through nodes mid − 1, mid, mid + 1 at t = pe − mid.
-            let mid = i.clamp(1, ETAS.len() - 2);
-            let t = pe - mid as f64;
-            (
-                mid - 1,
-                [0.5 * t * (t - 1.0), 1.0 - t * t, 0.5 * t * (t + 1.0), 0.0],
-            )
-        } else {
-            let u = pe - i as f64;
-            (
-                i - 1,
-                [
-                    -u * (u - 1.0) * (u - 2.0) / 6.0,
-                    (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0,
-                    -(u + 1.0) * u * (u - 2.0) / 2.0,
-                    (u + 1.0) * u * (u - 1.0) / 6.0,
-                ],
-            )
-        };
-        let s = (1.0 - alpha.clamp(0.0, 1.0)).sqrt();
-        let pr = if s <= S_MIN {
-            0.0
-        } else {
-            ((s / S_MIN).ln() / (1.0 / S_MIN).ln() * (N_ALBEDO - 1) as f64)
-                .clamp(0.0, (N_ALBEDO - 1) as f64)
-        };
-        let (r0, fr) = split(pr, N_ALBEDO);
+        let (first, we) = eta_weights(eta, &ETAS);
+        let (r0, fr) = row_position(alpha, N_ALBEDO);
         let c = |dp: usize, dr: usize| Corner {
             plane: (first + dp).min(ETAS.len() - 1) as u8,
             row: (r0 + dr) as u8,
@@ -115,7 +82,7 @@ impl TabulatedTerm {
     /// R̂ summed over the selected kinds and interpolated corners, in bin `j` (1/mfp²);
     /// never negative (the quadratic weights can overshoot where a bin is nearly empty).
     #[inline]
-    fn bin_value(&self, j: usize) -> f64 {
+    pub(crate) fn bin_value(&self, j: usize) -> f64 {
         let t = table();
         let mut v = 0.0;
         for c in &self.corners {
@@ -133,30 +100,9 @@ impl TabulatedTerm {
         v.max(0.0)
     }
 
-    /// R̂ at optical radius `x`: log–log interpolation between bin centres.
+    /// R̂ at optical radius `x` ([`radial_value`]).
     fn value(&self, x: f64) -> f64 {
-        if x >= X_LAST {
-            return 0.0;
-        }
-        if x <= centre(0) {
-            return self.bin_value(0);
-        }
-        if x < centre(1) {
-            let f = (x - centre(0)) / (centre(1) - centre(0));
-            return (1.0 - f) * self.bin_value(0) + f * self.bin_value(1);
-        }
-        let u = (x / X_FIRST).log10() * BINS_PER_DECADE as f64 + 0.5;
-        let j = (u as usize).clamp(1, N_BINS - 1);
-        if j >= N_BINS - 1 {
-            return self.bin_value(N_BINS - 1);
-        }
-        let f = (u - j as f64).clamp(0.0, 1.0);
-        let (a, b) = (self.bin_value(j), self.bin_value(j + 1));
-        if a > 0.0 && b > 0.0 {
-            (a.ln() * (1.0 - f) + b.ln() * f).exp()
-        } else {
-            (1.0 - f) * a + f * b
-        }
+        radial_value(x, |j| self.bin_value(j))
     }
 
     /// Probability mass of each bin (sums to ≤ 1 before normalisation) and their total. A scan
@@ -179,6 +125,80 @@ impl TabulatedTerm {
 fn split(p: f64, n: usize) -> (usize, f64) {
     let i = (p.floor() as usize).min(n - 2);
     (i, (p - i as f64).clamp(0.0, 1.0))
+}
+
+/// Lagrange weights for `eta` on the uniform grid `etas` (at least 3 planes; `eta` clamped to
+/// its range): the first of the four planes used and their weights. Cubic through the four
+/// planes around `eta`, quadratic in the first and last interval: exact at the planes and
+/// continuous between them. Linear interpolation between planes 0.15 apart would miss the
+/// totals' curvature by several times the table's noise near α = 1 (measured; see
+/// docs/tabulated-profile.md). The fourth weight is 0 in the end intervals.
+pub(crate) fn eta_weights(eta: f64, etas: &[f64]) -> (usize, [f64; 4]) {
+    let n = etas.len();
+    let last = (n - 1) as f64;
+    let pe = ((eta - etas[0]) / (etas[1] - etas[0])).clamp(0.0, last);
+    let i = (pe.floor() as usize).min(n - 2);
+    if i == 0 || i == n - 2 {
+        // Quadratic through nodes mid − 1, mid, mid + 1 at t = pe − mid.
+        let mid = i.clamp(1, n - 2);
+        let t = pe - mid as f64;
+        (
+            mid - 1,
+            [0.5 * t * (t - 1.0), 1.0 - t * t, 0.5 * t * (t + 1.0), 0.0],
+        )
+    } else {
+        let u = pe - i as f64;
+        (
+            i - 1,
+            [
+                -u * (u - 1.0) * (u - 2.0) / 6.0,
+                (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0,
+                -(u + 1.0) * u * (u - 2.0) / 2.0,
+                (u + 1.0) * u * (u - 1.0) / 6.0,
+            ],
+        )
+    }
+}
+
+/// The albedo rows around `alpha` on a grid of `rows` rows with `s = √(1 − α)` geometric from
+/// [`S_MIN`] to 1 (linear in log s; larger albedos use the first row): the lower row and the
+/// weight of the next.
+pub(crate) fn row_position(alpha: f64, rows: usize) -> (usize, f64) {
+    let s = (1.0 - alpha.clamp(0.0, 1.0)).sqrt();
+    let pr = if s <= S_MIN {
+        0.0
+    } else {
+        ((s / S_MIN).ln() / (1.0 / S_MIN).ln() * (rows - 1) as f64).clamp(0.0, (rows - 1) as f64)
+    };
+    split(pr, rows)
+}
+
+/// A binned density (`bin(j)`, 1/mfp², on the grid of [`super::grid`]) at optical radius `x`:
+/// log–log interpolation between bin centres (linear where a neighbour is 0, constant inside
+/// the first bin's centre, 0 from the last edge on).
+pub(crate) fn radial_value(x: f64, bin: impl Fn(usize) -> f64) -> f64 {
+    if x >= X_LAST {
+        return 0.0;
+    }
+    if x <= centre(0) {
+        return bin(0);
+    }
+    if x < centre(1) {
+        let f = (x - centre(0)) / (centre(1) - centre(0));
+        return (1.0 - f) * bin(0) + f * bin(1);
+    }
+    let u = (x / X_FIRST).log10() * BINS_PER_DECADE as f64 + 0.5;
+    let j = (u as usize).clamp(1, N_BINS - 1);
+    if j >= N_BINS - 1 {
+        return bin(N_BINS - 1);
+    }
+    let f = (u - j as f64).clamp(0.0, 1.0);
+    let (a, b) = (bin(j), bin(j + 1));
+    if a > 0.0 && b > 0.0 {
+        (a.ln() * (1.0 - f) + b.ln() * f).exp()
+    } else {
+        (1.0 - f) * a + f * b
+    }
 }
 
 impl RadialProfile for TabulatedTerm {

@@ -78,13 +78,13 @@ impl Tally {
 }
 
 /// SplitMix64 (Steele, Lea & Flood 2014), one stream per photon.
-struct Stream(u64);
+pub(crate) struct Stream(u64);
 
 impl Stream {
     /// A stream whose starting state is a hash of (seed, plane, photon): streams of different
     /// photons start at unrelated points of the generator's period (a state merely offset by
     /// the photon index would make photon i + 1 replay photon i's numbers shifted by one).
-    fn new(seed: u64, plane: u64, photon: u64) -> Self {
+    pub(crate) fn new(seed: u64, plane: u64, photon: u64) -> Self {
         let key = mix(photon ^ mix(plane ^ mix(seed)));
         Stream(key)
     }
@@ -109,26 +109,52 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Traces one photon; calls `exit(n, x)` with its number of scattering events and exit radius.
-/// Returns false if it was capped.
-fn trace(eta: f64, rng: &mut Stream, mut exit: impl FnMut(u32, f64)) -> bool {
+/// The face a photon leaves through: the entry face z = 0 (reflection) or, in a slab, the
+/// opposite face z = −d (transmission).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Face {
+    /// The face the beam entered through.
+    Entry,
+    /// The slab's opposite face.
+    Opposite,
+}
+
+/// Traces one photon in a medium bounded by z = 0 above and, for a slab, by z = −`thickness`
+/// below (`f64::INFINITY` for the half-space); calls `exit(n, x, face)` with its number of
+/// scattering events, exit radius and face. Returns false if it was capped. Both faces
+/// reflect with the same dielectric Fresnel reflectance. For the half-space the random numbers
+/// drawn are exactly those of the half-space-only version this generalises (the built-in
+/// table stays reproducible).
+pub(crate) fn trace(
+    eta: f64,
+    thickness: f64,
+    rng: &mut Stream,
+    mut exit: impl FnMut(u32, f64, Face),
+) -> bool {
     let (mut px, mut py, mut pz) = (0.0f64, 0.0f64, 0.0f64);
     let (mut dx, mut dy, mut dz) = (0.0f64, 0.0f64, -1.0f64);
     let mut n = 0u32;
     loop {
         let t = -rng.uniform().ln();
         let z_new = pz + t * dz;
-        if z_new >= 0.0 && dz > 0.0 {
-            // Reaches the boundary before the next collision.
-            let tb = -pz / dz;
+        let face = if z_new >= 0.0 && dz > 0.0 {
+            Some((Face::Entry, 0.0))
+        } else if z_new <= -thickness && dz < 0.0 {
+            Some((Face::Opposite, -thickness))
+        } else {
+            None
+        };
+        if let Some((face, z_face)) = face {
+            // Reaches a boundary before the next collision.
+            let tb = (z_face - pz) / dz;
             px += tb * dx;
             py += tb * dy;
-            pz = 0.0;
-            if eta != 1.0 && rng.uniform() <= dielectric(dz, 1.0 / eta) {
+            pz = z_face;
+            if eta != 1.0 && rng.uniform() <= dielectric(dz.abs(), 1.0 / eta) {
                 dz = -dz; // internal reflection; the free path restarts (memoryless)
                 continue;
             }
-            exit(n, (px * px + py * py).sqrt());
+            exit(n, (px * px + py * py).sqrt(), face);
             return true;
         }
         px += t * dx;
@@ -151,7 +177,7 @@ fn chunk(eta: f64, plane: u64, seed: u64, start: u64, count: u64, ln_alpha: &[f6
     let mut t = Tally::new();
     for i in start..start + count {
         let mut rng = Stream::new(seed, plane, i);
-        let ok = trace(eta, &mut rng, |n, x| {
+        let ok = trace(eta, f64::INFINITY, &mut rng, |n, x, _| {
             let kind = usize::from(n >= 2);
             let bin = bin_of(x);
             for (row, la) in ln_alpha.iter().enumerate() {
@@ -178,20 +204,37 @@ fn chunk(eta: f64, plane: u64, seed: u64, start: u64, count: u64, ln_alpha: &[f6
 /// of the random key) on `threads` threads; bit-identical for any `threads ≥ 1`.
 pub fn simulate(eta: f64, plane: u64, seed: u64, photons: u64, threads: usize) -> Tally {
     let ln_alpha: Vec<f64> = (0..N_ALBEDO).map(|k| albedo_of_row(k).ln()).collect();
+    let mut total = Tally::new();
+    for t in in_chunks(photons, threads, |start, count| {
+        chunk(eta, plane, seed, start, count, &ln_alpha)
+    }) {
+        total.merge(&t);
+    }
+    total
+}
+
+/// Runs `work(start, count)` over the chunks of [`CHUNK`] photons of `0..photons` on `threads`
+/// threads and returns the chunks' results in chunk order (so that merging them in that order
+/// is independent of the thread count).
+pub(crate) fn in_chunks<T: Send>(
+    photons: u64,
+    threads: usize,
+    work: impl Fn(u64, u64) -> T + Sync,
+) -> Vec<T> {
     let chunks = photons.div_ceil(CHUNK);
     let threads = threads.max(1) as u64;
-    let mut results: Vec<Option<Tally>> = vec![None; chunks as usize];
+    let mut results: Vec<Option<T>> = (0..chunks).map(|_| None).collect();
     std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads)
             .map(|w| {
-                let ln_alpha = &ln_alpha;
+                let work = &work;
                 s.spawn(move || {
                     (0..chunks)
                         .filter(|c| c % threads == w)
                         .map(|c| {
                             let start = c * CHUNK;
                             let count = CHUNK.min(photons - start);
-                            (c, chunk(eta, plane, seed, start, count, ln_alpha))
+                            (c, work(start, count))
                         })
                         .collect::<Vec<_>>()
                 })
@@ -203,9 +246,5 @@ pub fn simulate(eta: f64, plane: u64, seed: u64, photons: u64, threads: usize) -
             }
         }
     });
-    let mut total = Tally::new();
-    for t in results.into_iter().flatten() {
-        total.merge(&t);
-    }
-    total
+    results.into_iter().flatten().collect()
 }

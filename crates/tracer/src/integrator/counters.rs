@@ -99,6 +99,32 @@ impl PathCounters {
         }
     }
 
+    /// The slab profile of `family` at coefficients `c` and thickness `d` (length; +∞ for
+    /// the half-space), on `face` at distance `r` (1/length², per channel); a family without
+    /// a slab table gives its half-space profile at `r`. Failures count as
+    /// [`PathCounters::eval_profile`]'s.
+    pub fn eval_slab_profile(
+        &mut self,
+        family: &bssrdf_core::ProfileFamily,
+        c: het_estimate::Coefficients,
+        d: f64,
+        face: bssrdf_core::SlabFace,
+        r: f64,
+    ) -> bssrdf_core::Rgb {
+        let mut rd = bssrdf_core::Rgb::ZERO;
+        for ch in 0..3 {
+            rd[ch] = match family.slab(c.sigma_a[ch], c.sigma_s[ch], d) {
+                Ok(Some(slab)) => slab.eval(face, r),
+                Ok(None) => self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r),
+                Err(_) => {
+                    self.profile_failures += 1;
+                    0.0
+                }
+            };
+        }
+        rd
+    }
+
     /// Adds tracking work.
     pub fn add_tracking(&mut self, t: &TrackingCounters) {
         self.delta_steps += t.delta_steps;

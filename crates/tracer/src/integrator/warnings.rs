@@ -160,10 +160,11 @@ fn small_objects(scene: &Scene) -> Vec<String> {
             warnings.push(format!(
                 "translucent object `{}` ({share:.1} % of the image's pixels) is {thinnest:.3} \
                  across its thinnest side, {:.2} {unit} of its most translucent part \
-                 ({symbol} = {value}, g = {}): BSSRDF profiles assume a half-space, so light \
-                 leaving through other faces, or never returning from a small curved part, is \
-                 not modelled, and those pixels can be several times too bright (thin parts) \
-                 or too dark (small bodies); compare with `--method pt`",
+                 ({symbol} = {value}, g = {}): BSSRDF profiles assume a half-space (the \
+                 tabulated profile at |g| <= 0.5: a slab of the local thickness on flat thin \
+                 parts), so light leaving through other faces, or never returning from a small \
+                 curved part, is not modelled, and those pixels can be several times too \
+                 bright (thin parts) or too dark (small bodies); compare with `--method pt`",
                 scene.objects()[i as usize].name,
                 thinnest / longest,
                 t.g

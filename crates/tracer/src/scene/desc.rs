@@ -309,6 +309,9 @@ pub struct TranslucentDesc {
     pub eta: f64,
     /// Profile model name (dipole | pbd | better-dipole | tabulated).
     pub profile: Option<String>,
+    /// With the tabulated profile, weigh pairs by the slab profile of the local thickness
+    /// (default true; `Translucent::thickness_aware`).
+    pub thickness_aware: Option<bool>,
     /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.
     /// 1000 for coefficients per mm in a scene modelled in metres. An artist radius is
     /// divided by it.

@@ -636,6 +636,7 @@ impl Cx {
             g,
             eta: d.eta,
             profile,
+            thickness_aware: d.thickness_aware.unwrap_or(true),
             unit_scale: d.unit_scale,
             key: key.to_string(),
             line: self.loc.line_of_key(key),

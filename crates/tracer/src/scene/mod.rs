@@ -117,6 +117,11 @@ pub struct Translucent {
     pub eta: f64,
     /// Profile model requested by the material, if any.
     pub profile: Option<ProfileModel>,
+    /// Whether a BSSRDF render with the tabulated profile weighs each pair by the slab
+    /// profile of the object's local thickness (reflection on the entry side, transmission
+    /// through the opposite face; `integrator/bssrdf.rs`, docs/shapes.md). Default true; the
+    /// scene key `thickness_aware = false` turns it off (the half-space profile everywhere).
+    pub thickness_aware: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
     /// Key of the material in the scene file (`material[2]`) for messages.
@@ -158,6 +163,7 @@ impl Translucent {
             g,
             eta,
             profile: None,
+            thickness_aware: true,
             unit_scale: 1.0,
             line: None,
         }
