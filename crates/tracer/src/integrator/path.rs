@@ -417,9 +417,12 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Evaluates every BSSRDF continuation's profile weight at once (`false`) instead of when
-    /// the path first adds light (`true`, the default; see [`Deferred`]). Both give the same
-    /// image in expectation; the switch exists to test that, and to measure what deferring
-    /// saves.
+    /// the path first adds light (`true`, the default). At each BSSRDF vertex the path goes on
+    /// from one incident point; when that point gathered no light, its weight (an estimate,
+    /// the costly part of a BSSRDF sample) is owed to the path's throughput and evaluated
+    /// only if light arrives later, which on a convex object lit from one side it mostly does
+    /// not. Both give the same image in expectation; the switch exists to test that, and to
+    /// measure what deferring saves.
     pub fn with_deferred_weights(mut self, defer: bool) -> Self {
         self.defer_weights = defer;
         self
