@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
 use experiments::beam::{PhotonBudget, write_beam_map};
-use experiments::converge::{MethodSummary, check_dir, summarize, write_outputs};
+use experiments::converge::{MethodSummary, check_dir, summarize_with_reference, write_outputs};
 use experiments::run::{RenderJob, write_render};
 use experiments::study::{
     BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
@@ -141,8 +141,14 @@ fn print_summary(summary: &[MethodSummary]) {
             ),
             _ => "no path-tracing runs".into(),
         };
+        let aware = match (s.pt_time_reference_aware, s.speedup_reference_aware) {
+            (Some(t), Some(x)) if s.pt_extrapolated => {
+                format!(" (with the reference's own noise: {t:.3} s -> {x:.1}x)")
+            }
+            _ => String::new(),
+        };
         eprintln!(
-            "{:>24}: converged rel. L2 {:.4} after {:.3} s; {pt}",
+            "{:>24}: converged rel. L2 {:.4} after {:.3} s; {pt}{aware}",
             s.method, s.converged_error, s.time_to_converge
         );
     }
@@ -286,7 +292,8 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     )?;
     bar.finish_and_clear();
     // Results first (they are small and the point of the run), images last.
-    let summary = summarize(&runs);
+    let reference_budget = args.reference.is_none().then_some(args.reference_spp);
+    let summary = summarize_with_reference(&runs, reference_budget);
     let title = format!("{} — error against time", scene.display_name());
     write_outputs(
         out,
@@ -420,7 +427,8 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     )?;
     bar.finish_and_clear();
     // Results first (they are small and the point of the run), images last.
-    let summary = summarize(&runs);
+    let reference_budget = args.reference.is_none().then_some(args.reference_photons);
+    let summary = summarize_with_reference(&runs, reference_budget);
     let title = format!("beam ({}) — error against time", args.setup.tag());
     write_outputs(
         out,
