@@ -14,7 +14,9 @@ use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 use crate::common::chandrasekhar::emergent_radiance;
-use crate::common::half_space::{half_space_scene, half_space_scene_with, mean_and_se};
+use crate::common::half_space::{
+    half_space_scene, half_space_scene_with, image_mean_and_se, mean_and_se,
+};
 use crate::common::harness::{render_multiple, sone};
 
 #[test]
@@ -434,22 +436,8 @@ fn deferring_unlit_carriers_weights_leaves_the_image_unchanged_in_expectation() 
         let integrator = PathIntegrator::new(&scene, method, options)
             .unwrap()
             .with_deferred_weights(defer);
-        let mut estimates = 0;
-        let means: Vec<f64> = (0..seeds)
-            .map(|seed| {
-                let r = render(
-                    16,
-                    16,
-                    &integrator,
-                    &RenderOptions::samples(spp, 500 + seed),
-                );
-                estimates += r.counters.estimates;
-                r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64
-            })
-            .collect();
-        let m = means.iter().sum::<f64>() / seeds as f64;
-        let var = means.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (seeds - 1) as f64;
-        (m, (var / seeds as f64).sqrt(), estimates)
+        let (m, se, counters) = image_mean_and_se(&integrator, spp, seeds);
+        (m[0], se[0], counters.estimates)
     };
     let (m_eager, se_eager, est_eager) = run(false);
     let (m_defer, se_defer, est_defer) = run(true);

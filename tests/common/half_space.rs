@@ -7,9 +7,9 @@ use het_estimate::Coefficients;
 use tracer::camera::Camera;
 use tracer::field::MediumField;
 use tracer::geometry::primitives;
-use tracer::integrator::{Method, PathIntegrator, PathOptions};
+use tracer::integrator::{Method, PathCounters, PathIntegrator, PathOptions};
 use tracer::light::Light;
-use tracer::render::{RenderOptions, render};
+use tracer::render::{Counters, RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
 /// A huge half-space (top z = 0, η = `eta`, isotropic) seen from above over a 0.5 × 0.5 patch
@@ -78,17 +78,29 @@ pub fn mean_and_se_rgb(
     seeds: u64,
 ) -> (Rgb, Rgb, u64) {
     let integrator = PathIntegrator::new(scene, method, options).unwrap();
-    let (w, h) = scene.camera().resolution();
-    let mut lost = 0;
+    let (m, se, counters) = image_mean_and_se(&integrator, spp, seeds);
+    (m, se, counters.capped + counters.leaks)
+}
+
+/// Per-channel image mean and its standard error from `seeds` independent renders (seeds
+/// 1000, 1001, …) of `spp` samples per pixel with `integrator`, at the scene's resolution,
+/// with the counters of all the renders together.
+pub fn image_mean_and_se(
+    integrator: &PathIntegrator,
+    spp: u32,
+    seeds: u64,
+) -> (Rgb, Rgb, PathCounters) {
+    let (w, h) = integrator.scene().camera().resolution();
+    let mut counters = PathCounters::default();
     let means: Vec<Rgb> = (0..seeds)
         .map(|seed| {
-            let r = render(w, h, &integrator, &RenderOptions::samples(spp, 1000 + seed));
-            lost += r.counters.capped + r.counters.leaks;
+            let r = render(w, h, integrator, &RenderOptions::samples(spp, 1000 + seed));
+            counters.merge(&r.counters);
             r.pixels.iter().fold(Rgb::ZERO, |a, &p| a + p) * (1.0 / r.pixels.len() as f64)
         })
         .collect();
     let m = means.iter().fold(Rgb::ZERO, |a, &x| a + x) * (1.0 / seeds as f64);
     let var = means.iter().fold(Rgb::ZERO, |a, &x| a + (x - m) * (x - m));
     let se = (var * (1.0 / ((seeds - 1) * seeds) as f64)).map(f64::sqrt);
-    (m, se, lost)
+    (m, se, counters)
 }

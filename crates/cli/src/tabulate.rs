@@ -43,44 +43,41 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .threads
         .map_or_else(rayon::current_num_threads, |t| t as usize);
     if args.slab {
-        return run_slab(&args, threads);
+        // The slab table: one plane per (thickness, η).
+        let planes = SLAB_THICKNESSES.len() * SLAB_ETAS.len();
+        return simulate_and_write(&args, planes, "slab planes", |progress| {
+            let data = tabulate_slab(args.seed, args.photons, threads, progress);
+            let capped = data.planes.iter().map(|p| p.capped).sum();
+            (data.to_bytes(), capped)
+        });
     }
-    let bar = experiments::progress::bar(ETAS.len() as u64, "tabulate", "planes");
-    let start = std::time::Instant::now();
-    let data = tabulate(args.seed, args.photons, threads, |_| bar.inc(1));
-    bar.finish_and_clear();
-    tracer::output::write_atomic(&args.out, &data.to_bytes())
-        .with_context(|| format!("cannot write `{}`", args.out.display()))?;
-    let capped: u64 = data.planes.iter().map(|p| p.capped).sum();
-    println!(
-        "wrote {} ({} planes x {} photons, seed {}, {} paths cut at the event cap) in {:.1} s",
-        args.out.display(),
-        data.planes.len(),
-        data.photons,
-        data.seed,
-        capped,
-        start.elapsed().as_secs_f64()
-    );
-    Ok(())
+    simulate_and_write(&args, ETAS.len(), "planes", |progress| {
+        let data = tabulate(args.seed, args.photons, threads, progress);
+        let capped = data.planes.iter().map(|p| p.capped).sum();
+        (data.to_bytes(), capped)
+    })
 }
 
-/// `--slab`: the slab table, one plane per (thickness, η).
-fn run_slab(args: &Args, threads: usize) -> anyhow::Result<()> {
-    let planes = SLAB_THICKNESSES.len() * SLAB_ETAS.len();
+/// Runs `simulate` (which reports each finished plane and returns the file's bytes and the
+/// paths cut at the event cap) behind a progress bar of `planes` planes, writes the file
+/// atomically and says what it wrote.
+fn simulate_and_write(
+    args: &Args,
+    planes: usize,
+    what: &str,
+    simulate: impl FnOnce(&mut dyn FnMut(usize)) -> (Vec<u8>, u64),
+) -> anyhow::Result<()> {
     let bar = experiments::progress::bar(planes as u64, "tabulate", "planes");
     let start = std::time::Instant::now();
-    let data = tabulate_slab(args.seed, args.photons, threads, |_| bar.inc(1));
+    let (bytes, capped) = simulate(&mut |_| bar.inc(1));
     bar.finish_and_clear();
-    tracer::output::write_atomic(&args.out, &data.to_bytes())
+    tracer::output::write_atomic(&args.out, &bytes)
         .with_context(|| format!("cannot write `{}`", args.out.display()))?;
-    let capped: u64 = data.planes.iter().map(|p| p.capped).sum();
     println!(
-        "wrote {} ({} slab planes x {} photons, seed {}, {} paths cut at the event cap) in {:.1} s",
+        "wrote {} ({planes} {what} x {} photons, seed {}, {capped} paths cut at the event cap) in {:.1} s",
         args.out.display(),
-        data.planes.len(),
-        data.photons,
-        data.seed,
-        capped,
+        args.photons,
+        args.seed,
         start.elapsed().as_secs_f64()
     );
     Ok(())

@@ -147,11 +147,7 @@ pub fn summarize_with_reference(runs: &[Run], reference_budget: Option<u64>) -> 
         .filter(|r| r.method == "pt")
         .map(|r| (r.budget, r.seconds, r.metrics.rel_l2))
         .collect();
-    let pt: Vec<(f64, f64)> = runs
-        .iter()
-        .filter(|r| r.method == "pt")
-        .map(|r| (r.seconds, r.metrics.rel_l2))
-        .collect();
+    let pt: Vec<(f64, f64)> = pt_budgets.iter().map(|&(_, t, e)| (t, e)).collect();
     let mut methods: Vec<&str> = Vec::new();
     for r in runs {
         if r.method != "pt" && !methods.contains(&r.method.as_str()) {

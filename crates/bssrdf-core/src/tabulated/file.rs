@@ -51,17 +51,9 @@ impl Plane {
     /// Mean and standard error per bin and total from a tally of `eta`.
     pub fn from_tally(eta: f64, t: &Tally) -> Self {
         let n = t.photons as f64;
-        let mean_se = |s: f64, s2: f64| mean_se(s, s2, n);
-        let mut density = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
-        let mut density_se = vec![0.0f32; 2 * N_ALBEDO * N_BINS];
-        for (i, (d, se)) in density.iter_mut().zip(density_se.iter_mut()).enumerate() {
-            let (m, e) = mean_se(t.sum[i], t.sum2[i]);
-            let area = annulus_area(i % N_BINS);
-            *d = (m / area) as f32;
-            *se = (e / area) as f32;
-        }
+        let (density, density_se) = densities(&t.sum, &t.sum2, n);
         let (total, total_se) = (0..2 * N_ALBEDO)
-            .map(|k| mean_se(t.total[k], t.total2[k]))
+            .map(|k| mean_se(t.total[k], t.total2[k], n))
             .unzip();
         Self {
             eta,
@@ -122,6 +114,43 @@ pub(crate) fn mean_se(s: f64, s2: f64, n: f64) -> (f64, f64) {
     (m, ((s2 / n - m * m).max(0.0) / n).sqrt())
 }
 
+/// The exitance density per bin (1/mfp²) and its standard error, from per-bin sums `sum`, `sum2`
+/// of `n` photons laid out `[..][bin]` with [`N_BINS`] bins innermost: each bin's mean over
+/// its annulus's area.
+pub(crate) fn densities(sum: &[f64], sum2: &[f64], n: f64) -> (Vec<f32>, Vec<f32>) {
+    (0..sum.len())
+        .map(|i| {
+            let (m, e) = mean_se(sum[i], sum2[i], n);
+            let area = annulus_area(i % N_BINS);
+            ((m / area) as f32, (e / area) as f32)
+        })
+        .unzip()
+}
+
+/// Appends `values` little-endian.
+pub(crate) fn put_f64s<'a>(b: &mut Vec<u8>, values: impl IntoIterator<Item = &'a f64>) {
+    for v in values {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// Appends `values` little-endian.
+pub(crate) fn put_f32s<'a>(b: &mut Vec<u8>, values: impl IntoIterator<Item = &'a f32>) {
+    for v in values {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// True when every value is finite and non-negative (what a table file may hold).
+pub(crate) fn all_valid<'a, T: Into<f64> + Copy + 'a>(
+    values: impl IntoIterator<Item = &'a T>,
+) -> bool {
+    values.into_iter().all(|&v| {
+        let v: f64 = v.into();
+        v.is_finite() && v >= 0.0
+    })
+}
+
 impl TableData {
     /// Serialises the table (see the module docs).
     pub fn to_bytes(&self) -> Vec<u8> {
@@ -133,17 +162,11 @@ impl TableData {
         for v in [self.planes.len(), N_ALBEDO, N_BINS] {
             b.extend_from_slice(&(v as u32).to_le_bytes());
         }
-        for p in &self.planes {
-            b.extend_from_slice(&p.eta.to_le_bytes());
-        }
+        put_f64s(&mut b, self.planes.iter().map(|p| &p.eta));
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
-            for v in p.density.iter().chain(&p.density_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
-            for v in p.total.iter().chain(&p.total_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
+            put_f32s(&mut b, p.density.iter().chain(&p.density_se));
+            put_f64s(&mut b, p.total.iter().chain(&p.total_se));
         }
         b
     }
@@ -162,7 +185,7 @@ impl TableData {
         if planes != ETAS.len() || rows != N_ALBEDO || bins != N_BINS {
             return Err(TableFileError("grid differs from this crate's"));
         }
-        let etas: Vec<f64> = (0..planes).map(|_| r.f64()).collect::<Result<_, _>>()?;
+        let etas = r.f64s(planes)?;
         if etas.iter().zip(ETAS).any(|(a, b)| *a != b) {
             return Err(TableFileError(
                 "refractive indices differ from this crate's",
@@ -172,22 +195,12 @@ impl TableData {
         let mut out = Vec::with_capacity(planes);
         for eta in etas {
             let capped = r.u64()?;
-            let density = (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>()?;
-            let density_se = (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>()?;
-            let total = (0..2 * N_ALBEDO)
-                .map(|_| r.f64())
-                .collect::<Result<Vec<_>, _>>()?;
-            let total_se = (0..2 * N_ALBEDO)
-                .map(|_| r.f64())
-                .collect::<Result<Vec<_>, _>>()?;
-            let finite = density
-                .iter()
-                .chain(&density_se)
-                .all(|v| v.is_finite() && *v >= 0.0)
-                && total
-                    .iter()
-                    .chain(&total_se)
-                    .all(|v| v.is_finite() && *v >= 0.0);
+            let density = r.f32s(n)?;
+            let density_se = r.f32s(n)?;
+            let total = r.f64s(2 * N_ALBEDO)?;
+            let total_se = r.f64s(2 * N_ALBEDO)?;
+            let finite = all_valid(density.iter().chain(&density_se))
+                && all_valid(total.iter().chain(&total_se));
             if !finite {
                 return Err(TableFileError("negative or non-finite value"));
             }
@@ -241,6 +254,12 @@ impl<'a> Reader<'a> {
         Ok(f64::from_le_bytes(
             self.take(8)?.try_into().expect("8 bytes"),
         ))
+    }
+    pub(crate) fn f32s(&mut self, n: usize) -> Result<Vec<f32>, TableFileError> {
+        (0..n).map(|_| self.f32()).collect()
+    }
+    pub(crate) fn f64s(&mut self, n: usize) -> Result<Vec<f64>, TableFileError> {
+        (0..n).map(|_| self.f64()).collect()
     }
 }
 

@@ -16,15 +16,26 @@ pub const S_MIN: f64 = 0.005;
 /// `s_k = √(1 − α_k)` of row `k`, geometric from [`S_MIN`] to 1 (dense near α = 1, where
 /// the profiles change fastest and translucent materials live: α = 0.999 is s ≈ 0.032).
 pub fn s_of_row(k: usize) -> f64 {
-    if k + 1 >= N_ALBEDO {
-        return 1.0;
-    }
-    S_MIN * (1.0 / S_MIN).powf(k as f64 / (N_ALBEDO - 1) as f64)
+    s_of_row_in(k, N_ALBEDO)
 }
 
 /// Single-scattering albedo α_k of row `k`.
 pub fn albedo_of_row(k: usize) -> f64 {
-    let s = s_of_row(k);
+    albedo_of_row_in(k, N_ALBEDO)
+}
+
+/// `s_k` of row `k` of a grid of `rows` rows with the same law (geometric from [`S_MIN`] to 1;
+/// the slab table uses fewer rows than the half-space table).
+pub fn s_of_row_in(k: usize, rows: usize) -> f64 {
+    if k + 1 >= rows {
+        return 1.0;
+    }
+    S_MIN * (1.0 / S_MIN).powf(k as f64 / (rows - 1) as f64)
+}
+
+/// Single-scattering albedo of row `k` of a grid of `rows` rows ([`s_of_row_in`]).
+pub fn albedo_of_row_in(k: usize, rows: usize) -> f64 {
+    let s = s_of_row_in(k, rows);
     1.0 - s * s
 }
 

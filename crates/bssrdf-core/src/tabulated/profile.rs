@@ -32,12 +32,13 @@ pub fn table() -> &'static TableData {
 /// Largest η the table covers.
 pub const ETA_MAX: f64 = ETAS[ETAS.len() - 1];
 
-/// One evaluation corner: plane, row, weight.
+/// One evaluation corner of a table: plane (the half-space table's η plane, or the slab
+/// table's thickness-major plane), albedo row, weight.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Corner {
-    plane: u8,
-    row: u8,
-    w: f64,
+pub(crate) struct Corner {
+    pub(crate) plane: u8,
+    pub(crate) row: u8,
+    pub(crate) w: f64,
 }
 
 /// The tabulated profile at one `(σt, α, η)`, for the scattering orders selected. `Copy`; a

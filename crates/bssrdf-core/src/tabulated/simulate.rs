@@ -179,25 +179,50 @@ fn chunk(eta: f64, plane: u64, seed: u64, start: u64, count: u64, ln_alpha: &[f6
         let mut rng = Stream::new(seed, plane, i);
         let ok = trace(eta, f64::INFINITY, &mut rng, |n, x, _| {
             let kind = usize::from(n >= 2);
-            let bin = bin_of(x);
-            for (row, la) in ln_alpha.iter().enumerate() {
-                let w = (n as f64 * la).exp();
-                if w == 0.0 {
-                    continue;
-                }
-                let k = kind * N_ALBEDO + row;
-                t.total[k] += w;
-                t.total2[k] += w * w;
-                if let Some(b) = bin {
-                    t.sum[Tally::index(kind, row, b)] += w;
-                    t.sum2[Tally::index(kind, row, b)] += w * w;
-                }
+            ExitSums {
+                total: &mut t.total,
+                total2: &mut t.total2,
+                sum: &mut t.sum,
+                sum2: &mut t.sum2,
             }
+            .add(ln_alpha, n, bin_of(x), kind * N_ALBEDO);
         });
         t.capped += u64::from(!ok);
     }
     t.photons = count;
     t
+}
+
+/// The sums a table keeps per exit, borrowed from a tally: per row k the sums of the weight α^n
+/// and of its square over every exit (`total`, `total2`), and per row and radial bin
+/// (`sum[k·N_BINS + bin]`, `sum2`) over exits inside the last bin.
+pub(super) struct ExitSums<'a> {
+    pub(super) total: &'a mut [f64],
+    pub(super) total2: &'a mut [f64],
+    pub(super) sum: &'a mut [f64],
+    pub(super) sum2: &'a mut [f64],
+}
+
+impl ExitSums<'_> {
+    /// Adds an exit after `n` scattering events in radial bin `bin` (`None`: beyond the last)
+    /// to the rows `first + row` with weights α_row^n = exp(n·ln α_row) (rows weighted 0 are
+    /// skipped).
+    #[inline]
+    pub(super) fn add(&mut self, ln_alpha: &[f64], n: u32, bin: Option<usize>, first: usize) {
+        for (row, la) in ln_alpha.iter().enumerate() {
+            let w = (f64::from(n) * la).exp();
+            if w == 0.0 {
+                continue;
+            }
+            let k = first + row;
+            self.total[k] += w;
+            self.total2[k] += w * w;
+            if let Some(b) = bin {
+                self.sum[k * N_BINS + b] += w;
+                self.sum2[k * N_BINS + b] += w * w;
+            }
+        }
+    }
 }
 
 /// Traces `photons` photons for refractive index `eta` (plane number `plane` of the table, part

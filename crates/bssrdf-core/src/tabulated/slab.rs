@@ -28,29 +28,25 @@
 
 use std::sync::OnceLock;
 
-use super::grid::S_MIN;
-use super::profile::{POOL_REL_SE, TabulatedTerm, eta_weights, radial_value, row_position};
+use super::grid::{albedo_of_row_in, s_of_row_in};
+use super::profile::{Corner, POOL_REL_SE, TabulatedTerm, eta_weights, radial_value, row_position};
 use super::slab_file::{SlabData, SlabPlane};
 
 /// Optical thicknesses σt·d (mean free paths) of the table's planes.
 pub const SLAB_THICKNESSES: [f64; 7] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
 /// Relative refractive indices of the table's planes (uniform; cubic interpolation between).
 pub const SLAB_ETAS: [f64; 5] = [1.0, 1.15, 1.3, 1.45, 1.6];
-/// Number of albedo rows: `s = √(1 − α)` geometric from [`S_MIN`] to 1.
+/// Number of albedo rows: `s = √(1 − α)` geometric from [`super::grid::S_MIN`] to 1.
 pub const SLAB_ROWS: usize = 16;
 
 /// `s = √(1 − α)` of slab row `k`.
 pub fn slab_s_of_row(k: usize) -> f64 {
-    if k + 1 >= SLAB_ROWS {
-        return 1.0;
-    }
-    S_MIN * (1.0 / S_MIN).powf(k as f64 / (SLAB_ROWS - 1) as f64)
+    s_of_row_in(k, SLAB_ROWS)
 }
 
 /// Albedo α of slab row `k`.
 pub fn slab_albedo_of_row(k: usize) -> f64 {
-    let s = slab_s_of_row(k);
-    1.0 - s * s
+    albedo_of_row_in(k, SLAB_ROWS)
 }
 
 /// The data file built into the crate (regenerate with `het-bssrdf tabulate --slab`).
@@ -84,14 +80,6 @@ impl SlabFace {
             SlabFace::Transmission => 1,
         }
     }
-}
-
-/// One interpolation corner: plane (thickness-major), row, weight.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Corner {
-    plane: u8,
-    row: u8,
-    w: f64,
 }
 
 /// The slab profile at one `(σt, α, η, d)`, multiple scattering. `Copy`; evaluating costs a

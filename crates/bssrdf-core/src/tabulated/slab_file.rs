@@ -25,9 +25,11 @@
 //! total (f64) and its standard error (f64), totals counting every exit, also beyond the last
 //! bin.
 
-use super::file::{Reader, TableFileError, mean_se, pool_sparse_bins};
-use super::grid::{N_BINS, annulus_area, bin_of};
-use super::simulate::{Face, Stream, in_chunks, trace};
+use super::file::{
+    Reader, TableFileError, all_valid, densities, mean_se, pool_sparse_bins, put_f32s, put_f64s,
+};
+use super::grid::{N_BINS, bin_of};
+use super::simulate::{ExitSums, Face, Stream, in_chunks, trace};
 use super::slab::{SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, slab_albedo_of_row};
 
 const MAGIC: &[u8; 8] = b"HBSSRDFS";
@@ -120,20 +122,13 @@ fn slab_chunk(
                 }
                 return;
             }
-            let bin = bin_of(x);
-            for (row, la) in ln_alpha.iter().enumerate() {
-                let w = (n as f64 * la).exp();
-                if w == 0.0 {
-                    continue;
-                }
-                let k = f * SLAB_ROWS + row;
-                t.total[k] += w;
-                t.total2[k] += w * w;
-                if let Some(b) = bin {
-                    t.sum[k * N_BINS + b] += w;
-                    t.sum2[k * N_BINS + b] += w * w;
-                }
+            ExitSums {
+                total: &mut t.total,
+                total2: &mut t.total2,
+                sum: &mut t.sum,
+                sum2: &mut t.sum2,
             }
+            .add(ln_alpha, n, bin_of(x), f * SLAB_ROWS);
         });
         t.capped += u64::from(!ok);
     }
@@ -173,14 +168,7 @@ pub struct SlabPlane {
 impl SlabPlane {
     fn from_tally(thickness: f64, eta: f64, t: &SlabTally) -> Self {
         let n = t.photons as f64;
-        let mut density = vec![0.0f32; PER_PLANE];
-        let mut density_se = vec![0.0f32; PER_PLANE];
-        for (i, (d, se)) in density.iter_mut().zip(density_se.iter_mut()).enumerate() {
-            let (m, e) = mean_se(t.sum[i], t.sum2[i], n);
-            let area = annulus_area(i % N_BINS);
-            *d = (m / area) as f32;
-            *se = (e / area) as f32;
-        }
+        let (density, density_se) = densities(&t.sum, &t.sum2, n);
         let (total, total_se) = (0..2 * SLAB_ROWS)
             .map(|k| mean_se(t.total[k], t.total2[k], n))
             .unzip();
@@ -245,24 +233,14 @@ impl SlabData {
         for v in [SLAB_THICKNESSES.len(), SLAB_ETAS.len(), SLAB_ROWS, N_BINS] {
             b.extend_from_slice(&(v as u32).to_le_bytes());
         }
-        for v in SLAB_THICKNESSES.iter().chain(&SLAB_ETAS) {
-            b.extend_from_slice(&v.to_le_bytes());
-        }
+        put_f64s(&mut b, SLAB_THICKNESSES.iter().chain(&SLAB_ETAS));
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
             b.extend_from_slice(&p.mean_events.to_le_bytes());
-            for v in p.ballistic.iter().chain(&p.ballistic_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
-            for v in p.single.iter().chain(&p.single_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
-            for v in p.density.iter().chain(&p.density_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
-            for v in p.total.iter().chain(&p.total_se) {
-                b.extend_from_slice(&v.to_le_bytes());
-            }
+            put_f64s(&mut b, p.ballistic.iter().chain(&p.ballistic_se));
+            put_f64s(&mut b, p.single.iter().chain(&p.single_se));
+            put_f32s(&mut b, p.density.iter().chain(&p.density_se));
+            put_f64s(&mut b, p.total.iter().chain(&p.total_se));
         }
         b
     }
@@ -295,28 +273,23 @@ impl SlabData {
                 let mean_events = r.f64()?;
                 let ballistic = [r.f64()?, r.f64()?];
                 let ballistic_se = [r.f64()?, r.f64()?];
-                let f32s =
-                    |r: &mut Reader, n| (0..n).map(|_| r.f32()).collect::<Result<Vec<_>, _>>();
-                let f64s =
-                    |r: &mut Reader, n| (0..n).map(|_| r.f64()).collect::<Result<Vec<_>, _>>();
-                let single = f64s(&mut r, 2 * SLAB_ROWS)?;
-                let single_se = f64s(&mut r, 2 * SLAB_ROWS)?;
-                let density = f32s(&mut r, PER_PLANE)?;
-                let density_se = f32s(&mut r, PER_PLANE)?;
-                let total = f64s(&mut r, 2 * SLAB_ROWS)?;
-                let total_se = f64s(&mut r, 2 * SLAB_ROWS)?;
-                let ok32 = |v: &f32| v.is_finite() && *v >= 0.0;
-                let ok64 = |v: &f64| v.is_finite() && *v >= 0.0;
-                let finite = density.iter().chain(&density_se).all(ok32)
-                    && total
-                        .iter()
-                        .chain(&total_se)
-                        .chain(&ballistic)
-                        .chain(&ballistic_se)
-                        .chain(&single)
-                        .chain(&single_se)
-                        .chain([&mean_events])
-                        .all(ok64);
+                let single = r.f64s(2 * SLAB_ROWS)?;
+                let single_se = r.f64s(2 * SLAB_ROWS)?;
+                let density = r.f32s(PER_PLANE)?;
+                let density_se = r.f32s(PER_PLANE)?;
+                let total = r.f64s(2 * SLAB_ROWS)?;
+                let total_se = r.f64s(2 * SLAB_ROWS)?;
+                let finite = all_valid(density.iter().chain(&density_se))
+                    && all_valid(
+                        total
+                            .iter()
+                            .chain(&total_se)
+                            .chain(&ballistic)
+                            .chain(&ballistic_se)
+                            .chain(&single)
+                            .chain(&single_se)
+                            .chain([&mean_events]),
+                    );
                 if !finite {
                     return Err(TableFileError("negative or non-finite value"));
                 }
