@@ -43,6 +43,12 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     let thickness_aware = !args.iter().any(|a| a == "--half-space");
+    let corrected = args.iter().any(|a| a == "--corrected");
+    let only: Option<String> = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .cloned();
     let g = args
         .iter()
         .position(|a| a == "--g")
@@ -51,7 +57,11 @@ fn main() {
         .unwrap_or(0.0);
     let bunny = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bunny.obj");
     let columns: Vec<Medium> = Medium::COLUMNS.iter().map(|m| Medium { g, ..*m }).collect();
-    let models = [ProfileModel::Tabulated, ProfileModel::Dipole];
+    let models: Vec<ProfileModel> = if args.iter().any(|a| a == "--tabulated-only") {
+        vec![ProfileModel::Tabulated]
+    } else {
+        vec![ProfileModel::Tabulated, ProfileModel::Dipole]
+    };
     let mut shapes_list = vec![Shape::HalfSpace];
     if args.iter().any(|a| a == "--oblique") {
         // The half-space seen obliquely: the part of the error due to the exit direction.
@@ -60,7 +70,8 @@ fn main() {
         shapes_list.extend(
             Shape::TABLE
                 .into_iter()
-                .filter(|s| *s != Shape::Bunny || bunny.exists()),
+                .filter(|s| *s != Shape::Bunny || bunny.exists())
+                .filter(|s| only.as_ref().is_none_or(|o| s.label().contains(o.as_str()))),
         );
     }
     // results[shape][column] = (PT, per-model BSSRDF, per-model miss fraction)
@@ -71,7 +82,7 @@ fn main() {
         let mut row = Vec::new();
         let mut miss_row = Vec::new();
         for (ci, &m) in columns.iter().enumerate() {
-            let scene = shape_scene_with(shape, m, &bunny, thickness_aware);
+            let scene = shape_scene_with(shape, m, &bunny, thickness_aware, corrected);
             let outside = outside_light(&scene, m.eta, 32);
             let t0 = std::time::Instant::now();
             let seed0 = 1000 * ci as u64;
@@ -117,8 +128,8 @@ fn main() {
         println!();
     };
     println!(
-        "\n## (BSSRDF/PT on the shape) / (BSSRDF/PT on the half-space) ± 1 SE, {} / {}\n",
-        models[0], models[1]
+        "\n## (BSSRDF/PT on the shape) / (BSSRDF/PT on the half-space) ± 1 SE, {:?}\n",
+        models
     );
     header("shape");
     let hs = &through[0];
@@ -138,8 +149,8 @@ fn main() {
         println!();
     }
     println!(
-        "\n## BSSRDF/PT on the half-space (the profile's own error), {} / {}\n",
-        models[0], models[1]
+        "\n## BSSRDF/PT on the half-space (the profile's own error), {:?}\n",
+        models
     );
     header("shape");
     print!("| half-space |");
@@ -155,8 +166,8 @@ fn main() {
     }
     println!();
     println!(
-        "\n## Probe-miss fraction (shading points whose three probes found nothing), {} / {}\n",
-        models[0], models[1]
+        "\n## Probe-miss fraction (shading points whose three probes found nothing), {:?}\n",
+        models
     );
     header("shape");
     for (si, &shape) in shapes_list.iter().enumerate() {

@@ -171,18 +171,15 @@ impl Medium {
     }
 }
 
-/// `shape` filled with `medium` under a uniform environment of radiance 1.
-pub fn shape_scene(shape: Shape, medium: Medium, bunny: &Path) -> Scene {
-    shape_scene_with(shape, medium, bunny, true)
-}
-
-/// [`shape_scene`] with the material's `thickness_aware` set (false: the half-space profile
-/// everywhere, `examples/shapes.rs -- --half-space`).
+/// `shape` filled with `medium` under a uniform environment of radiance 1, with the material's
+/// `thickness_aware` set (false: the half-space profile everywhere, `examples/shapes.rs --
+/// --half-space`) and its `shape_correction` (`examples/shapes.rs -- --corrected`).
 pub fn shape_scene_with(
     shape: Shape,
     medium: Medium,
     bunny: &Path,
     thickness_aware: bool,
+    shape_correction: bool,
 ) -> Scene {
     let (mesh, camera) = shape.mesh_and_camera(bunny);
     let (w, h) = camera.resolution();
@@ -195,6 +192,7 @@ pub fn shape_scene_with(
             mesh,
             Material::Translucent(Translucent {
                 thickness_aware,
+                shape_correction,
                 ..Translucent::new("m", field, medium.g, medium.eta)
             }),
         )

@@ -38,6 +38,7 @@ use crate::field::MediumField;
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::probe::ProbeSampler;
+use crate::integrator::shape_correction::Directional;
 use crate::rng::Rng;
 use crate::scene::Translucent;
 
@@ -60,6 +61,9 @@ pub(crate) struct BssrdfObject {
     /// material is `thickness_aware`, the family has a slab table (tabulated model) and
     /// |g| ≤ [`SLAB_MAX_G`].
     thickness_aware: bool,
+    /// The shape correction c (module docs of [`super::shape_correction`]), when the material
+    /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
+    pub correction: Option<super::shape_correction::ShapeCorrection>,
 }
 
 impl BssrdfObject {
@@ -85,7 +89,26 @@ impl BssrdfObject {
             sw_norm: 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / material.eta),
             eta: material.eta,
             extent,
+            correction: None,
         })
+    }
+
+    /// Relative index of refraction η.
+    pub fn eta(&self) -> f64 {
+        self.eta
+    }
+
+    /// One probe set around `x_o` over `chords` (the object, or the shape correction's
+    /// tangent plane), with the radii the renderer uses on this object.
+    pub(crate) fn probe_set<C: het_estimate::probe::ProbeChords<Point = Hit>>(
+        &self,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: het_estimate::Coefficients,
+        rng: &mut Rng,
+    ) -> crate::integrator::probe::ProbeSet {
+        self.sampler
+            .probe_chords(chords, x_o, coeffs, self.extent, rng)
     }
 
     /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
@@ -117,16 +140,38 @@ impl BssrdfObject {
     ) -> Rgb {
         let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
         counters.record_estimate(&est.diagnostics);
+        self.weigh(surface, est.coefficients, x_i, x_o, counters)
+    }
+
+    /// The shape correction's directional factor f at `hit` (1 without a correction): S is
+    /// scaled by f(x_i, μ_i)·f(x_o, μ_o) (`super::shape_correction`).
+    #[inline]
+    pub fn correction_at(&self, hit: &Hit) -> Directional {
+        self.correction
+            .as_ref()
+            .map_or(Directional::ONE, |c| c.at(hit.p, hit.ns))
+    }
+
+    /// The profile of the pair at the homogeneous coefficients `coeffs`: the half-space
+    /// profile at |x_i − x_o|, or for a thickness-aware object the slab profile's reflection or
+    /// transmission where the pair sits as on a slab (module docs). Without the shape
+    /// correction.
+    pub(crate) fn weigh(
+        &self,
+        surface: &ObjectSurface<'_>,
+        coeffs: het_estimate::Coefficients,
+        x_i: &Hit,
+        x_o: &Hit,
+        counters: &mut PathCounters,
+    ) -> Rgb {
         let r = (x_i.p - x_o.p).length();
         if !self.thickness_aware {
-            return counters.eval_profile(&self.family, est.coefficients, r);
+            return counters.eval_profile(&self.family, coeffs, r);
         }
         let d = 0.5 * (thickness(surface, x_i) + thickness(surface, x_o));
         match slab_pair(x_i, x_o, d) {
-            Some((face, dist)) => {
-                counters.eval_slab_profile(&self.family, est.coefficients, d, face, dist)
-            }
-            None => counters.eval_profile(&self.family, est.coefficients, r),
+            Some((face, dist)) => counters.eval_slab_profile(&self.family, coeffs, d, face, dist),
+            None => counters.eval_profile(&self.family, coeffs, r),
         }
     }
 
@@ -147,8 +192,15 @@ impl BssrdfObject {
         let (Some(n_i), Some(n_o)) = (facing_normal(x_i, w_i), facing_normal(x_o, w_o)) else {
             return Rgb::ZERO;
         };
-        let fresnel = self.transmission(w_i.dot(n_i)) * self.transmission(w_o.dot(n_o));
-        self.profile(surface, medium, x_i, x_o, rng, counters) * (fresnel / (self.sw_norm * PI))
+        let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
+        let fresnel = self.transmission(cos_i) * self.transmission(cos_o);
+        let s = self.profile(surface, medium, x_i, x_o, rng, counters)
+            * (fresnel / (self.sw_norm * PI));
+        if self.correction.is_none() {
+            return s;
+        }
+        // The product of the two factors is formed before it meets S (reciprocity, as above).
+        s * (self.correction_at(x_i).at(cos_i) * self.correction_at(x_o).at(cos_o))
     }
 }
 

@@ -10,6 +10,7 @@ pub mod lighting;
 mod method;
 pub mod path;
 pub mod probe;
+mod shape_correction;
 pub mod walk;
 pub mod warnings;
 

@@ -37,6 +37,7 @@ use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
 use crate::integrator::probe::probe_within;
+use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
@@ -183,12 +184,15 @@ struct Direct {
     /// entered a medium (with no scattering there), which the scattering-order filter must
     /// see exactly as it sees the direction-sampled path through the same medium.
     through_medium: bool,
+    /// The sampled direction toward the light (zero when nothing was found).
+    wi: DVec3,
 }
 
 impl Direct {
     const NONE: Direct = Direct {
         l: Rgb::ZERO,
         through_medium: false,
+        wi: DVec3::ZERO,
     };
 }
 
@@ -375,16 +379,23 @@ impl<'s> PathIntegrator<'s> {
                         Method::PathTraced => None,
                         Method::Bssrdf { estimator, profile } => {
                             let (lo, hi) = scene.geometry().object_bounds(index as u32);
-                            Some(Box::new(
-                                BssrdfObject::new(
-                                    t,
-                                    profile,
-                                    options.scattering,
-                                    estimator,
-                                    (hi - lo).max_element(),
-                                )
-                                .map_err(|(what, e)| RenderError::param(&object.name, what, e))?,
-                            ))
+                            let mut b = BssrdfObject::new(
+                                t,
+                                profile,
+                                options.scattering,
+                                estimator,
+                                (hi - lo).max_element(),
+                            )
+                            .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
+                            if t.shape_correction {
+                                b.correction = Some(ShapeCorrection::build(
+                                    &b,
+                                    scene.geometry(),
+                                    index as u32,
+                                    &t.medium,
+                                ));
+                            }
+                            Some(Box::new(b))
                         }
                     };
                     ObjectKind::Translucent {
@@ -609,6 +620,7 @@ impl<'s> PathIntegrator<'s> {
         Direct {
             l: ls.li * shadow.tr * (f * w / self.lights.select_pdf()),
             through_medium: shadow.through_medium,
+            wi: ls.wi,
         }
     }
 
@@ -952,6 +964,11 @@ impl<'s> PathIntegrator<'s> {
                 );
             }
         }
+        let corrected = b.correction.is_some();
+        if corrected {
+            // The shape correction's exit factor f(x_o, μ_o).
+            st.beta *= b.correction_at(hit).at(-ray.dir.dot(n_o));
+        }
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
         let set = probe_within(
@@ -995,11 +1012,15 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
-            let ld = ld.l;
+            let f_i = corrected.then(|| b.correction_at(&x_i));
+            let ld = match (&f_i, facing_normal(&x_i, ld.wi)) {
+                (Some(f), Some(n)) => ld.l * f.at(ld.wi.dot(n)),
+                _ => ld.l,
+            };
             if ld.is_zero() && (k != carrier || self.defer_weights) {
                 // Nothing to gather: skip the (costly) estimate, or owe it (the carrier).
                 if k == carrier {
-                    next = Some((x_i, Err(ph.weight * set.len() as f64)));
+                    next = Some((x_i, f_i, Err(ph.weight * set.len() as f64)));
                 }
                 continue;
             }
@@ -1008,10 +1029,10 @@ impl<'s> PathIntegrator<'s> {
             self.settle(st, rng, counters);
             st.l += st.beta * w * ld;
             if k == carrier {
-                next = Some((x_i, Ok(w * set.len() as f64)));
+                next = Some((x_i, f_i, Ok(w * set.len() as f64)));
             }
         }
-        let Some((x_i, w)) = next else {
+        let Some((x_i, f_i, w)) = next else {
             return Step::Stop;
         };
         match w {
@@ -1039,6 +1060,9 @@ impl<'s> PathIntegrator<'s> {
         }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
+        if let Some(f) = f_i {
+            st.beta *= f.at(cos);
+        }
         st.prev = Prev::Sampled {
             p: x_i.p,
             pdf: cos / std::f64::consts::PI,

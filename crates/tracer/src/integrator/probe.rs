@@ -27,6 +27,18 @@ impl ProbeSampler {
     pub fn probe_radius(&self, c: Coefficients) -> f64 {
         self.0.probe_radius(c)
     }
+
+    /// [`probe_within`] over any surface of tracer hits (the shape correction's tangent plane).
+    pub(crate) fn probe_chords<C: ProbeChords<Point = Hit>>(
+        &self,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: Coefficients,
+        max_radius: f64,
+        rng: &mut Rng,
+    ) -> ProbeSet {
+        lib::probe_within(chords, x_o, coeffs, &self.0, max_radius, rng)
+    }
 }
 
 /// A found incident point and its estimator weight `1/p(x)`.

@@ -312,6 +312,9 @@ pub struct TranslucentDesc {
     /// With the tabulated profile, weigh pairs by the slab profile of the local thickness
     /// (default true; `Translucent::thickness_aware`).
     pub thickness_aware: Option<bool>,
+    /// Scale the BSSRDF by the shape correction measured in the object (default false;
+    /// `Translucent::shape_correction`).
+    pub shape_correction: Option<bool>,
     /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.
     /// 1000 for coefficients per mm in a scene modelled in metres. An artist radius is
     /// divided by it.

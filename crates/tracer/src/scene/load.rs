@@ -637,6 +637,7 @@ impl Cx {
             eta: d.eta,
             profile,
             thickness_aware: d.thickness_aware.unwrap_or(true),
+            shape_correction: d.shape_correction.unwrap_or(false),
             unit_scale: d.unit_scale,
             key: key.to_string(),
             line: self.loc.line_of_key(key),

@@ -122,6 +122,10 @@ pub struct Translucent {
     /// through the opposite face; `integrator/bssrdf.rs`, docs/shapes.md). Default true; the
     /// scene key `thickness_aware = false` turns it off (the half-space profile everywhere).
     pub thickness_aware: bool,
+    /// Whether a BSSRDF render scales the profile by the shape correction measured by random
+    /// walks in the object when the render is prepared (`integrator/shape_correction.rs`,
+    /// docs/shapes.md). Scene key `shape_correction`; default false.
+    pub shape_correction: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
     /// Key of the material in the scene file (`material[2]`) for messages.
@@ -164,6 +168,7 @@ impl Translucent {
             eta,
             profile: None,
             thickness_aware: true,
+            shape_correction: false,
             unit_scale: 1.0,
             line: None,
         }
