@@ -141,7 +141,7 @@ fn main() {
             let cells: Vec<String> = (0..models.len())
                 .map(|k| {
                     let (q, se) = ratio(ratio(b[k], pt), ratio(b_hs[k], pt_hs));
-                    format!("{q:.2} ± {se:.2}")
+                    format!("{q:.3} ± {se:.3}")
                 })
                 .collect();
             print!(" {} |", cells.join(" / "));

@@ -261,6 +261,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for w in &outcome.warnings {
         eprintln!("warning: {w}");
     }
+    for n in &outcome.notes {
+        eprintln!("note: {n}");
+    }
     warn_counters(&outcome.counters);
     Ok(())
 }

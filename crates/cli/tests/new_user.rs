@@ -512,6 +512,37 @@ fn small_translucent_objects_warn_with_bssrdf_methods() {
             r.stderr
         );
     }
+    // The warning points at the shape correction; with it on, the warning says so and the
+    // render notes what measuring it took.
+    assert!(
+        r.stderr.contains("`shape_correction = true`"),
+        "{}",
+        r.stderr
+    );
+    s.write(
+        "corrected.toml",
+        edit(
+            MINIMAL,
+            "sigma_s = 1.0\n",
+            "sigma_s = 1.0\nshape_correction = true\n",
+        ),
+    );
+    let r = s.run(&[
+        "render",
+        "corrected.toml",
+        "--method",
+        "sone",
+        "--out",
+        "c.exr",
+    ]);
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("`shape_correction` scales")
+            && r.stderr.contains("note: shape correction of `")
+            && !r.stderr.contains("`shape_correction = true`"),
+        "{}",
+        r.stderr
+    );
 }
 
 /// Every example scene the README points at loads and renders with the path tracer and with

@@ -81,6 +81,8 @@ pub struct RenderOutcome {
     pub method: String,
     /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
     pub warnings: Vec<String>,
+    /// What the preparation did that a user may want to know (see [`PathIntegrator::notes`]).
+    pub notes: Vec<String>,
     /// True when the render was interrupted: `spp` counts the completed passes only.
     pub interrupted: bool,
     /// True for a checkpoint written while the render goes on (`spp` so far).
@@ -106,6 +108,7 @@ impl RenderOutcome {
             counters,
             method,
             warnings: Vec::new(),
+            notes: Vec::new(),
             interrupted: false,
             checkpoint: true,
         }
@@ -155,6 +158,7 @@ pub fn render_scene_observed(
         counters,
         method: job.method.name().to_string(),
         warnings: integrator.warnings().to_vec(),
+        notes: integrator.notes(),
         interrupted,
         checkpoint: false,
     })

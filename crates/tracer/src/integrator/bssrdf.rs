@@ -200,7 +200,7 @@ impl BssrdfObject {
             return s;
         }
         // The product of the two factors is formed before it meets S (reciprocity, as above).
-        s * (self.correction_at(x_i).at(cos_i) * self.correction_at(x_o).at(cos_o))
+        s * (self.correction_at(x_i).along(w_i, n_i) * self.correction_at(x_o).along(w_o, n_o))
     }
 }
 

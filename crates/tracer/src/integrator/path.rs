@@ -444,6 +444,29 @@ impl<'s> PathIntegrator<'s> {
         &self.warnings
     }
 
+    /// What preparing the render did that a user may want to know: one line per object whose
+    /// shape correction was measured (points, spacing, wall time).
+    pub fn notes(&self) -> Vec<String> {
+        self.scene
+            .objects()
+            .iter()
+            .zip(&self.objects)
+            .filter_map(|(object, kind)| match kind {
+                ObjectKind::Translucent {
+                    bssrdf: Some(b), ..
+                } => b.correction.as_ref().map(|c| {
+                    let (points, h, seconds) = c.summary();
+                    format!(
+                        "shape correction of `{}`: {points} points {h:.3} apart, measured in \
+                         {seconds:.2} s",
+                        object.name
+                    )
+                }),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// The method rendered.
     pub fn method(&self) -> Method {
         self.method
@@ -967,7 +990,7 @@ impl<'s> PathIntegrator<'s> {
         let corrected = b.correction.is_some();
         if corrected {
             // The shape correction's exit factor f(x_o, μ_o).
-            st.beta *= b.correction_at(hit).at(-ray.dir.dot(n_o));
+            st.beta *= b.correction_at(hit).along(-ray.dir, n_o);
         }
         let object = hit.object;
         let at_xo = material.medium.coefficients(hit);
@@ -1014,7 +1037,7 @@ impl<'s> PathIntegrator<'s> {
             );
             let f_i = corrected.then(|| b.correction_at(&x_i));
             let ld = match (&f_i, facing_normal(&x_i, ld.wi)) {
-                (Some(f), Some(n)) => ld.l * f.at(ld.wi.dot(n)),
+                (Some(f), Some(n)) => ld.l * f.along(ld.wi, n),
                 _ => ld.l,
             };
             if ld.is_zero() && (k != carrier || self.defer_weights) {
@@ -1061,7 +1084,7 @@ impl<'s> PathIntegrator<'s> {
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
         if let Some(f) = f_i {
-            st.beta *= f.at(cos);
+            st.beta *= f.along(wi, x_i.ns);
         }
         st.prev = Prev::Sampled {
             p: x_i.p,

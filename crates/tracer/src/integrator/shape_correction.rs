@@ -53,14 +53,14 @@ use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::walk::{reflect, refract};
 use crate::rng::Rng;
-use crate::volume::direction_about;
+use crate::volume::{direction_about, orthonormal_basis};
 
 /// Seed of the correction's random numbers (combined with the object's index and the sample).
 const SEED: u64 = 0x005a_4ec0_77ec;
-/// Walks per sample point, channel and exit cosine.
-pub const WALKS_PER_NODE: u32 = 32;
+/// Walks per sample point, channel and direction node.
+pub const WALKS_PER_NODE: u32 = 12;
 /// Probe sets per sample point for B.
-pub const PROBES_PER_POINT: u32 = 64;
+pub const PROBES_PER_POINT: u32 = 128;
 /// Fixed-point steps after the first estimate ([`Sums::refine`]).
 const ITERATIONS: usize = 2;
 /// Bounds on the number of sample points per object.
@@ -85,19 +85,33 @@ struct Sample {
 /// Exit cosines μ at which the walks start (the factor is linear in μ between them and
 /// constant beyond).
 pub const MU_NODES: [f64; 5] = [0.1, 0.325, 0.55, 0.775, 1.0];
+/// Exit azimuths per cosine, equally spaced in the tangent frame of the shading normal
+/// (`het_estimate::frame::orthonormal_basis`); the factor is periodic-linear between them.
+pub const PHI_NODES: usize = 6;
+/// Directions per point: [`MU_NODES`] × [`PHI_NODES`], index `j · PHI_NODES + k`.
+pub const DIRECTIONS: usize = MU_NODES.len() * PHI_NODES;
 
-/// The correction's directional factor f(μ) at one surface point, per channel, at
-/// [`MU_NODES`]: S is scaled by f(x_i, μ_i)·f(x_o, μ_o).
+/// The direction outside the medium of node `(j, k)` about the unit normal `n`.
+fn node_direction(n: DVec3, j: usize, k: usize) -> DVec3 {
+    let (t, b) = orthonormal_basis(n);
+    let mu = MU_NODES[j];
+    let phi = TAU * k as f64 / PHI_NODES as f64;
+    let s = (1.0 - mu * mu).max(0.0).sqrt();
+    (n * mu + (t * phi.cos() + b * phi.sin()) * s).normalize()
+}
+
+/// The correction's directional factor f(ω) at one surface point, per channel, at the
+/// direction nodes ([`DIRECTIONS`]): S is scaled by f(x_i, ω_i)·f(x_o, ω_o).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Directional(pub [Rgb; MU_NODES.len()]);
+pub struct Directional(pub [Rgb; DIRECTIONS]);
 
 impl Directional {
     /// No correction.
-    pub const ONE: Directional = Directional([Rgb::ONE; MU_NODES.len()]);
+    pub const ONE: Directional = Directional([Rgb::ONE; DIRECTIONS]);
 
     /// ⟨f⟩ over uniform incident light, per channel ([`incident_weights`]).
     #[inline]
-    pub fn incident_mean(&self, weights: &[f64; MU_NODES.len()]) -> Rgb {
+    pub fn incident_mean(&self, weights: &[f64; DIRECTIONS]) -> Rgb {
         let mut m = Rgb::ZERO;
         for (f, w) in self.0.iter().zip(weights) {
             m += *f * *w;
@@ -105,20 +119,36 @@ impl Directional {
         m
     }
 
-    /// f at the cosine `mu` (of the direction outside the medium against the normal).
+    /// f along the unit direction `w` outside the medium, about the unit normal `n` (the
+    /// shading normal the correction was sampled about).
     #[inline]
-    pub fn at(&self, mu: f64) -> Rgb {
+    pub fn along(&self, w: DVec3, n: DVec3) -> Rgb {
+        let (t, b) = orthonormal_basis(n);
+        let mu = w.dot(n).clamp(0.0, 1.0);
+        let phi = w.dot(b).atan2(w.dot(t)).rem_euclid(TAU);
+        self.at(mu, phi)
+    }
+
+    /// f at exit cosine `mu` and azimuth `phi` ∈ [0, 2π).
+    #[inline]
+    pub fn at(&self, mu: f64, phi: f64) -> Rgb {
+        let x = phi / TAU * PHI_NODES as f64;
+        let k0 = (x as usize).min(PHI_NODES - 1);
+        let k1 = (k0 + 1) % PHI_NODES;
+        let s = (x - k0 as f64).clamp(0.0, 1.0);
+        let row =
+            |j: usize| self.0[j * PHI_NODES + k0] * (1.0 - s) + self.0[j * PHI_NODES + k1] * s;
         let n = MU_NODES.len();
         if mu <= MU_NODES[0] {
-            return self.0[0];
+            return row(0);
         }
         for j in 1..n {
             if mu <= MU_NODES[j] {
                 let t = (mu - MU_NODES[j - 1]) / (MU_NODES[j] - MU_NODES[j - 1]);
-                return self.0[j - 1] * (1.0 - t) + self.0[j] * t;
+                return row(j - 1) * (1.0 - t) + row(j) * t;
             }
         }
-        self.0[n - 1]
+        row(n - 1)
     }
 }
 
@@ -127,6 +157,8 @@ impl Directional {
 pub(crate) struct ShapeCorrection {
     samples: Vec<Sample>,
     grid: Grid,
+    /// Wall time of the build (s).
+    seconds: f64,
 }
 
 /// A uniform grid over sample points, for Gaussian-weighted neighbourhood sums.
@@ -230,6 +262,7 @@ impl ShapeCorrection {
         object: u32,
         medium: &MediumField,
     ) -> Self {
+        let t0 = std::time::Instant::now();
         let mesh = geometry.mesh(object);
         let (lo, hi) = geometry.object_bounds(object);
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
@@ -276,7 +309,7 @@ impl ShapeCorrection {
         // bias, of order 1/(escapes per point), would not average out).
         let pooled: Vec<Sums> = (0..raw.len())
             .into_par_iter()
-            .map(|i| pool(&grid, i, &|j| raw[j].2))
+            .map(|i| pool(&grid, i, &|j| raw[j].2).regularised())
             .collect();
         let mut corr = Self {
             samples: raw
@@ -289,6 +322,7 @@ impl ShapeCorrection {
                 })
                 .collect(),
             grid,
+            seconds: 0.0,
         };
         // Where c varies on the scale of the profile (corners, edges), the incident side's
         // factor differs from x_o's: iterate f ← √(f · T / B'), B' the body's response with
@@ -319,13 +353,19 @@ impl ShapeCorrection {
                 s.f = f;
             }
         }
+        corr.seconds = t0.elapsed().as_secs_f64();
         corr
+    }
+
+    /// What the build did: sample points, spacing h and wall time (s), for the render's notes.
+    pub fn summary(&self) -> (usize, f64, f64) {
+        (self.samples.len(), self.grid.h, self.seconds)
     }
 
     /// f at a surface point: the Gaussian-weighted mean of the samples within 2h whose normals
     /// face like `n`; 1 where none is near.
     pub fn at(&self, p: DVec3, n: DVec3) -> Directional {
-        let mut sum = [Rgb::ZERO; MU_NODES.len()];
+        let mut sum = [Rgb::ZERO; DIRECTIONS];
         let mut wsum = 0.0;
         self.grid.for_each_near(
             p,
@@ -405,8 +445,8 @@ fn point_sums(
         object: x_o.object,
     };
     // P: walks per exit cosine and channel (one channel for a grey medium).
-    let mut p_body = [Rgb::ZERO; MU_NODES.len()];
-    let mut p_half = [Rgb::ZERO; MU_NODES.len()];
+    let mut p_body = [Rgb::ZERO; DIRECTIONS];
+    let mut p_half = [Rgb::ZERO; DIRECTIONS];
     let channels = if grey { 1 } else { 3 };
     let eta = bssrdf.eta();
     for ch in 0..channels {
@@ -421,20 +461,24 @@ fn point_sums(
             eta,
             orders: bssrdf.family.scattering(),
         };
-        for (j, &mu) in MU_NODES.iter().enumerate() {
-            for k in 0..WALKS_PER_NODE as u64 {
-                let keys = [object, index, 1, (j as u64) << 32 | k];
-                let mut rb = Rng::from_keys(SEED, &keys);
-                let mut rh = Rng::from_keys(SEED, &keys);
-                p_body[j][ch] += walk.escape(&Boundary::Body(surface), x_o, mu, &mut rb);
-                p_half[j][ch] += walk.escape(&Boundary::Plane(&plane), x_o, mu, &mut rh);
+        for j in 0..MU_NODES.len() {
+            for k in 0..PHI_NODES {
+                let d = j * PHI_NODES + k;
+                let w_o = node_direction(x_o.ns, j, k);
+                for m in 0..WALKS_PER_NODE as u64 {
+                    let keys = [object, index, 1, (d as u64) << 32 | m];
+                    let mut rb = Rng::from_keys(SEED, &keys);
+                    let mut rh = Rng::from_keys(SEED, &keys);
+                    p_body[d][ch] += walk.escape(&Boundary::Body(surface), x_o, w_o, &mut rb);
+                    p_half[d][ch] += walk.escape(&Boundary::Plane(&plane), x_o, w_o, &mut rh);
+                }
             }
         }
     }
     if grey {
-        for j in 0..MU_NODES.len() {
-            p_body[j] = Rgb::splat(p_body[j][0]);
-            p_half[j] = Rgb::splat(p_half[j][0]);
+        for d in 0..DIRECTIONS {
+            p_body[d] = Rgb::splat(p_body[d][0]);
+            p_half[d] = Rgb::splat(p_half[d][0]);
         }
     }
     // B: probes, all channels at once.
@@ -460,15 +504,48 @@ fn point_sums(
 /// cosine and channel in the body and under the tangent plane, and probe sums B.
 #[derive(Debug, Clone, Copy, Default)]
 struct Sums {
-    p_body: [Rgb; MU_NODES.len()],
-    p_half: [Rgb; MU_NODES.len()],
+    p_body: [Rgb; DIRECTIONS],
+    p_half: [Rgb; DIRECTIONS],
     b_body: Rgb,
     b_half: Rgb,
 }
 
 impl Sums {
-    fn add_scaled(&mut self, o: &Sums, w: f64) {
+    /// The sums with the symmetries the estimates must have imposed, and the azimuthal
+    /// dependence kept to its first harmonic, which lowers their noise: under the tangent plane
+    /// P does not depend on the azimuth (its nodes are averaged), at μ = 1 every azimuth node
+    /// is the same direction (averaged too), and elsewhere P_body(μ, ·) is projected on
+    /// {1, cos φ, sin φ}.
+    fn regularised(&self) -> Sums {
+        let mut out = *self;
+        let k_n = PHI_NODES as f64;
         for j in 0..MU_NODES.len() {
+            let row = j * PHI_NODES..(j + 1) * PHI_NODES;
+            let mut half = Rgb::ZERO;
+            let (mut a0, mut a1, mut b1) = (Rgb::ZERO, Rgb::ZERO, Rgb::ZERO);
+            for (k, d) in row.clone().enumerate() {
+                let phi = TAU * k as f64 / k_n;
+                half += self.p_half[d] * (1.0 / k_n);
+                a0 += self.p_body[d] * (1.0 / k_n);
+                a1 += self.p_body[d] * (2.0 * phi.cos() / k_n);
+                b1 += self.p_body[d] * (2.0 * phi.sin() / k_n);
+            }
+            let symmetric = j + 1 == MU_NODES.len();
+            for (k, d) in row.enumerate() {
+                let phi = TAU * k as f64 / k_n;
+                out.p_half[d] = half;
+                out.p_body[d] = if symmetric {
+                    a0
+                } else {
+                    a0 + a1 * phi.cos() + b1 * phi.sin()
+                };
+            }
+        }
+        out
+    }
+
+    fn add_scaled(&mut self, o: &Sums, w: f64) {
+        for j in 0..DIRECTIONS {
             self.p_body[j] += o.p_body[j] * w;
             self.p_half[j] += o.p_half[j] * w;
         }
@@ -479,6 +556,12 @@ impl Sums {
     /// c(μ_j) = (P_body/P_half)/(B_body/B_half) per channel, then f = c / √c̄ with c̄ the mean
     /// of c over incident light as the BSSRDF gathers it at x_i ([`incident_mean`]); 1 in a
     /// channel where an estimate is empty.
+    /// P_body/P_half at direction node `d` and channel `ch`.
+    fn p_ratio(&self, d: usize, ch: usize) -> Option<f64> {
+        let (pb, ph) = (self.p_body[d][ch], self.p_half[d][ch]);
+        (ph > 0.0).then(|| pb / ph)
+    }
+
     fn factor(&self, eta: f64) -> Directional {
         let mut out = Directional::ONE;
         for ch in 0..3 {
@@ -488,20 +571,17 @@ impl Sums {
             }
             let mut c = Directional::ONE;
             let mut ok = true;
-            for j in 0..MU_NODES.len() {
-                let (pb, ph) = (self.p_body[j][ch], self.p_half[j][ch]);
-                let v = (pb / ph) / (bb / bh);
-                if ph > 0.0 && v.is_finite() {
-                    c.0[j][ch] = v.clamp(C_RANGE.0, C_RANGE.1);
-                } else {
-                    ok = false;
+            for j in 0..DIRECTIONS {
+                match self.p_ratio(j, ch).map(|r| r / (bb / bh)) {
+                    Some(v) if v.is_finite() => c.0[j][ch] = v.clamp(C_RANGE.0, C_RANGE.1),
+                    _ => ok = false,
                 }
             }
             if !ok {
                 continue;
             }
             let mean = incident_mean(&c, ch, eta);
-            for j in 0..MU_NODES.len() {
+            for j in 0..DIRECTIONS {
                 out.0[j][ch] = c.0[j][ch] / mean.sqrt();
             }
         }
@@ -518,10 +598,12 @@ impl Sums {
             if !(b_prime[ch] > 0.0 && self.b_half[ch] > 0.0) {
                 continue;
             }
-            for j in 0..MU_NODES.len() {
-                let (pb, ph) = (self.p_body[j][ch], self.p_half[j][ch]);
-                let target = self.b_half[ch] * pb / ph / b_prime[ch];
-                if ph > 0.0 && target.is_finite() && target > 0.0 {
+            for j in 0..DIRECTIONS {
+                let Some(r) = self.p_ratio(j, ch) else {
+                    continue;
+                };
+                let target = self.b_half[ch] * r / b_prime[ch];
+                if target.is_finite() && target > 0.0 {
                     out.0[j][ch] = (f.0[j][ch] * target).sqrt().clamp(C_RANGE.0, C_RANGE.1);
                 }
             }
@@ -539,7 +621,11 @@ fn incident_mean(c: &Directional, ch: usize, eta: f64) -> f64 {
     for k in 0..n {
         let mu = (k as f64 + 0.5) / n as f64;
         let w = (1.0 - bssrdf_core::fresnel::dielectric(mu, eta)) * mu;
-        num += w * c.at(mu)[ch];
+        let ring: f64 = (0..PHI_NODES)
+            .map(|k| c.at(mu, TAU * k as f64 / PHI_NODES as f64)[ch])
+            .sum::<f64>()
+            / PHI_NODES as f64;
+        num += w * ring;
         den += w;
     }
     num / den
@@ -571,9 +657,9 @@ fn body_response(
 
 /// Quadrature weights W_j with ⟨f⟩ = Σ_j W_j f(μ_j) for f linear between [`MU_NODES`]
 /// ([`incident_mean`] of each node's hat function).
-fn incident_weights(eta: f64) -> [f64; MU_NODES.len()] {
+fn incident_weights(eta: f64) -> [f64; DIRECTIONS] {
     std::array::from_fn(|j| {
-        let mut hat = Directional([Rgb::ZERO; MU_NODES.len()]);
+        let mut hat = Directional([Rgb::ZERO; DIRECTIONS]);
         hat.0[j] = Rgb::ONE;
         incident_mean(&hat, 0, eta)
     })
@@ -625,52 +711,52 @@ struct Walk {
 }
 
 impl Walk {
-    /// The weight with which a walk entering at `x_o` (reversing light that leaves at the
-    /// exit cosine `mu` against the geometric normal, azimuth drawn uniformly, weighted by its
-    /// Fresnel transmission) leaves through `boundary` after a counted number of scattering
-    /// events; absorption by weighting (×ϖ per collision) with Russian roulette. Draws 1
-    /// number, then 4 per step whatever happens, so that two walks with the same generator
-    /// stay in step until their boundaries differ.
-    fn escape(&self, boundary: &Boundary<'_>, x_o: &Hit, mu: f64, rng: &mut Rng) -> f64 {
-        self.escape_through(boundary, x_o, mu, rng).0
-    }
-
-    /// [`Walk::escape`] and the normal of the face the walk left through (zero if it did not).
-    fn escape_through(
-        &self,
-        boundary: &Boundary<'_>,
-        x_o: &Hit,
-        mu: f64,
-        rng: &mut Rng,
-    ) -> (f64, DVec3) {
+    /// The expected weight with which a walk entering at `x_o`, reversing light that leaves
+    /// along `w_o` (unit, outside; weighted by its Fresnel transmission, 0 if `w_o` is behind
+    /// the geometric normal), leaves through `boundary` after a counted number of scattering
+    /// events. Expected-value estimation: from every vertex the flight's chance of reaching the
+    /// boundary, e^{−σt·s}, times the Fresnel transmission there is tallied, and the walk goes
+    /// on with a collision before the boundary or a Fresnel reflection at it, chosen by their
+    /// probabilities (1 − e^{−σt·s} and e^{−σt·s}·F) with the weight multiplied by their sum;
+    /// absorption by weighting (×ϖ per collision) with Russian roulette. Draws 5 numbers per
+    /// step whatever happens, so that two walks with the same generator stay in step until
+    /// their boundaries differ.
+    fn escape(&self, boundary: &Boundary<'_>, x_o: &Hit, w_o: DVec3, rng: &mut Rng) -> f64 {
         let n = x_o.ng;
-        let u2 = rng.uniform();
-        let w_o = direction_about(n, mu, TAU * u2);
+        let mu = w_o.dot(n);
+        if mu <= 0.0 {
+            return 0.0;
+        }
         let mut w = 1.0 - bssrdf_core::fresnel::dielectric(mu, self.eta);
         let Some(mut d) = refract(-w_o, n, self.eta) else {
-            return (0.0, DVec3::ZERO);
+            return 0.0;
         };
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
         let mut order = 0u32;
+        let mut tally = 0.0;
         for _ in 0..MAX_STEPS {
-            let (u_t, u_c, u_p, u_e) = (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
-            let t = -(1.0 - u_t).ln() / self.sigma_t;
+            let u = [0; 5].map(|_| rng.uniform());
             let crossing = match boundary {
                 Boundary::Body(s) => {
                     let origin = on.map_or(pos, |h| h.spawn_origin(d));
-                    s.geometry
-                        .intersect_object(s.object, &Ray::with_range(origin, d, 0.0, t))
-                        .map(|h| (h.p, h.ng, Some(h)))
+                    match s.geometry.intersect_object(s.object, &Ray::new(origin, d)) {
+                        Some(h) => Some(((h.p - pos).length(), h.p, h.ng, Some(h))),
+                        // No far side (a leak through a crack): nothing more leaves.
+                        None => return tally,
+                    }
                 }
                 Boundary::Plane(pl) => {
                     let dn = d.dot(pl.n);
-                    let s = -(pos - pl.p0).dot(pl.n) / dn;
-                    (dn > 0.0 && s <= t).then(|| (pos + s * d, pl.n, None))
+                    (dn > 0.0).then(|| {
+                        let s = (-(pos - pl.p0).dot(pl.n) / dn).max(0.0);
+                        (s, pos + s * d, pl.n, None)
+                    })
                 }
             };
-            match crossing {
-                Some((p, ng, hit)) => {
+            let t = match crossing {
+                None => -(1.0 - u[0]).ln() / self.sigma_t,
+                Some((s, p, ng, hit)) => {
                     let cos = d.dot(ng);
                     if cos <= 0.0 {
                         // Met from outside (numerically behind a face): step over it.
@@ -678,36 +764,41 @@ impl Walk {
                         on = hit;
                         continue;
                     }
+                    let reach = (-self.sigma_t * s).exp();
                     let f = bssrdf_core::fresnel::dielectric(cos, 1.0 / self.eta);
-                    let out = if u_e < f {
-                        None
-                    } else {
-                        refract(d, -ng, 1.0 / self.eta)
-                    };
-                    if out.is_some() {
-                        return (if self.counts(order) { w } else { 0.0 }, ng);
+                    if self.counts(order) {
+                        tally += w * reach * (1.0 - f);
                     }
-                    d = reflect(d, -ng);
-                    pos = p;
-                    on = hit;
-                }
-                None => {
-                    pos += t * d;
-                    on = None;
-                    order += 1;
-                    w *= self.albedo;
-                    let cos = bssrdf_core::hg::sample_cos_theta(self.g, u_c);
-                    d = direction_about(d, cos, TAU * u_p);
-                    if w < RR_WEIGHT {
-                        if u_e * RR_WEIGHT >= w {
-                            return (0.0, DVec3::ZERO);
-                        }
-                        w = RR_WEIGHT;
+                    let (collide, reflect_p) = (1.0 - reach, reach * f);
+                    let total = collide + reflect_p;
+                    if total <= 0.0 {
+                        return tally;
                     }
+                    w *= total;
+                    if u[3] * total >= collide {
+                        d = reflect(d, -ng);
+                        pos = p;
+                        on = hit;
+                        continue;
+                    }
+                    // A collision before the boundary: the exponential truncated to [0, s).
+                    -(1.0 - u[0] * collide).ln() / self.sigma_t
                 }
+            };
+            pos += t * d;
+            on = None;
+            order += 1;
+            w *= self.albedo;
+            let cos = bssrdf_core::hg::sample_cos_theta(self.g, u[1]);
+            d = direction_about(d, cos, TAU * u[2]);
+            if w < RR_WEIGHT {
+                if u[4] * RR_WEIGHT >= w {
+                    return tally;
+                }
+                w = RR_WEIGHT;
             }
         }
-        (0.0, DVec3::ZERO)
+        tally
     }
 
     fn counts(&self, order: u32) -> bool {
@@ -752,8 +843,8 @@ mod tests {
     /// Far from the edges of a box 8 mfp deep (4.4 diffusion lengths at ϖ 0.9) the body is a
     /// half-space and c = 1 whatever the profile's own error: the walks and probes in the
     /// body and under the tangent plane must measure the same thing (start, Fresnel at η 1.3,
-    /// orders counted, probe radii). Every node of f within 6 % (the pooled estimate's noise
-    /// is about 2 % here).
+    /// orders counted, probe radii). The mean of f over its 30 direction nodes within 2.5 %
+    /// and every node within 10 % (the pooled estimate's noise is about 2.5 % per node here).
     #[test]
     fn the_correction_is_one_on_a_half_space() {
         let mesh = primitives::subdivided_cuboid(
@@ -764,12 +855,15 @@ mod tests {
         let (geometry, b) = corrected(mesh, 0.9, 1.3);
         let c = b.correction.as_ref().unwrap();
         let f = c.at(hit_from_above(&geometry, DVec3::ZERO, DVec3::Z).p, DVec3::Z);
-        for (j, v) in f.0.iter().enumerate() {
+        let values: Vec<f64> = f.0.iter().map(|v| v[0]).collect();
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        assert!((mean - 1.0).abs() < 0.025, "mean f {mean}: {values:?}");
+        for (d, v) in values.iter().enumerate() {
+            let (j, k) = (d / PHI_NODES, d % PHI_NODES);
             assert!(
-                (v[0] - 1.0).abs() < 0.06,
-                "f(μ = {}) = {}",
+                (v - 1.0).abs() < 0.1,
+                "f(μ = {}, azimuth node {k}) = {v}: {values:?}",
                 MU_NODES[j],
-                v[0]
             );
         }
     }
