@@ -1,43 +1,50 @@
-//! The shape correction: a per-point factor that makes the BSSRDF's response to uniform light
-//! on a finite body equal the volume's, measured by random walks in the body itself when the
-//! scene is prepared (docs/shapes.md, "The shape correction").
+//! The shape correction: a per-point, per-direction factor that makes the BSSRDF's response to
+//! uniform light on a finite body equal the volume's, measured by random walks in the body
+//! itself when the render is prepared (docs/shapes.md, "The shape correction", has the
+//! measurements and the variants rejected).
 //!
 //! A half-space profile weighs the surface around x_o by R(|x_i − x_o|). On a finite body that
-//! misses two things (issue 18): light that enters one face and leaves another, and the
-//! smaller absorbing volume per unit of surface. Under uniform, unoccluded incident light both
-//! are summed up by one number per exit point: the probability that light leaving at x_o got
-//! there from anywhere on the surface, which by reciprocity is the probability P(x_o) that a
-//! walk entering the medium at x_o (cosine-weighted exit direction, Fresnel transmission at
-//! η) leaves it again after the scattering orders the profile models (two or more for
-//! `Multiple`, one for `Single`, one or more for `All`). The BSSRDF's own response to the same
-//! light is proportional to B(x_o) = ∫_surface R(x_i, x_o) dA(x_i) (the constant Fresnel
-//! and S_w factors are the same on every shape). The correction is
+//! misses (issue 18) light that enters one face and leaves another, and the smaller absorbing
+//! volume per unit of surface. Under uniform, unoccluded incident light both are summed up, for
+//! light leaving x_o along ω, by one number: by reciprocity the probability P(x_o, ω) that a
+//! walk entering the medium at x_o along the refraction of −ω (weighted by the Fresnel
+//! transmission at η) leaves it again after the scattering orders the profile models (two or
+//! more for `Multiple`, one for `Single`, one or more for `All`). The BSSRDF's own response to
+//! the same light is proportional to B(x_o) = ∫_surface R(x_i, x_o) dA(x_i) (the Fresnel and
+//! S_w factors are the same on every shape). The correction is
 //!
-//! c(x_o) = [P_body(x_o) / P_half(x_o)] / [B_body(x_o) / B_half(x_o)],
+//! c(x_o, ω) = [P_body(x_o, ω) / P_half(x_o, ω)] / [B_body(x_o) / B_half(x_o)],
 //!
-//! "half" meaning the half-space bounded by the tangent plane at x_o, with the coefficients
-//! of the medium at x_o. On a half-space c = 1 (to within the estimates' noise), whatever the
-//! profile's own error; on a body, the BSSRDF scaled by c responds to uniform light in the
-//! same ratio to the path tracer as it does on a half-space. Both ratios are estimated with
-//! common random numbers: the walk in the body and the walk under the tangent plane draw the
-//! same four numbers at each step (free flight, two for the phase function, one for the
-//! Fresnel choice or Russian roulette), as do the probes on the body and on the plane, so
-//! that where the body looks like its tangent plane the two estimates agree sample by sample.
+//! "half" meaning the half-space bounded by the tangent plane at x_o, with the coefficients of
+//! the medium at x_o. On a half-space c = 1 whatever the profile's own error; on a body, the
+//! corrected BSSRDF responds to uniform light in the same ratio to the path tracer as it does
+//! on a half-space.
 //!
-//! The factor enters the BSSRDF as √(c(x_i) c(x_o)), so S stays symmetric in the pair
-//! (docs/reciprocity.md); under uniform light and a slowly varying c this is c(x_o).
+//! S is scaled by f(x_i, ω_i)·f(x_o, ω_o), f = c/√c̄, with c̄ the mean of c over the light a
+//! uniform sky brings to an incident point (weight (1 − F(μ))μ): under uniform light the exit
+//! along ω_o then gets c(ω_o) exactly, and the product of the two factors keeps S symmetric in
+//! the pair (docs/reciprocity.md). Where c varies within the profile's reach (corners), two
+//! fixed-point steps ([`Sums::refine`]) make the response right with the factors the incident
+//! points actually carry.
 //!
-//! What it does not correct: the angular distribution of the exit (c is averaged over
-//! cosine-weighted exit directions), and the spatial distribution of non-uniform light over
-//! the body (c is exact for uniform light, a first-order correction otherwise). The walks use
-//! the homogeneous coefficients at the sample point, so the correction is a property of the
-//! shape and the local material and corrects nothing of the estimators' averaging.
+//! Estimation:
+//! * ω at 5 exit cosines ([`MU_NODES`]) × 6 azimuths ([`PHI_NODES`]) in the tangent frame of the
+//!   shading normal; f is interpolated linearly between them.
+//! * P by expected-value walks ([`Walk::escape`]) with common random numbers: the walk in the
+//!   body and the walk under the tangent plane draw the same five numbers at each step, so
+//!   that where the body looks like its tangent plane they agree step for step.
+//! * B by probe sets on the body and on the tangent plane with the same random numbers.
+//! * Points drawn uniformly by area on the object's mesh (fixed seed per object, so renders
+//!   stay deterministic whatever the thread count), about one per h² of surface with h half
+//!   the material's diffusion length, bounded by the object's extent. The raw sums are pooled
+//!   over each point's neighbourhood (a Gaussian of width h, weighted by the agreement of the
+//!   normals so that the two faces of a thin part do not mix) before dividing, with the
+//!   symmetries imposed and the azimuthal dependence kept to its first harmonic
+//!   ([`Sums::regularised`]); f is interpolated from the points the same way at render time.
 //!
-//! Sampling and interpolation: points are drawn uniformly by area on the object's mesh (fixed
-//! seed per object, so renders stay deterministic whatever the thread count), about one per
-//! h² of surface with h half the material's diffusion length, bounded by the object's
-//! extent; c is interpolated with a Gaussian of width h, weighted by the agreement of the
-//! normals so that the two faces of a thin part do not mix.
+//! What it does not correct: the spatial and angular distribution of non-uniform light (c is
+//! exact for uniform light, a first-order correction otherwise), and nothing of the
+//! estimators' averaging (the walks use the homogeneous coefficients at each point).
 
 use std::f64::consts::TAU;
 
@@ -66,8 +73,8 @@ const ITERATIONS: usize = 2;
 /// Bounds on the number of sample points per object.
 const MIN_POINTS: usize = 64;
 const MAX_POINTS: usize = 4096;
-/// Steps (collisions and boundary events) after which a walk is abandoned: it counts as
-/// absorbed in both the body and the half-space walk, which then cancel.
+/// Steps (collisions and boundary events) after which a walk stops: a guard against
+/// pathological inputs (σa = 0 in a huge body); Russian roulette ends walks long before.
 const MAX_STEPS: u32 = 20_000;
 /// Russian roulette below this path weight (survivors carry it).
 const RR_WEIGHT: f64 = 0.05;

@@ -124,7 +124,9 @@ pub struct Translucent {
     pub thickness_aware: bool,
     /// Whether a BSSRDF render scales the profile by the shape correction measured by random
     /// walks in the object when the render is prepared (`integrator/shape_correction.rs`,
-    /// docs/shapes.md). Scene key `shape_correction`; default false.
+    /// docs/shapes.md): small and curved bodies answer uniform light as the volume does. Its
+    /// preparation costs seconds to minutes (more with higher albedo and larger objects).
+    /// Scene key `shape_correction`; default false.
     pub shape_correction: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
