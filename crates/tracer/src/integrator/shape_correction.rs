@@ -68,6 +68,10 @@ const SEED: u64 = 0x005a_4ec0_77ec;
 pub const WALKS_PER_NODE: u32 = 12;
 /// Probe sets per sample point for B.
 pub const PROBES_PER_POINT: u32 = 128;
+/// Radius, in [`transport_length`]s, of the half-ball below a point that, held by the body,
+/// sets c = 1 there without walks: light that reaches it before leaving or being absorbed is
+/// of order e^{−6} of the total.
+const HALF_BALL: f64 = 6.0;
 /// Fixed-point steps after the first estimate ([`Sums::refine`]).
 const ITERATIONS: usize = 2;
 /// Bounds on the number of sample points per object.
@@ -286,20 +290,25 @@ impl ShapeCorrection {
         }
         let surface = ObjectSurface { geometry, object };
         let grey = medium.is_grey();
-        let raw: Vec<(Hit, Coefficients, Sums)> = (0..n_points)
+        // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
+        // c = 1 (the walks and probes in the body and under the plane agree but for what
+        // leaves that ball): no walks there (`None`).
+        let raw: Vec<(Hit, Coefficients, Option<Sums>)> = (0..n_points)
             .into_par_iter()
             .filter_map(|i| {
                 let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
                 let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
                 let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                let sums = point_sums(bssrdf, &surface, &x_o, coeffs, grey, i as u64);
+                let reach = HALF_BALL * transport_length(coeffs, bssrdf.family.g());
+                let sums = (!contains_half_ball(&surface, &x_o, reach))
+                    .then(|| point_sums(bssrdf, &surface, &x_o, coeffs, grey, i as u64));
                 Some((x_o, coeffs, sums))
             })
             .collect();
         let points: Vec<DVec3> = raw.iter().map(|(x, _, _)| x.p).collect();
         let grid = Grid::new(&points, h, lo, hi);
         let eta = bssrdf.eta();
-        let pool = |grid: &Grid, i: usize, value: &dyn Fn(usize) -> Sums| {
+        let pool = |grid: &Grid, i: usize, value: &dyn Fn(usize) -> Option<Sums>| {
             let mut pooled = Sums::default();
             let x = &raw[i].0;
             grid.for_each_near(
@@ -307,16 +316,25 @@ impl ShapeCorrection {
                 x.ns,
                 |j| raw[j].0.p,
                 |j| raw[j].0.ns,
-                |j, w| pooled.add_scaled(&value(j), w),
+                |j, w| {
+                    if let Some(v) = value(j) {
+                        pooled.add_scaled(&v, w);
+                    }
+                },
             );
             pooled
         };
         // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
         // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
         // bias, of order 1/(escapes per point), would not average out).
-        let pooled: Vec<Sums> = (0..raw.len())
+        let pooled: Vec<Option<Sums>> = (0..raw.len())
             .into_par_iter()
-            .map(|i| pool(&grid, i, &|j| raw[j].2).regularised())
+            .map(|i| {
+                raw[i]
+                    .2
+                    .is_some()
+                    .then(|| pool(&grid, i, &|j| raw[j].2).regularised())
+            })
             .collect();
         let mut corr = Self {
             samples: raw
@@ -325,7 +343,7 @@ impl ShapeCorrection {
                 .map(|((x, _, _), s)| Sample {
                     p: x.p,
                     n: x.ns,
-                    f: s.factor(eta),
+                    f: s.map_or(Directional::ONE, |s| s.factor(eta)),
                 })
                 .collect(),
             grid,
@@ -336,24 +354,31 @@ impl ShapeCorrection {
         // the current factors at the incident points, T what it should be (module docs).
         let weights = incident_weights(eta);
         for _ in 0..ITERATIONS {
-            let response: Vec<Rgb> = raw
+            let response: Vec<Option<Rgb>> = raw
                 .par_iter()
                 .enumerate()
-                .map(|(i, (x, coeffs, _))| {
-                    body_response(bssrdf, &surface, x, *coeffs, i as u64, |x_i| {
-                        corr.at(x_i.p, x_i.ns).incident_mean(&weights)
+                .map(|(i, (x, coeffs, sums))| {
+                    sums.is_some().then(|| {
+                        body_response(bssrdf, &surface, x, *coeffs, i as u64, |x_i| {
+                            corr.at(x_i.p, x_i.ns).incident_mean(&weights)
+                        })
                     })
                 })
                 .collect();
             let updated: Vec<Directional> = (0..raw.len())
                 .into_par_iter()
-                .map(|i| {
-                    let b_prime = pool(&corr.grid, i, &|j| Sums {
-                        b_body: response[j],
-                        ..Sums::default()
-                    })
-                    .b_body;
-                    pooled[i].refine(&corr.samples[i].f, b_prime)
+                .map(|i| match &pooled[i] {
+                    None => Directional::ONE,
+                    Some(p) => {
+                        let b_prime = pool(&corr.grid, i, &|j| {
+                            response[j].map(|b| Sums {
+                                b_body: b,
+                                ..Sums::default()
+                            })
+                        })
+                        .b_body;
+                        p.refine(&corr.samples[i].f, b_prime)
+                    }
                 })
                 .collect();
             for (s, f) in corr.samples.iter_mut().zip(updated) {
@@ -392,6 +417,56 @@ impl ShapeCorrection {
             Directional::ONE
         }
     }
+}
+
+/// The longest of the diffusion length 1/σtr and the transport mean free path 1/σt' over the
+/// channels at `c` (∞ without absorption): the reach of the walks that [`HALF_BALL`] scales.
+fn transport_length(c: Coefficients, g: f64) -> f64 {
+    let mut ell: f64 = 0.0;
+    for ch in 0..3 {
+        let (a, s) = (c.sigma_a[ch], c.sigma_s[ch]);
+        let tp = a + (1.0 - g) * s;
+        let tr = (3.0 * a * tp).sqrt();
+        let l = if tr > 0.0 { 1.0 / tr } else { f64::INFINITY };
+        ell = ell.max(l).max(if tp > 0.0 { 1.0 / tp } else { 0.0 });
+    }
+    ell
+}
+
+/// Whether the body holds the half-ball of radius `reach` below the tangent plane at `x_o`, as
+/// far as 37 rays from x_o into the body can tell (straight down, and 12 azimuths at each of
+/// three depressions down to 1° below the tangent plane): none meets the surface within
+/// `reach`. A polyhedral body whose faces, edges and corners stay farther than `reach` passes;
+/// so would a feature that slips between the rays, which the ±1° fan makes narrow.
+fn contains_half_ball(surface: &ObjectSurface<'_>, x_o: &Hit, reach: f64) -> bool {
+    if !reach.is_finite() {
+        return false;
+    }
+    let n = x_o.ns;
+    let (t, b) = orthonormal_basis(n);
+    let ray_clear = |d: DVec3| {
+        surface
+            .geometry
+            .intersect_object(
+                surface.object,
+                &Ray::with_range(x_o.spawn_origin(d), d, 0.0, reach),
+            )
+            .is_none()
+    };
+    if !ray_clear(-n) {
+        return false;
+    }
+    for depression in [0.017_f64, 0.3, 0.7] {
+        let (sd, cd) = depression.sin_cos();
+        for k in 0..12 {
+            let phi = TAU * k as f64 / 12.0;
+            let d = (t * phi.cos() + b * phi.sin()) * cd - n * sd;
+            if !ray_clear(d) {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// The spacing h of the sample points: half the diffusion length 1/σtr of the most
@@ -873,6 +948,44 @@ mod tests {
                 MU_NODES[j],
             );
         }
+    }
+
+    /// The early out: the centre of a large box face holds the half-ball, a point 2 from an
+    /// edge does not (reach 5), nor does a point on a sphere of radius 10, nor a thin slab.
+    #[test]
+    fn the_half_ball_test_passes_flat_interiors_only() {
+        let big = Geometry::build(vec![primitives::subdivided_cuboid(
+            DVec3::new(-50.0, -50.0, -50.0),
+            DVec3::new(50.0, 50.0, 0.0),
+            [4, 4, 4],
+        )]);
+        let surface = ObjectSurface {
+            geometry: &big,
+            object: 0,
+        };
+        let centre = hit_from_above(&big, DVec3::new(0.3, 0.1, 0.0), DVec3::Z);
+        assert!(contains_half_ball(&surface, &centre, 5.0));
+        let near_edge = hit_from_above(&big, DVec3::new(48.0, 0.1, 0.0), DVec3::Z);
+        assert!(!contains_half_ball(&surface, &near_edge, 5.0));
+        assert!(!contains_half_ball(&surface, &centre, f64::INFINITY));
+        let sphere = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 10.0, 4)]);
+        let on_sphere = hit_from_above(&sphere, DVec3::new(0.0, 0.0, 10.0), DVec3::Z);
+        let surface = ObjectSurface {
+            geometry: &sphere,
+            object: 0,
+        };
+        assert!(!contains_half_ball(&surface, &on_sphere, 5.0));
+        let slab = Geometry::build(vec![primitives::subdivided_cuboid(
+            DVec3::new(-50.0, -50.0, -2.0),
+            DVec3::new(50.0, 50.0, 0.0),
+            [4, 4, 1],
+        )]);
+        let top = hit_from_above(&slab, DVec3::new(0.3, 0.1, 0.0), DVec3::Z);
+        let surface = ObjectSurface {
+            geometry: &slab,
+            object: 0,
+        };
+        assert!(!contains_half_ball(&surface, &top, 5.0));
     }
 
     /// The correction keeps S reciprocal bit for bit (the two factors are multiplied before
