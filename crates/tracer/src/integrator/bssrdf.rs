@@ -149,7 +149,7 @@ impl BssrdfObject {
     pub fn correction_at(&self, hit: &Hit) -> Directional {
         self.correction
             .as_ref()
-            .map_or(Directional::ONE, |c| c.at(hit.p, hit.ns))
+            .map_or(Directional::ONE, |c| c.at_hit(hit))
     }
 
     /// The profile of the pair at the homogeneous coefficients `coeffs`: the half-space

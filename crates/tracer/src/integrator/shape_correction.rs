@@ -168,6 +168,10 @@ impl Directional {
 pub(crate) struct ShapeCorrection {
     samples: Vec<Sample>,
     grid: Grid,
+    /// f at the mesh's vertices and its triangles, when no edge is longer than h: a lookup is
+    /// then a barycentric interpolation ([`ShapeCorrection::at_hit`]) instead of a
+    /// neighbourhood query.
+    vertices: Option<(Vec<Directional>, Vec<[u32; 3]>)>,
     /// Wall time of the build (s).
     seconds: f64,
 }
@@ -347,6 +351,7 @@ impl ShapeCorrection {
                 })
                 .collect(),
             grid,
+            vertices: None,
             seconds: 0.0,
         };
         // Where c varies on the scale of the profile (corners, edges), the incident side's
@@ -385,8 +390,55 @@ impl ShapeCorrection {
                 s.f = f;
             }
         }
+        corr.vertices = corr.vertex_factors(mesh);
         corr.seconds = t0.elapsed().as_secs_f64();
         corr
+    }
+
+    /// f at every vertex of `mesh` (the neighbourhood query at the vertex, about its
+    /// area-weighted normal), when the mesh is fine enough for barycentric interpolation to
+    /// follow f: no edge longer than h.
+    fn vertex_factors(
+        &self,
+        mesh: &crate::geometry::TriangleMesh,
+    ) -> Option<(Vec<Directional>, Vec<[u32; 3]>)> {
+        let h = self.grid.h;
+        let mut normals = vec![DVec3::ZERO; mesh.positions.len()];
+        for (i, tri) in mesh.triangles.iter().enumerate() {
+            let [a, b, c] = mesh.triangle_vertices(i);
+            if (b - a).length() > h || (c - b).length() > h || (a - c).length() > h {
+                return None;
+            }
+            let n = (b - a).cross(c - a);
+            for &v in tri {
+                normals[v as usize] += n;
+            }
+        }
+        let f = mesh
+            .positions
+            .par_iter()
+            .zip(&normals)
+            .map(|(&p, n)| self.at(p, n.normalize_or_zero()))
+            .collect();
+        Some((f, mesh.triangles.clone()))
+    }
+
+    /// f at a hit on the object: barycentric interpolation of the vertices' f where the mesh
+    /// is fine enough, else the neighbourhood query ([`ShapeCorrection::at`]).
+    #[inline]
+    pub fn at_hit(&self, hit: &Hit) -> Directional {
+        match &self.vertices {
+            Some((f, tris)) if (hit.prim as usize) < tris.len() => {
+                let [i0, i1, i2] = tris[hit.prim as usize];
+                let (b1, b2) = (hit.bary.x, hit.bary.y);
+                let b0 = 1.0 - b1 - b2;
+                let (f0, f1, f2) = (&f[i0 as usize].0, &f[i1 as usize].0, &f[i2 as usize].0);
+                Directional(std::array::from_fn(|d| {
+                    f0[d] * b0 + f1[d] * b1 + f2[d] * b2
+                }))
+            }
+            _ => self.at(hit.p, hit.ns),
+        }
     }
 
     /// What the build did: sample points, spacing h and wall time (s), for the render's notes.
