@@ -1040,6 +1040,71 @@ mod tests {
         assert!(!contains_half_ball(&surface, &top, 5.0));
     }
 
+    /// Stiff and extreme media build a finite, positive correction: no absorption (walks end
+    /// only by leaving), no scattering, an optically huge and an optically tiny body, a
+    /// refractive boundary with total internal reflection, g near ±1.
+    #[test]
+    fn extreme_media_give_finite_positive_factors() {
+        let cases = [
+            (Coefficients::grey(0.0, 1.0), 0.0, 1.3),
+            (Coefficients::grey(1.0, 0.0), 0.0, 1.0),
+            (Coefficients::grey(5e5, 5e5), 0.0, 3.0),
+            (Coefficients::grey(1e-7, 1e-6), 0.0, 1.0),
+            (Coefficients::grey(0.01, 2.0), 0.95, 1.5),
+            (Coefficients::grey(0.01, 2.0), -0.95, 1.0),
+        ];
+        for (c, g, eta) in cases {
+            let geometry = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 1.0, 2)]);
+            let field = MediumField::homogeneous(c).unwrap();
+            let t = Translucent::new("m", field.clone(), g, eta);
+            let (lo, hi) = geometry.object_bounds(0);
+            // The tabulated profile stops at η 1.6; the dipole takes η 3.
+            let profile = if eta > 1.6 {
+                ProfileModel::Dipole
+            } else {
+                ProfileModel::Tabulated
+            };
+            let mut b = BssrdfObject::new(
+                &t,
+                Some(profile),
+                Scattering::Multiple,
+                "jensen-out".parse().unwrap(),
+                (hi - lo).max_element(),
+            )
+            .unwrap();
+            let corr = ShapeCorrection::build(&b, &geometry, 0, &field);
+            let x = hit_from_above(
+                &geometry,
+                DVec3::ZERO,
+                DVec3::new(0.2, 0.3, 1.0).normalize(),
+            );
+            let f = corr.at_hit(&x);
+            for v in f.0 {
+                for ch in 0..3 {
+                    assert!(
+                        v[ch].is_finite() && v[ch] > 0.0,
+                        "{c:?} g {g} eta {eta}: {v:?}"
+                    );
+                }
+            }
+            b.correction = Some(corr);
+            let s = b.eval(
+                &ObjectSurface {
+                    geometry: &geometry,
+                    object: 0,
+                },
+                &field,
+                &x,
+                x.ns,
+                &x,
+                x.ns,
+                &mut Rng::from_keys(1, &[]),
+                &mut PathCounters::default(),
+            );
+            assert!((0..3).all(|ch| s[ch].is_finite()), "{c:?}: S = {s:?}");
+        }
+    }
+
     /// The correction keeps S reciprocal bit for bit (the two factors are multiplied before
     /// they meet S), and it is not vacuous: on a sphere of radius 1 mfp it changes S.
     #[test]
