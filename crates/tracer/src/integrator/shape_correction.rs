@@ -30,9 +30,11 @@
 //! Estimation:
 //! * ω at 5 exit cosines ([`MU_NODES`]) × 6 azimuths ([`PHI_NODES`]) in the tangent frame of the
 //!   shading normal; f is interpolated linearly between them.
-//! * P by expected-value walks ([`Walk::escape`]) with common random numbers: the walk in the
-//!   body and the walk under the tangent plane draw the same five numbers at each step, so
-//!   that where the body looks like its tangent plane they agree step for step.
+//! * P by expected-value walks ([`Walk::escape`]) with common random numbers (both techniques:
+//!   SG69 in docs/references.md): the walk in the body and the walk under the tangent plane
+//!   draw the same five numbers at each step, so that where the body looks like its tangent
+//!   plane they agree step for step. The reciprocity that turns exitance under a uniform sky
+//!   into an escape probability is that of Vea97 (adjoint transport).
 //! * B by probe sets on the body and on the tangent plane with the same random numbers.
 //! * Points drawn uniformly by area on the object's mesh (fixed seed per object, so renders
 //!   stay deterministic whatever the thread count), about one per h² of surface with h half
