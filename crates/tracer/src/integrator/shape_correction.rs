@@ -523,20 +523,11 @@ fn contains_half_ball(surface: &ObjectSurface<'_>, x_o: &Hit, reach: f64) -> boo
     true
 }
 
-/// The spacing h of the sample points: half the diffusion length 1/σtr of the most
-/// translucent part of the medium (the scale on which the profile, and so the correction,
-/// varies), bounded to [extent/40, extent/4].
+/// The spacing h of the sample points: half the diffusion length 1/σtr (or transport mean
+/// free path, whichever is longer) of the most translucent part of the medium (the scale on
+/// which the profile, and so the correction, varies), bounded to [extent/40, extent/4].
 fn sample_spacing(medium: &MediumField, g: f64, extent: f64) -> f64 {
-    let b = medium.field_bounds().min;
-    let mut ell: f64 = 0.0;
-    for ch in 0..3 {
-        let (a, s) = (b.sigma_a[ch], b.sigma_s[ch]);
-        let tp = a + (1.0 - g) * s;
-        let tr = (3.0 * a * tp).sqrt();
-        let l = if tr > 0.0 { 1.0 / tr } else { f64::INFINITY };
-        ell = ell.max(l.max(if tp > 0.0 { 1.0 / tp } else { 0.0 }));
-    }
-    (0.5 * ell).clamp(extent / 40.0, extent / 4.0)
+    (0.5 * transport_length(medium.field_bounds().min, g)).clamp(extent / 40.0, extent / 4.0)
 }
 
 /// A point drawn uniformly by area on `object`'s mesh, as a hit (shading normal, texture
