@@ -463,28 +463,37 @@ fn sone() -> Estimator {
 /// with 5 × 2 degrees of freedom, where 4.5 is still a 0.1 % tail per block).
 const Z_MAX: f64 = 4.5;
 
+/// Asserts that a light-traced and a camera-traced render of one scene agree: every block
+/// within [`Z_MAX`], the image means within 3 SE, and the means' ratio known to 2 % (else the
+/// test is too weak to tell).
+fn assert_agree(what: &str, light: &Blocks, camera: &Blocks) {
+    let (max_z, ratio, ratio_se) = compare(light, camera);
+    eprintln!("{what}: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
+    assert!(max_z < Z_MAX, "{what}: max |z| = {max_z}");
+    assert!(
+        (ratio - 1.0).abs() < 3.0 * ratio_se,
+        "{what}: {ratio} ± {ratio_se}"
+    );
+    assert!(ratio_se < 0.02, "{what}: test too weak: ratio ± {ratio_se}");
+}
+
 #[test]
 fn light_traced_sone_agrees_with_camera_traced_sone() {
     for (eta, perspective) in [(1.0, false), (1.3, true)] {
         let scene = slab_scene(eta, N, perspective);
         let camera = camera_traced(&scene, sone(), 16);
         let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
-        let (max_z, ratio, ratio_se) = compare(&light, &camera);
-        eprintln!(
-            "η = {eta}, perspective {perspective}: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}"
+        assert_agree(
+            &format!("η = {eta}, perspective {perspective}"),
+            &light,
+            &camera,
         );
-        assert!(max_z < Z_MAX, "η = {eta}: max |z| = {max_z}");
         // The stripes show (the comparison is not between two flat images).
         let (lo, hi) = camera
             .mean
             .iter()
             .fold((f64::MAX, 0.0f64), |(a, b), &m| (a.min(m), b.max(m)));
         assert!(hi > 2.0 * lo, "no contrast: {lo} .. {hi}");
-        assert!(
-            (ratio - 1.0).abs() < 3.0 * ratio_se,
-            "η = {eta}: {ratio} ± {ratio_se}"
-        );
-        assert!(ratio_se < 0.02, "test too weak: ratio ± {ratio_se}");
     }
 }
 
@@ -535,11 +544,7 @@ fn light_traced_sone_agrees_under_distant_lights() {
     let scene = builder.build().unwrap();
     let camera = camera_traced(&scene, sone(), 16);
     let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
-    let (max_z, ratio, ratio_se) = compare(&light, &camera);
-    eprintln!("distant lights: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
-    assert!(max_z < Z_MAX, "max |z| = {max_z}");
-    assert!((ratio - 1.0).abs() < 3.0 * ratio_se, "{ratio} ± {ratio_se}");
-    assert!(ratio_se < 0.02, "test too weak: ratio ± {ratio_se}");
+    assert_agree("distant lights", &light, &camera);
 }
 
 /// With the material's shape correction on (docs/shapes.md), light- and camera-traced sone
@@ -572,11 +577,7 @@ fn light_traced_sone_agrees_with_camera_traced_sone_with_the_shape_correction() 
     let scene = sphere(true);
     let camera = camera_traced(&scene, sone(), 16);
     let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
-    let (max_z, ratio, ratio_se) = compare(&light, &camera);
-    eprintln!("shape correction: light/camera = {ratio:.4} ± {ratio_se:.4}, max |z| = {max_z:.2}");
-    assert!(max_z < Z_MAX, "max |z| = {max_z}");
-    assert!((ratio - 1.0).abs() < 3.0 * ratio_se, "{ratio} ± {ratio_se}");
-    assert!(ratio_se < 0.02, "test too weak: ratio ± {ratio_se}");
+    assert_agree("shape correction", &light, &camera);
     let plain = camera_traced_seeds(&sphere(false), sone(), 16, 300);
     let (_, changed, changed_se) = compare(&camera, &plain);
     eprintln!("corrected / uncorrected camera-traced: {changed:.4} ± {changed_se:.4}");

@@ -38,7 +38,6 @@ use crate::field::MediumField;
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::probe::ProbeSampler;
-use crate::integrator::shape_correction::Directional;
 use crate::rng::Rng;
 use crate::scene::Translucent;
 
@@ -99,7 +98,8 @@ impl BssrdfObject {
     }
 
     /// One probe set around `x_o` over `chords` (the object, or the shape correction's
-    /// tangent plane), with the radii the renderer uses on this object.
+    /// tangent plane), with the radii the renderers use on this object (at most its extent:
+    /// [`super::probe::probe_within`]).
     pub(crate) fn probe_set<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,
         chords: &C,
@@ -143,13 +143,12 @@ impl BssrdfObject {
         self.weigh(surface, est.coefficients, x_i, x_o, counters)
     }
 
-    /// The shape correction's directional factor f at `hit` (1 without a correction): S is
-    /// scaled by f(x_i, μ_i)·f(x_o, μ_o) (`super::shape_correction`).
+    /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium
+    /// about the normal `n` (`super::shape_correction`; S is scaled by f(x_i, ω_i)·f(x_o, ω_o)),
+    /// or `None` when the material has no correction.
     #[inline]
-    pub fn correction_at(&self, hit: &Hit) -> Directional {
-        self.correction
-            .as_ref()
-            .map_or(Directional::ONE, |c| c.at_hit(hit))
+    pub fn correction_along(&self, hit: &Hit, w: DVec3, n: DVec3) -> Option<Rgb> {
+        self.correction.as_ref().map(|c| c.at_hit(hit).along(w, n))
     }
 
     /// The profile of the pair at the homogeneous coefficients `coeffs`: the half-space
@@ -196,11 +195,15 @@ impl BssrdfObject {
         let fresnel = self.transmission(cos_i) * self.transmission(cos_o);
         let s = self.profile(surface, medium, x_i, x_o, rng, counters)
             * (fresnel / (self.sw_norm * PI));
-        if self.correction.is_none() {
-            return s;
+        match (
+            self.correction_along(x_i, w_i, n_i),
+            self.correction_along(x_o, w_o, n_o),
+        ) {
+            // The product of the two factors is formed before it meets S (reciprocity, as
+            // above).
+            (Some(f_i), Some(f_o)) => s * (f_i * f_o),
+            _ => s,
         }
-        // The product of the two factors is formed before it meets S (reciprocity, as above).
-        s * (self.correction_at(x_i).along(w_i, n_i) * self.correction_at(x_o).along(w_o, n_o))
     }
 }
 

@@ -53,7 +53,6 @@ use crate::film::Film;
 use crate::geometry::{Hit, ObjectSurface, Ray, offset_ray_origin};
 use crate::integrator::bssrdf::facing_normal;
 use crate::integrator::counters::PathCounters;
-use crate::integrator::probe::probe_within;
 use crate::integrator::{Method, PathIntegrator, PathOptions, RenderError};
 use crate::light::{Light, uniform_sphere};
 use crate::render::Counters;
@@ -302,15 +301,15 @@ impl<'s> LightTracer<'s> {
         }
         let beta = flux * (w_i.dot(n_i) / cos_g);
         let at_xi = self.camera_side.lookup(&x_i).unwrap_or_default();
-        let set = probe_within(geometry, x_i.object, &x_i, at_xi, &b.sampler, b.extent, rng);
-        if set.is_empty() {
-            counters.probe_misses += 1;
-            return;
-        }
         let surface = ObjectSurface {
             geometry,
             object: x_i.object,
         };
+        let set = b.probe_set(&surface, &x_i, at_xi, rng);
+        if set.is_empty() {
+            counters.probe_misses += 1;
+            return;
+        }
         let camera = scene.camera();
         let width = camera.resolution().0;
         for ph in set.iter() {

@@ -36,7 +36,6 @@ use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
-use crate::integrator::probe::probe_within;
 use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
@@ -987,31 +986,21 @@ impl<'s> PathIntegrator<'s> {
                 );
             }
         }
-        let corrected = b.correction.is_some();
-        if corrected {
-            // The shape correction's exit factor f(x_o, μ_o).
-            st.beta *= b.correction_at(hit).along(-ray.dir, n_o);
+        if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
+            st.beta *= f_o; // the shape correction's exit factor
         }
         let object = hit.object;
-        let at_xo = material.medium.coefficients(hit);
-        let set = probe_within(
-            self.scene.geometry(),
+        let surface = ObjectSurface {
+            geometry: self.scene.geometry(),
             object,
-            hit,
-            at_xo,
-            &b.sampler,
-            b.extent,
-            rng,
-        );
+        };
+        let at_xo = material.medium.coefficients(hit);
+        let set = b.probe_set(&surface, hit, at_xo, rng);
         counters.probe_sets += 1;
         if set.is_empty() {
             counters.probe_misses += 1;
             return Step::Stop;
         }
-        let surface = ObjectSurface {
-            geometry: self.scene.geometry(),
-            object,
-        };
         // Every hit gathers light; one, chosen uniformly, carries the path on (weight n).
         let carrier = rng.below(set.len() as u32) as usize;
         let mut next = None;
@@ -1035,15 +1024,17 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
-            let f_i = corrected.then(|| b.correction_at(&x_i));
-            let ld = match (&f_i, facing_normal(&x_i, ld.wi)) {
-                (Some(f), Some(n)) => ld.l * f.along(ld.wi, n),
+            // The shape correction's entry factor for the light's direction.
+            let ld = match facing_normal(&x_i, ld.wi) {
+                Some(n) if !ld.l.is_zero() => b
+                    .correction_along(&x_i, ld.wi, n)
+                    .map_or(ld.l, |f_i| ld.l * f_i),
                 _ => ld.l,
             };
             if ld.is_zero() && (k != carrier || self.defer_weights) {
                 // Nothing to gather: skip the (costly) estimate, or owe it (the carrier).
                 if k == carrier {
-                    next = Some((x_i, f_i, Err(ph.weight * set.len() as f64)));
+                    next = Some((x_i, Err(ph.weight * set.len() as f64)));
                 }
                 continue;
             }
@@ -1052,10 +1043,10 @@ impl<'s> PathIntegrator<'s> {
             self.settle(st, rng, counters);
             st.l += st.beta * w * ld;
             if k == carrier {
-                next = Some((x_i, f_i, Ok(w * set.len() as f64)));
+                next = Some((x_i, Ok(w * set.len() as f64)));
             }
         }
-        let Some((x_i, f_i, w)) = next else {
+        let Some((x_i, w)) = next else {
             return Step::Stop;
         };
         match w {
@@ -1083,8 +1074,8 @@ impl<'s> PathIntegrator<'s> {
         }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
         st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
-        if let Some(f) = f_i {
-            st.beta *= f.along(wi, x_i.ns);
+        if let Some(f_i) = b.correction_along(&x_i, wi, x_i.ns) {
+            st.beta *= f_i; // the shape correction's entry factor for the continuation
         }
         st.prev = Prev::Sampled {
             p: x_i.p,

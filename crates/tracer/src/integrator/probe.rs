@@ -28,7 +28,8 @@ impl ProbeSampler {
         self.0.probe_radius(c)
     }
 
-    /// [`probe_within`] over any surface of tracer hits (the shape correction's tangent plane).
+    /// [`probe_within`] over any surface of tracer hits: the object (`ObjectSurface`), or the
+    /// shape correction's tangent plane.
     pub(crate) fn probe_chords<C: ProbeChords<Point = Hit>>(
         &self,
         chords: &C,
@@ -81,8 +82,13 @@ pub fn probe_within(
     max_radius: f64,
     rng: &mut Rng,
 ) -> ProbeSet {
-    let surface = ObjectSurface { geometry, object };
-    lib::probe_within(&surface, x_o, coeffs, &sampler.0, max_radius, rng)
+    sampler.probe_chords(
+        &ObjectSurface { geometry, object },
+        x_o,
+        coeffs,
+        max_radius,
+        rng,
+    )
 }
 
 /// The density `p(x)` (1/length²) with which [`probe`] around `x_o` finds `x_i`.

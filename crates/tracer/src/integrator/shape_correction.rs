@@ -61,6 +61,7 @@ use crate::geometry::{Geometry, Hit, ObjectSurface, Ray};
 use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::walk::{reflect, refract};
+use crate::integrator::warnings::light_reach;
 use crate::rng::Rng;
 use crate::volume::{direction_about, orthonormal_basis};
 
@@ -70,7 +71,8 @@ const SEED: u64 = 0x005a_4ec0_77ec;
 pub const WALKS_PER_NODE: u32 = 12;
 /// Probe sets per sample point for B.
 pub const PROBES_PER_POINT: u32 = 128;
-/// Radius, in [`transport_length`]s, of the half-ball below a point that, held by the body,
+/// Radius, in diffusion lengths (or transport mean free paths, whichever is longer:
+/// [`light_reach`]), of the half-ball below a point that, held by the body,
 /// sets c = 1 there without walks: light that reaches it before leaving or being absorbed is
 /// of order e^{−6} of the total.
 const HALF_BALL: f64 = 6.0;
@@ -151,17 +153,8 @@ impl Directional {
         let s = (x - k0 as f64).clamp(0.0, 1.0);
         let row =
             |j: usize| self.0[j * PHI_NODES + k0] * (1.0 - s) + self.0[j * PHI_NODES + k1] * s;
-        let n = MU_NODES.len();
-        if mu <= MU_NODES[0] {
-            return row(0);
-        }
-        for j in 1..n {
-            if mu <= MU_NODES[j] {
-                let t = (mu - MU_NODES[j - 1]) / (MU_NODES[j] - MU_NODES[j - 1]);
-                return row(j - 1) * (1.0 - t) + row(j) * t;
-            }
-        }
-        row(n - 1)
+        let [(j0, w0), (j1, w1)] = mu_weights(mu);
+        row(j0) * w0 + row(j1) * w1
     }
 }
 
@@ -224,6 +217,12 @@ impl Grid {
             start,
             order,
         }
+    }
+
+    /// [`Grid::for_each_near`] about `hits[i]`, the grid being built over `hits`' positions.
+    #[inline]
+    fn around(&self, hits: &[Hit], i: usize, f: impl FnMut(usize, f64)) {
+        self.for_each_near(hits[i].p, hits[i].ns, |j| hits[j].p, |j| hits[j].ns, f)
     }
 
     /// Calls `f(i, w)` for every point i within 2h of `p` whose normal faces like `n`, with
@@ -305,51 +304,40 @@ impl ShapeCorrection {
                 let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
                 let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
                 let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                let reach = HALF_BALL * transport_length(coeffs, bssrdf.family.g());
+                let reach = HALF_BALL * light_reach(coeffs, bssrdf.family.g()).0;
                 let sums = (!contains_half_ball(&surface, &x_o, reach))
                     .then(|| point_sums(bssrdf, &surface, &x_o, coeffs, grey, i as u64));
                 Some((x_o, coeffs, sums))
             })
             .collect();
-        let points: Vec<DVec3> = raw.iter().map(|(x, _, _)| x.p).collect();
+        let hits: Vec<Hit> = raw.iter().map(|(x, _, _)| *x).collect();
+        let points: Vec<DVec3> = hits.iter().map(|x| x.p).collect();
         let grid = Grid::new(&points, h, lo, hi);
-        let eta = bssrdf.eta();
-        let pool = |grid: &Grid, i: usize, value: &dyn Fn(usize) -> Option<Sums>| {
-            let mut pooled = Sums::default();
-            let x = &raw[i].0;
-            grid.for_each_near(
-                x.p,
-                x.ns,
-                |j| raw[j].0.p,
-                |j| raw[j].0.ns,
-                |j, w| {
-                    if let Some(v) = value(j) {
-                        pooled.add_scaled(&v, w);
-                    }
-                },
-            );
-            pooled
-        };
+        let weights = incident_weights(bssrdf.eta());
         // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
         // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
         // bias, of order 1/(escapes per point), would not average out).
         let pooled: Vec<Option<Sums>> = (0..raw.len())
             .into_par_iter()
             .map(|i| {
-                raw[i]
-                    .2
-                    .is_some()
-                    .then(|| pool(&grid, i, &|j| raw[j].2).regularised())
+                raw[i].2.as_ref()?;
+                let mut pooled = Sums::default();
+                grid.around(&hits, i, |j, w| {
+                    if let Some(sums) = &raw[j].2 {
+                        pooled.add_scaled(sums, w);
+                    }
+                });
+                Some(pooled.regularised())
             })
             .collect();
         let mut corr = Self {
-            samples: raw
+            samples: hits
                 .iter()
                 .zip(&pooled)
-                .map(|((x, _, _), s)| Sample {
+                .map(|(x, s)| Sample {
                     p: x.p,
                     n: x.ns,
-                    f: s.map_or(Directional::ONE, |s| s.factor(eta)),
+                    f: s.as_ref().map_or(Directional::ONE, |s| s.factor(&weights)),
                 })
                 .collect(),
             grid,
@@ -359,33 +347,35 @@ impl ShapeCorrection {
         // Where c varies on the scale of the profile (corners, edges), the incident side's
         // factor differs from x_o's: iterate f ← √(f · T / B'), B' the body's response with
         // the current factors at the incident points, T what it should be (module docs).
-        let weights = incident_weights(eta);
         for _ in 0..ITERATIONS {
             let response: Vec<Option<Rgb>> = raw
                 .par_iter()
                 .enumerate()
                 .map(|(i, (x, coeffs, sums))| {
-                    sums.is_some().then(|| {
-                        body_response(bssrdf, &surface, x, *coeffs, i as u64, |x_i| {
-                            corr.at(x_i.p, x_i.ns).incident_mean(&weights)
-                        })
-                    })
+                    sums.as_ref()?;
+                    Some(body_response(
+                        bssrdf,
+                        &surface,
+                        x,
+                        *coeffs,
+                        i as u64,
+                        |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
+                    ))
                 })
                 .collect();
             let updated: Vec<Directional> = (0..raw.len())
                 .into_par_iter()
-                .map(|i| match &pooled[i] {
-                    None => Directional::ONE,
-                    Some(p) => {
-                        let b_prime = pool(&corr.grid, i, &|j| {
-                            response[j].map(|b| Sums {
-                                b_body: b,
-                                ..Sums::default()
-                            })
-                        })
-                        .b_body;
-                        p.refine(&corr.samples[i].f, b_prime)
-                    }
+                .map(|i| {
+                    let Some(p) = &pooled[i] else {
+                        return Directional::ONE;
+                    };
+                    let mut b_prime = Rgb::ZERO;
+                    corr.grid.around(&hits, i, |j, w| {
+                        if let Some(r) = response[j] {
+                            b_prime += r * w;
+                        }
+                    });
+                    p.refine(&corr.samples[i].f, b_prime)
                 })
                 .collect();
             for (s, f) in corr.samples.iter_mut().zip(updated) {
@@ -473,20 +463,6 @@ impl ShapeCorrection {
     }
 }
 
-/// The longest of the diffusion length 1/σtr and the transport mean free path 1/σt' over the
-/// channels at `c` (∞ without absorption): the reach of the walks that [`HALF_BALL`] scales.
-fn transport_length(c: Coefficients, g: f64) -> f64 {
-    let mut ell: f64 = 0.0;
-    for ch in 0..3 {
-        let (a, s) = (c.sigma_a[ch], c.sigma_s[ch]);
-        let tp = a + (1.0 - g) * s;
-        let tr = (3.0 * a * tp).sqrt();
-        let l = if tr > 0.0 { 1.0 / tr } else { f64::INFINITY };
-        ell = ell.max(l).max(if tp > 0.0 { 1.0 / tp } else { 0.0 });
-    }
-    ell
-}
-
 /// Whether the body holds the half-ball of radius `reach` below the tangent plane at `x_o`, as
 /// far as 37 rays from x_o into the body can tell (straight down, and 12 azimuths at each of
 /// three depressions down to 1° below the tangent plane): none meets the surface within
@@ -527,7 +503,7 @@ fn contains_half_ball(surface: &ObjectSurface<'_>, x_o: &Hit, reach: f64) -> boo
 /// free path, whichever is longer) of the most translucent part of the medium (the scale on
 /// which the profile, and so the correction, varies), bounded to [extent/40, extent/4].
 fn sample_spacing(medium: &MediumField, g: f64, extent: f64) -> f64 {
-    (0.5 * transport_length(medium.field_bounds().min, g)).clamp(extent / 40.0, extent / 4.0)
+    (0.5 * light_reach(medium.field_bounds().min, g).0).clamp(extent / 40.0, extent / 4.0)
 }
 
 /// A point drawn uniformly by area on `object`'s mesh, as a hit (shading normal, texture
@@ -680,16 +656,16 @@ impl Sums {
         self.b_half += o.b_half * w;
     }
 
-    /// c(μ_j) = (P_body/P_half)/(B_body/B_half) per channel, then f = c / √c̄ with c̄ the mean
-    /// of c over incident light as the BSSRDF gathers it at x_i ([`incident_mean`]); 1 in a
-    /// channel where an estimate is empty.
     /// P_body/P_half at direction node `d` and channel `ch`.
     fn p_ratio(&self, d: usize, ch: usize) -> Option<f64> {
         let (pb, ph) = (self.p_body[d][ch], self.p_half[d][ch]);
         (ph > 0.0).then(|| pb / ph)
     }
 
-    fn factor(&self, eta: f64) -> Directional {
+    /// c(ω_d) = (P_body/P_half)/(B_body/B_half) per channel, then f = c / √c̄ with c̄ the mean
+    /// of c over incident light as the BSSRDF gathers it at x_i (`weights`:
+    /// [`incident_weights`]); 1 in a channel where an estimate is empty.
+    fn factor(&self, weights: &[f64; DIRECTIONS]) -> Directional {
         let mut out = Directional::ONE;
         for ch in 0..3 {
             let (bb, bh) = (self.b_body[ch], self.b_half[ch]);
@@ -707,7 +683,7 @@ impl Sums {
             if !ok {
                 continue;
             }
-            let mean = incident_mean(&c, ch, eta);
+            let mean = c.incident_mean(weights)[ch];
             for j in 0..DIRECTIONS {
                 out.0[j][ch] = c.0[j][ch] / mean.sqrt();
             }
@@ -739,25 +715,6 @@ impl Sums {
     }
 }
 
-/// ∫ (1 − F(μ)) μ c(μ) dμ / ∫ (1 − F(μ)) μ dμ over [0, 1] for channel `ch` (midpoint rule, 256
-/// intervals): the mean of c over the light a BSSRDF's incident point gathers from a uniform
-/// sky.
-fn incident_mean(c: &Directional, ch: usize, eta: f64) -> f64 {
-    let n = 256;
-    let (mut num, mut den) = (0.0, 0.0);
-    for k in 0..n {
-        let mu = (k as f64 + 0.5) / n as f64;
-        let w = (1.0 - bssrdf_core::fresnel::dielectric(mu, eta)) * mu;
-        let ring: f64 = (0..PHI_NODES)
-            .map(|k| c.at(mu, TAU * k as f64 / PHI_NODES as f64)[ch])
-            .sum::<f64>()
-            / PHI_NODES as f64;
-        num += w * ring;
-        den += w;
-    }
-    num / den
-}
-
 /// Σ over [`PROBES_PER_POINT`] probe sets around x_o on the body of R(x_i, x_o)·g(x_i)/p(x_i)
 /// (per channel): B_body for g = 1, the body's response to uniform light with the incident
 /// factors of the current correction for g = ⟨f(x_i)⟩. The same probes for every g (and as
@@ -782,14 +739,42 @@ fn body_response(
     sum
 }
 
-/// Quadrature weights W_j with ⟨f⟩ = Σ_j W_j f(μ_j) for f linear between [`MU_NODES`]
-/// ([`incident_mean`] of each node's hat function).
+/// Weights W_d with ⟨f⟩ = Σ_d W_d f(ω_d) for f interpolated between the direction nodes as
+/// [`Directional::at`] does: the mean of f over the light a BSSRDF's incident point gathers
+/// from a uniform sky, ∫ (1 − F(μ)) μ f dω / ∫ (1 − F(μ)) μ dω (midpoint rule in μ, 256
+/// intervals; the azimuthal mean of the periodic-linear interpolant is that of its nodes).
 fn incident_weights(eta: f64) -> [f64; DIRECTIONS] {
-    std::array::from_fn(|j| {
-        let mut hat = Directional([Rgb::ZERO; DIRECTIONS]);
-        hat.0[j] = Rgb::ONE;
-        incident_mean(&hat, 0, eta)
-    })
+    let n = 256;
+    let mut weights = [0.0; DIRECTIONS];
+    let mut den = 0.0;
+    for k in 0..n {
+        let mu = (k as f64 + 0.5) / n as f64;
+        let w = (1.0 - bssrdf_core::fresnel::dielectric(mu, eta)) * mu;
+        den += w;
+        for (j, hat) in mu_weights(mu) {
+            for a in 0..PHI_NODES {
+                weights[j * PHI_NODES + a] += w * hat / PHI_NODES as f64;
+            }
+        }
+    }
+    weights.map(|w| w / den)
+}
+
+/// Linear interpolation in μ between [`MU_NODES`] (constant beyond them), as two (node,
+/// weight) pairs.
+#[inline]
+fn mu_weights(mu: f64) -> [(usize, f64); 2] {
+    let last = MU_NODES.len() - 1;
+    if mu <= MU_NODES[0] {
+        return [(0, 1.0), (0, 0.0)];
+    }
+    for j in 1..=last {
+        if mu <= MU_NODES[j] {
+            let t = (mu - MU_NODES[j - 1]) / (MU_NODES[j] - MU_NODES[j - 1]);
+            return [(j - 1, 1.0 - t), (j, t)];
+        }
+    }
+    [(last, 1.0), (last, 0.0)]
 }
 
 /// The tangent plane at x_o as a surface for probe chords: the half-space reference.

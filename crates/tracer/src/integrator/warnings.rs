@@ -108,6 +108,27 @@ fn hidden_cores(scene: &Scene) -> Vec<String> {
 /// whichever is longer) than this are reported by [`scene_warnings`].
 pub const SMALL_OBJECT_DIFFUSION_LENGTHS: f64 = 5.0;
 
+/// How far light spreads in a medium with coefficients `c`: the longest, over the channels, of
+/// the diffusion length 1/σtr (σtr = √(3σa σt'), JMLH01) and the transport mean free path
+/// 1/σt' (σt' = σa + (1 − g)σs), and whether it is the diffusion length. ∞ where a channel
+/// scatters without absorbing; 0 for a medium that neither absorbs nor scatters.
+pub(crate) fn light_reach(c: het_estimate::Coefficients, g: f64) -> (f64, bool) {
+    (0..3)
+        .map(|ch| {
+            let (a, s) = (c.sigma_a[ch], c.sigma_s[ch] * (1.0 - g));
+            let sigma_tp = a + s;
+            let sigma_tr = (3.0 * a * sigma_tp).sqrt();
+            let diffusion = if sigma_tr > 0.0 { 1.0 / sigma_tr } else { 0.0 };
+            let transport = if sigma_tp > 0.0 { 1.0 / sigma_tp } else { 0.0 };
+            if sigma_tp > 0.0 && sigma_tr == 0.0 {
+                (f64::INFINITY, true)
+            } else {
+                (diffusion.max(transport), diffusion >= transport)
+            }
+        })
+        .fold((0.0, true), |acc, x| if x.0 > acc.0 { x } else { acc })
+}
+
 /// Camera samples per side of the grid that measures an object's share of the image.
 const SHARE_GRID: u32 = 128;
 
@@ -127,21 +148,7 @@ fn small_objects(scene: &Scene) -> Vec<String> {
         let (lo, hi) = scene.geometry().object_bounds(i);
         let thinnest = (hi - lo).min_element();
         let b = t.medium.field_bounds();
-        // The longest length over the channels, and whether it is the diffusion length.
-        let (longest, diffusive) = (0..3)
-            .map(|c| {
-                let (a, s) = (b.min.sigma_a[c], b.min.sigma_s[c] * (1.0 - t.g));
-                let sigma_tp = a + s;
-                let sigma_tr = (3.0 * a * sigma_tp).sqrt();
-                let diffusion = if sigma_tr > 0.0 { 1.0 / sigma_tr } else { 0.0 };
-                let transport = if sigma_tp > 0.0 { 1.0 / sigma_tp } else { 0.0 };
-                if sigma_tp > 0.0 && sigma_tr == 0.0 {
-                    (f64::INFINITY, true)
-                } else {
-                    (diffusion.max(transport), diffusion >= transport)
-                }
-            })
-            .fold((0.0, true), |acc, x| if x.0 > acc.0 { x } else { acc });
+        let (longest, diffusive) = light_reach(b.min, t.g);
         if longest > 0.0
             && thinnest.is_finite()
             && thinnest < SMALL_OBJECT_DIFFUSION_LENGTHS * longest
