@@ -36,6 +36,12 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// H(μ; ϖ) for 0 ≤ ϖ < 1.
 pub fn h(omega: f64, mu: f64) -> f64 {
+    h_function(omega)(mu)
+}
+
+/// H(·; ϖ) for 0 ≤ ϖ < 1, solved once: evaluating the returned function at any μ costs one
+/// quadrature sum.
+pub fn h_function(omega: f64) -> impl Fn(f64) -> f64 {
     let (x, w) = gauss_legendre(200);
     let s = (1.0 - omega).sqrt();
     let mut hk = vec![1.0; x.len()];
@@ -62,13 +68,15 @@ pub fn h(omega: f64, mu: f64) -> f64 {
             break;
         }
     }
-    let integral: f64 = x
-        .iter()
-        .zip(&w)
-        .zip(&hk)
-        .map(|((&mj, &wj), &hj)| wj * mj * hj / (mu + mj))
-        .sum();
-    1.0 / (s + 0.5 * omega * integral)
+    move |mu: f64| {
+        let integral: f64 = x
+            .iter()
+            .zip(&w)
+            .zip(&hk)
+            .map(|((&mj, &wj), &hj)| wj * mj * hj / (mu + mj))
+            .sum();
+        1.0 / (s + 0.5 * omega * integral)
+    }
 }
 
 /// Plane albedo of an isotropic, index-matched half-space at normal incidence.

@@ -181,6 +181,21 @@ pub fn shape_scene_with(
     thickness_aware: bool,
     shape_correction: bool,
 ) -> Scene {
+    shape_scene_material(shape, medium, bunny, |m| Translucent {
+        thickness_aware,
+        shape_correction,
+        ..m
+    })
+}
+
+/// `shape` filled with `medium` under a uniform environment of radiance 1, its material
+/// (the defaults of `Translucent::new`) passed through `material` first.
+pub fn shape_scene_material(
+    shape: Shape,
+    medium: Medium,
+    bunny: &Path,
+    material: impl FnOnce(Translucent) -> Translucent,
+) -> Scene {
     let (mesh, camera) = shape.mesh_and_camera(bunny);
     let (w, h) = camera.resolution();
     let field =
@@ -190,11 +205,7 @@ pub fn shape_scene_with(
         .object(
             "shape",
             mesh,
-            Material::Translucent(Translucent {
-                thickness_aware,
-                shape_correction,
-                ..Translucent::new("m", field, medium.g, medium.eta)
-            }),
+            Material::Translucent(material(Translucent::new("m", field, medium.g, medium.eta))),
         )
         .build()
         .unwrap()

@@ -3,11 +3,13 @@
 //! seed and photon count whatever the thread count; the built-in table is
 //! `crates/bssrdf-core/data/halfspace-profile-v1.bin`, made with the defaults below; `--slab`
 //! writes the slab table instead (`crates/bssrdf-core/data/slab-profile-v1.bin`, made with
-//! `--slab --photons 4000000`).
+//! `--slab --photons 4000000`); `--angular` writes the angular coupling
+//! (`crates/bssrdf-core/data/angular-coupling-v1.bin`).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
+use bssrdf_core::tabulated::angular_file::{ANGULAR_ETAS, tabulate_angular};
 use bssrdf_core::tabulated::file::tabulate;
 use bssrdf_core::tabulated::grid::ETAS;
 use bssrdf_core::tabulated::slab::{SLAB_ETAS, SLAB_THICKNESSES};
@@ -29,8 +31,13 @@ pub struct Args {
     seed: u64,
     /// Simulate the slab table (`bssrdf_core::tabulated::slab`, built in as
     /// `crates/bssrdf-core/data/slab-profile-v1.bin`) instead of the half-space one.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "angular")]
     slab: bool,
+    /// Simulate the angular coupling (`bssrdf_core::tabulated::angular`, built in as
+    /// `crates/bssrdf-core/data/angular-coupling-v1.bin`, made with `--angular --photons
+    /// 65536`; photons per incidence bin and plane) instead of the half-space table.
+    #[arg(long)]
+    angular: bool,
     /// Worker threads (default: every core); the file does not depend on it.
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     threads: Option<u64>,
@@ -47,6 +54,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let planes = SLAB_THICKNESSES.len() * SLAB_ETAS.len();
         return simulate_and_write(&args, planes, "slab planes", |progress| {
             let data = tabulate_slab(args.seed, args.photons, threads, progress);
+            let capped = data.planes.iter().map(|p| p.capped).sum();
+            (data.to_bytes(), capped)
+        });
+    }
+    if args.angular {
+        return simulate_and_write(&args, ANGULAR_ETAS.len(), "angular planes", |progress| {
+            let data = tabulate_angular(args.seed, args.photons, threads, progress);
             let capped = data.planes.iter().map(|p| p.capped).sum();
             (data.to_bytes(), capped)
         });

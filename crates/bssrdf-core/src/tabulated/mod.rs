@@ -7,6 +7,8 @@
 //! and radial bins), with the photon counts and standard errors it was made with ([`mod@file`]).
 //! The slab table ([`slab`], [`slab_file`]) holds the same for slabs of finite thickness:
 //! reflection and transmission.
+pub mod angular;
+pub mod angular_file;
 pub mod file;
 pub mod grid;
 pub mod profile;
@@ -14,5 +16,6 @@ pub mod simulate;
 pub mod slab;
 pub mod slab_file;
 
+pub use angular::AngularCoupling;
 pub use profile::TabulatedTerm;
 pub use slab::{SlabFace, SlabTerm};

@@ -96,7 +96,7 @@ impl Stream {
         z ^ (z >> 31)
     }
     /// Uniform in (0, 1].
-    fn uniform(&mut self) -> f64 {
+    pub(crate) fn uniform(&mut self) -> f64 {
         ((self.next_u64() >> 11) + 1) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 }
@@ -131,8 +131,23 @@ pub(crate) fn trace(
     rng: &mut Stream,
     mut exit: impl FnMut(u32, f64, Face),
 ) -> bool {
+    trace_from([0.0, 0.0, -1.0], eta, thickness, rng, |n, x, face, _| {
+        exit(n, x, face)
+    })
+}
+
+/// [`trace`] for a photon that starts at the origin along the unit direction `dir` (already
+/// refracted into the medium, pointing into it: `dir[2] < 0`); `exit` also receives the
+/// cosine of the photon's direction with the face's normal, inside the medium, as it leaves.
+pub(crate) fn trace_from(
+    dir: [f64; 3],
+    eta: f64,
+    thickness: f64,
+    rng: &mut Stream,
+    mut exit: impl FnMut(u32, f64, Face, f64),
+) -> bool {
     let (mut px, mut py, mut pz) = (0.0f64, 0.0f64, 0.0f64);
-    let (mut dx, mut dy, mut dz) = (0.0f64, 0.0f64, -1.0f64);
+    let [mut dx, mut dy, mut dz] = dir;
     let mut n = 0u32;
     loop {
         let t = -rng.uniform().ln();
@@ -154,7 +169,7 @@ pub(crate) fn trace(
                 dz = -dz; // internal reflection; the free path restarts (memoryless)
                 continue;
             }
-            exit(n, (px * px + py * py).sqrt(), face);
+            exit(n, (px * px + py * py).sqrt(), face, dz.abs());
             return true;
         }
         px += t * dx;

@@ -30,6 +30,7 @@
 
 use std::f64::consts::PI;
 
+use bssrdf_core::tabulated::AngularCoupling;
 use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SlabFace};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
@@ -63,6 +64,23 @@ pub(crate) struct BssrdfObject {
     /// The shape correction c (module docs of [`super::shape_correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
     pub correction: Option<super::shape_correction::ShapeCorrection>,
+    /// The tabulated profile's angular coupling T(α, μ_i, μ_o)
+    /// ([`bssrdf_core::tabulated::angular`]): with the tabulated model, unless the material
+    /// turns it off (`angular_coupling = false`).
+    coupling: Option<AngularCoupling>,
+}
+
+/// The profile weight of one pair, with what the angular coupling needs to finish it
+/// ([`BssrdfObject::coupling`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairWeight {
+    /// R (1/length², per channel): the half-space or slab profile at the pair's coefficients.
+    pub rd: Rgb,
+    /// The homogeneous coefficients the estimator gave for the pair.
+    coeffs: het_estimate::Coefficients,
+    /// Whether R is a reflection profile (the half-space's, or a slab's reflection), to which
+    /// the half-space's angular coupling applies; not for slab transmission.
+    reflection: bool,
 }
 
 impl BssrdfObject {
@@ -80,7 +98,17 @@ impl BssrdfObject {
         let thickness_aware = material.thickness_aware
             && family.model() == ProfileModel::Tabulated
             && family.g().abs() <= SLAB_MAX_G;
+        let coupling = if material.angular_coupling && family.model() == ProfileModel::Tabulated {
+            AngularCoupling::new(
+                material.eta,
+                scattering.includes_single(),
+                scattering.includes_multiple(),
+            )
+        } else {
+            None
+        };
         Ok(Self {
+            coupling,
             thickness_aware,
             sampler: ProbeSampler::new(family, &material.medium),
             family,
@@ -137,10 +165,37 @@ impl BssrdfObject {
         x_o: &Hit,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> Rgb {
+    ) -> PairWeight {
         let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
         counters.record_estimate(&est.diagnostics);
-        self.weigh(surface, est.coefficients, x_i, x_o, counters)
+        let (rd, reflection) = self.weigh_pair(surface, est.coefficients, x_i, x_o, counters);
+        PairWeight {
+            rd,
+            coeffs: est.coefficients,
+            reflection,
+        }
+    }
+
+    /// The angular coupling T(α', μ_i, μ_o) per channel for a pair weighed as `w`, light
+    /// entering at cosine `cos_i` and leaving at `cos_o` about the normals S uses (α' the
+    /// reduced albedo of the pair's coefficients, as the tabulated profile reads its rows;
+    /// [`bssrdf_core::tabulated::angular`]); 1 without a coupling or for slab transmission.
+    /// Symmetric in the two cosines, bit for bit.
+    #[inline]
+    pub fn coupling(&self, w: &PairWeight, cos_i: f64, cos_o: f64) -> Rgb {
+        let Some(t) = self.coupling.as_ref().filter(|_| w.reflection) else {
+            return Rgb::splat(1.0);
+        };
+        let g = self.family.g();
+        let mut out = Rgb::splat(1.0);
+        for ch in 0..3 {
+            let sp = (1.0 - g) * w.coeffs.sigma_s[ch];
+            let tp = w.coeffs.sigma_a[ch] + sp;
+            if tp > 0.0 {
+                out[ch] = t.factor(sp / tp, cos_i, cos_o);
+            }
+        }
+        out
     }
 
     /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium
@@ -163,14 +218,30 @@ impl BssrdfObject {
         x_o: &Hit,
         counters: &mut PathCounters,
     ) -> Rgb {
+        self.weigh_pair(surface, coeffs, x_i, x_o, counters).0
+    }
+
+    /// [`BssrdfObject::weigh`], and whether the profile used is a reflection one
+    /// ([`PairWeight::reflection`]).
+    fn weigh_pair(
+        &self,
+        surface: &ObjectSurface<'_>,
+        coeffs: het_estimate::Coefficients,
+        x_i: &Hit,
+        x_o: &Hit,
+        counters: &mut PathCounters,
+    ) -> (Rgb, bool) {
         let r = (x_i.p - x_o.p).length();
         if !self.thickness_aware {
-            return counters.eval_profile(&self.family, coeffs, r);
+            return (counters.eval_profile(&self.family, coeffs, r), true);
         }
         let d = 0.5 * (thickness(surface, x_i) + thickness(surface, x_o));
         match slab_pair(x_i, x_o, d) {
-            Some((face, dist)) => counters.eval_slab_profile(&self.family, coeffs, d, face, dist),
-            None => counters.eval_profile(&self.family, coeffs, r),
+            Some((face, dist)) => (
+                counters.eval_slab_profile(&self.family, coeffs, d, face, dist),
+                face == SlabFace::Reflection,
+            ),
+            None => (counters.eval_profile(&self.family, coeffs, r), true),
         }
     }
 
@@ -193,8 +264,8 @@ impl BssrdfObject {
         };
         let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
         let fresnel = self.transmission(cos_i) * self.transmission(cos_o);
-        let s = self.profile(surface, medium, x_i, x_o, rng, counters)
-            * (fresnel / (self.sw_norm * PI));
+        let w = self.profile(surface, medium, x_i, x_o, rng, counters);
+        let s = w.rd * (fresnel / (self.sw_norm * PI)) * self.coupling(&w, cos_i, cos_o);
         match (
             self.correction_along(x_i, w_i, n_i),
             self.correction_along(x_o, w_o, n_o),

@@ -327,6 +327,10 @@ struct Deferred {
     x_i: Hit,
     x_o: Hit,
     scale: f64,
+    /// Cosines of the continuation's direction at x_i and of the exit direction at x_o, for
+    /// the angular coupling ([`BssrdfObject::coupling`]).
+    cos_i: f64,
+    cos_o: f64,
 }
 
 impl PathState {
@@ -986,6 +990,7 @@ impl<'s> PathIntegrator<'s> {
                 );
             }
         }
+        let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
         if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
             st.beta *= f_o; // the shape correction's exit factor
         }
@@ -1024,12 +1029,15 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
-            // The shape correction's entry factor for the light's direction.
-            let ld = match facing_normal(&x_i, ld.wi) {
-                Some(n) if !ld.l.is_zero() => b
-                    .correction_along(&x_i, ld.wi, n)
-                    .map_or(ld.l, |f_i| ld.l * f_i),
-                _ => ld.l,
+            // The shape correction's entry factor for the light's direction, and the cosine
+            // the angular coupling reads.
+            let (ld, cos_light) = match facing_normal(&x_i, ld.wi) {
+                Some(n) if !ld.l.is_zero() => (
+                    b.correction_along(&x_i, ld.wi, n)
+                        .map_or(ld.l, |f_i| ld.l * f_i),
+                    ld.wi.dot(n),
+                ),
+                _ => (ld.l, 0.0),
             };
             if ld.is_zero() && (k != carrier || self.defer_weights) {
                 // Nothing to gather: skip the (costly) estimate, or owe it (the carrier).
@@ -1038,19 +1046,24 @@ impl<'s> PathIntegrator<'s> {
                 }
                 continue;
             }
-            let rd = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
-            let w = rd * ph.weight;
+            let pw = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
+            let w = pw.rd * ph.weight;
             self.settle(st, rng, counters);
-            st.l += st.beta * w * ld;
+            if !ld.is_zero() {
+                st.l += st.beta * w * ld * b.coupling(&pw, cos_light, cos_o);
+            }
             if k == carrier {
-                next = Some((x_i, Ok(w * set.len() as f64)));
+                next = Some((x_i, Ok((w * set.len() as f64, pw))));
             }
         }
         let Some((x_i, w)) = next else {
             return Step::Stop;
         };
-        match w {
-            Ok(w) => st.beta *= w,
+        let carried = match w {
+            Ok((w, pw)) => {
+                st.beta *= w;
+                Some(pw)
+            }
             Err(scale) => {
                 // One factor is owed at a time: settle an older one first.
                 self.settle(st, rng, counters);
@@ -1059,9 +1072,12 @@ impl<'s> PathIntegrator<'s> {
                     x_i,
                     x_o: *hit,
                     scale,
+                    cos_i: 1.0,
+                    cos_o,
                 });
+                None
             }
-        }
+        };
         if st.beta.is_zero() {
             return Step::Stop;
         }
@@ -1076,6 +1092,12 @@ impl<'s> PathIntegrator<'s> {
         st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
         if let Some(f_i) = b.correction_along(&x_i, wi, x_i.ns) {
             st.beta *= f_i; // the shape correction's entry factor for the continuation
+        }
+        // The angular coupling for the continuation: now, or when the owed weight is settled.
+        match (carried, st.deferred.as_mut()) {
+            (Some(pw), _) => st.beta *= b.coupling(&pw, cos, cos_o),
+            (None, Some(d)) => d.cos_i = cos,
+            (None, None) => {}
         }
         st.prev = Prev::Sampled {
             p: x_i.p,
@@ -1096,8 +1118,8 @@ impl<'s> PathIntegrator<'s> {
             geometry: self.scene.geometry(),
             object: d.object,
         };
-        let rd = b.profile(&surface, &material.medium, &d.x_i, &d.x_o, rng, counters);
-        st.beta *= rd * d.scale;
+        let pw = b.profile(&surface, &material.medium, &d.x_i, &d.x_o, rng, counters);
+        st.beta *= pw.rd * d.scale * b.coupling(&pw, d.cos_i, d.cos_o);
     }
 
     /// The translucent material and BSSRDF data of `object`, when it is rendered with a

@@ -315,6 +315,9 @@ pub struct TranslucentDesc {
     /// Scale the BSSRDF by the shape correction measured in the object (default false;
     /// `Translucent::shape_correction`).
     pub shape_correction: Option<bool>,
+    /// With the tabulated profile, scale it by the half-space's angular coupling (default
+    /// true; `Translucent::angular_coupling`).
+    pub angular_coupling: Option<bool>,
     /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.
     /// 1000 for coefficients per mm in a scene modelled in metres. An artist radius is
     /// divided by it.

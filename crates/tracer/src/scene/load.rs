@@ -638,6 +638,7 @@ impl Cx {
             profile,
             thickness_aware: d.thickness_aware.unwrap_or(true),
             shape_correction: d.shape_correction.unwrap_or(false),
+            angular_coupling: d.angular_coupling.unwrap_or(true),
             unit_scale: d.unit_scale,
             key: key.to_string(),
             line: self.loc.line_of_key(key),
@@ -1258,6 +1259,8 @@ enum FieldSpec {
 /// A shape's material: named in the scene file, or read from the mesh file (glTF).
 enum ShapeMaterial {
     Named(String),
+    /// Only glTF files carry materials.
+    #[cfg_attr(not(feature = "gltf"), allow(dead_code))]
     Built(Box<Material>),
 }
 

@@ -128,6 +128,11 @@ pub struct Translucent {
     /// preparation costs seconds to minutes (more with higher albedo and larger objects).
     /// Scene key `shape_correction`; default false.
     pub shape_correction: bool,
+    /// Whether a BSSRDF render with the tabulated profile scales it by the half-space's
+    /// angular coupling T(α, μ_i, μ_o) (`bssrdf_core::tabulated::angular`, docs/tabulated-profile.md):
+    /// exact for a flat half-space in every pair of directions, not only at normal incidence.
+    /// Scene key `angular_coupling`; default true.
+    pub angular_coupling: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
     /// Key of the material in the scene file (`material[2]`) for messages.
@@ -171,6 +176,7 @@ impl Translucent {
             profile: None,
             thickness_aware: true,
             shape_correction: false,
+            angular_coupling: true,
             unit_scale: 1.0,
             line: None,
         }
