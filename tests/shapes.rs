@@ -191,6 +191,22 @@ fn shapes_corrected_index_matched_albedo_0_9() {
     );
 }
 
+/// With the shape correction at η 1.3, ϖ 0.99: the spheres and the corner (0.53, 0.81 and
+/// 0.80 without it) within 15 %.
+#[test]
+fn shapes_corrected_refractive_albedo_0_99() {
+    check_with(
+        Medium::new(0.99, 1.3),
+        &[
+            (Shape::Sphere(1.0), Within15),
+            (Shape::Sphere(10.0), Within15),
+            (Shape::BoxCorner, Within15),
+        ],
+        80_000,
+        true,
+    );
+}
+
 /// The tabulated profile's angular coupling (docs/tabulated-profile.md, "Angular coupling"):
 /// a half-space at η 1, ϖ 0.9 seen at μ = 0.3 under a uniform sky. With the separable Fresnel
 /// lobes alone the BSSRDF gives 0.89 of the path tracer there (`examples/shapes.rs --
