@@ -125,11 +125,18 @@ impl AngularCoupling {
                 }
             }
             // Normalised at normal exit under uniform light: there the separable form already
-            // returns the normal-incidence total (reciprocity), which the last bin, an average
-            // over μ from 0.935 to 1, would otherwise miss by its spread in angle and noise.
-            let top = N_MU - 1;
-            let rho =
-                (0..N_MU).map(|j| a[j] * m[j * N_MU + top]).sum::<f64>() / a.iter().sum::<f64>();
+            // returns the normal-incidence total (reciprocity). The integral runs over the
+            // lookup itself (256 midpoints in μ²), so the normalisation holds for the values
+            // the renderer reads.
+            const NODES: usize = 256;
+            let (mut num, mut den) = (0.0, 0.0);
+            for n in 0..NODES {
+                let mu = ((n as f64 + 0.5) / NODES as f64).sqrt();
+                let w = 1.0 - dielectric(mu, eta);
+                num += w * Cells::new(mu, 1.0).eval(|j, k| m[j * N_MU + k]);
+                den += w;
+            }
+            let rho = num / den;
             if rho.is_finite() && rho > 0.0 {
                 m.iter_mut().for_each(|v| *v /= rho);
             }
@@ -138,37 +145,83 @@ impl AngularCoupling {
     }
 
     /// T(α, μ_i, μ_o) (unitless, finite and ≥ 0 for every input): bilinear in μ² between the
-    /// bins' centres (constant beyond the outer centres), linear between albedo rows as the
-    /// tabulated profile is. Exactly symmetric in (`mu_i`, `mu_o`). Non-finite arguments give 1.
+    /// bins' centres, extrapolated linearly over the half bins beyond the outer centres (to
+    /// μ = 0 and μ = 1), linear between albedo rows as the tabulated profile is. Exactly
+    /// symmetric in (`mu_i`, `mu_o`). Non-finite arguments give 1.
     pub fn factor(&self, alpha: f64, mu_i: f64, mu_o: f64) -> f64 {
-        if !(alpha.is_finite() && mu_i.is_finite() && mu_o.is_finite()) {
-            return 1.0;
+        self.factors([alpha; 1], mu_i, mu_o)[0]
+    }
+
+    /// [`AngularCoupling::factor`] for several albedos (the channels of one pair) at the same
+    /// pair of cosines: the cosines' cells are found once, and a channel whose albedo equals the
+    /// previous one's reuses its value.
+    pub fn factors<const N: usize>(&self, alpha: [f64; N], mu_i: f64, mu_o: f64) -> [f64; N] {
+        let mut out = [1.0; N];
+        if !(mu_i.is_finite() && mu_o.is_finite()) {
+            return out;
         }
-        let (a, b) = if mu_i <= mu_o {
-            (mu_i, mu_o)
-        } else {
-            (mu_o, mu_i)
+        let cells = Cells::new(mu_i, mu_o);
+        for ch in 0..N {
+            out[ch] = if ch > 0 && alpha[ch].to_bits() == alpha[ch - 1].to_bits() {
+                out[ch - 1]
+            } else if alpha[ch].is_finite() {
+                self.at(&cells, alpha[ch])
+            } else {
+                1.0
+            };
+        }
+        out
+    }
+
+    /// T at a finite `alpha` and the cosines' `cells`.
+    fn at(&self, cells: &Cells, alpha: f64) -> f64 {
+        let (r0, fr) = row_position(alpha, N_ALBEDO);
+        let row = |r: usize| {
+            let m = &self.t[r * N_MU * N_MU..(r + 1) * N_MU * N_MU];
+            cells.eval(|j, k| f64::from(m[j * N_MU + k]))
         };
-        let pos = |mu: f64| {
-            let x = (mu.clamp(0.0, 1.0).powi(2) * N_MU as f64 - 0.5).clamp(0.0, (N_MU - 1) as f64);
-            let i = (x as usize).min(N_MU - 2);
+        let v = if fr == 0.0 {
+            row(r0)
+        } else {
+            (1.0 - fr) * row(r0) + fr * row(r0 + 1)
+        };
+        v.max(0.0)
+    }
+}
+
+/// Where two cosines fall on the bins' centres in μ² (ordered, so that what is evaluated from
+/// them is symmetric bit for bit): the lower cell index and the weight of the next, per
+/// cosine, the weight in [−½, 3/2] over the outer half bins (linear extrapolation).
+#[derive(Clone, Copy)]
+struct Cells {
+    j: usize,
+    fj: f64,
+    k: usize,
+    fk: f64,
+}
+
+impl Cells {
+    fn new(mu_a: f64, mu_b: f64) -> Self {
+        let (a, b) = if mu_a <= mu_b {
+            (mu_a, mu_b)
+        } else {
+            (mu_b, mu_a)
+        };
+        let cell = |mu: f64| {
+            let x = mu.clamp(0.0, 1.0).powi(2) * N_MU as f64 - 0.5;
+            let i = (x.max(0.0) as usize).min(N_MU - 2);
             (i, x - i as f64)
         };
-        let ((j0, fj), (k0, fk)) = (pos(a), pos(b));
-        let (r0, fr) = row_position(alpha, N_ALBEDO);
-        let mut v = 0.0;
-        for (dr, wr) in [(0, 1.0 - fr), (1, fr)] {
-            for (dj, wj) in [(0, 1.0 - fj), (1, fj)] {
-                for (dk, wk) in [(0, 1.0 - fk), (1, fk)] {
-                    let w = wr * wj * wk;
-                    if w != 0.0 {
-                        let at = ((r0 + dr) * N_MU + j0 + dj) * N_MU + k0 + dk;
-                        v += w * f64::from(self.t[at]);
-                    }
-                }
-            }
-        }
-        v.max(0.0)
+        let ((j, fj), (k, fk)) = (cell(a), cell(b));
+        Self { j, fj, k, fk }
+    }
+
+    /// The matrix `m(j, k)` (values at the bins' centres) interpolated at the two cosines.
+    #[inline]
+    fn eval(&self, m: impl Fn(usize, usize) -> f64) -> f64 {
+        let Self { j, fj, k, fk } = *self;
+        (1.0 - fj) * ((1.0 - fk) * m(j, k) + fk * m(j, k + 1))
+            + fj * ((1.0 - fk) * m(j + 1, k) + fk * m(j + 1, k + 1))
     }
 }
 

@@ -23,7 +23,7 @@
 //! incidence bin `i mod N_MU`, and chunks are merged in order, so the file is bit-identical for
 //! a given seed and photon count whatever the number of threads.
 
-use super::file::{Reader, TableFileError, all_valid, mean_se, put_f32s, put_f64s};
+use super::file::{Header, Reader, TableFileError, all_valid, mean_se, put_f32s};
 use super::grid::{N_ALBEDO, albedo_of_row};
 use super::simulate::{Face, Stream, in_chunks, trace_from};
 use crate::fresnel::dielectric;
@@ -73,6 +73,18 @@ pub struct AngularData {
     pub photons: u64,
     /// One plane per entry of [`ANGULAR_ETAS`].
     pub planes: Vec<AngularPlane>,
+}
+
+/// The coupling file's header for a grid of `dims` (planes, rows, bins) and η planes `etas`.
+fn header<'a>(dims: &'a [usize], etas: &'a [f64]) -> Header<'a> {
+    Header {
+        magic: MAGIC,
+        version: VERSION,
+        not_this_kind: "not an angular coupling file (bad magic)",
+        dims,
+        axes: etas,
+        axes_differ: "refractive indices differ from this crate's",
+    }
 }
 
 /// The bin of external cosine `mu` (μ² · [`N_MU`], clamped).
@@ -194,14 +206,8 @@ impl AngularData {
     /// Serialises the data (see the module docs).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
-        b.extend_from_slice(MAGIC);
-        b.extend_from_slice(&VERSION.to_le_bytes());
-        b.extend_from_slice(&self.seed.to_le_bytes());
-        b.extend_from_slice(&self.photons.to_le_bytes());
-        for v in [self.planes.len(), N_ALBEDO, N_MU] {
-            b.extend_from_slice(&(v as u32).to_le_bytes());
-        }
-        put_f64s(&mut b, self.planes.iter().map(|p| &p.eta));
+        let etas: Vec<f64> = self.planes.iter().map(|p| p.eta).collect();
+        header(&[self.planes.len(), N_ALBEDO, N_MU], &etas).put(&mut b, self.seed, self.photons);
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
             put_f32s(&mut b, p.p.iter().chain(&p.p_se));
@@ -212,25 +218,10 @@ impl AngularData {
     /// Parses data written by [`AngularData::to_bytes`] with this crate's grid.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, TableFileError> {
         let mut r = Reader(bytes);
-        if r.take(8)? != MAGIC {
-            return Err(TableFileError("not an angular coupling file (bad magic)"));
-        }
-        if r.u32()? != VERSION {
-            return Err(TableFileError("unsupported version"));
-        }
-        let (seed, photons) = (r.u64()?, r.u64()?);
-        let (planes, rows, bins) = (r.u32()? as usize, r.u32()? as usize, r.u32()? as usize);
-        if planes != ANGULAR_ETAS.len() || rows != N_ALBEDO || bins != N_MU {
-            return Err(TableFileError("grid differs from this crate's"));
-        }
-        let etas = r.f64s(planes)?;
-        if etas.iter().zip(ANGULAR_ETAS).any(|(a, b)| *a != b) {
-            return Err(TableFileError(
-                "refractive indices differ from this crate's",
-            ));
-        }
-        let mut out = Vec::with_capacity(planes);
-        for eta in etas {
+        let (seed, photons) =
+            header(&[ANGULAR_ETAS.len(), N_ALBEDO, N_MU], &ANGULAR_ETAS).read(&mut r)?;
+        let mut out = Vec::with_capacity(ANGULAR_ETAS.len());
+        for eta in ANGULAR_ETAS {
             let capped = r.u64()?;
             let p = r.f32s(PLANE_LEN)?;
             let p_se = r.f32s(PLANE_LEN)?;

@@ -127,6 +127,59 @@ pub(crate) fn densities(sum: &[f64], sum2: &[f64], n: f64) -> (Vec<f32>, Vec<f32
         .unzip()
 }
 
+/// The header every table file of this crate starts with: what it is and the grid it was made
+/// on, so that a file from another grid is an error and not a misread.
+pub(crate) struct Header<'a> {
+    /// Eight bytes naming the kind of table.
+    pub(crate) magic: &'a [u8; 8],
+    /// The format version.
+    pub(crate) version: u32,
+    /// The error for a file of another kind.
+    pub(crate) not_this_kind: &'static str,
+    /// The grid's dimensions (written as u32 each).
+    pub(crate) dims: &'a [usize],
+    /// The grid's axis values (η planes, thicknesses; f64 each).
+    pub(crate) axes: &'a [f64],
+    /// The error for a file whose axis values differ.
+    pub(crate) axes_differ: &'static str,
+}
+
+impl Header<'_> {
+    /// Appends magic, version, `seed`, `photons`, the dimensions and the axis values.
+    pub(crate) fn put(&self, b: &mut Vec<u8>, seed: u64, photons: u64) {
+        b.extend_from_slice(self.magic);
+        b.extend_from_slice(&self.version.to_le_bytes());
+        b.extend_from_slice(&seed.to_le_bytes());
+        b.extend_from_slice(&photons.to_le_bytes());
+        for &v in self.dims {
+            b.extend_from_slice(&(v as u32).to_le_bytes());
+        }
+        put_f64s(b, self.axes);
+    }
+
+    /// Reads and checks what [`Header::put`] wrote; returns (seed, photons).
+    pub(crate) fn read(&self, r: &mut Reader<'_>) -> Result<(u64, u64), TableFileError> {
+        if r.take(8)? != self.magic {
+            return Err(TableFileError(self.not_this_kind));
+        }
+        if r.u32()? != self.version {
+            return Err(TableFileError("unsupported version"));
+        }
+        let (seed, photons) = (r.u64()?, r.u64()?);
+        for &want in self.dims {
+            if r.u32()? as usize != want {
+                return Err(TableFileError("grid differs from this crate's"));
+            }
+        }
+        for &want in self.axes {
+            if r.f64()? != want {
+                return Err(TableFileError(self.axes_differ));
+            }
+        }
+        Ok((seed, photons))
+    }
+}
+
 /// Appends `values` little-endian.
 pub(crate) fn put_f64s<'a>(b: &mut Vec<u8>, values: impl IntoIterator<Item = &'a f64>) {
     for v in values {
@@ -155,14 +208,8 @@ impl TableData {
     /// Serialises the table (see the module docs).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
-        b.extend_from_slice(MAGIC);
-        b.extend_from_slice(&VERSION.to_le_bytes());
-        b.extend_from_slice(&self.seed.to_le_bytes());
-        b.extend_from_slice(&self.photons.to_le_bytes());
-        for v in [self.planes.len(), N_ALBEDO, N_BINS] {
-            b.extend_from_slice(&(v as u32).to_le_bytes());
-        }
-        put_f64s(&mut b, self.planes.iter().map(|p| &p.eta));
+        let etas: Vec<f64> = self.planes.iter().map(|p| p.eta).collect();
+        header(&[self.planes.len(), N_ALBEDO, N_BINS], &etas).put(&mut b, self.seed, self.photons);
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
             put_f32s(&mut b, p.density.iter().chain(&p.density_se));
@@ -174,26 +221,10 @@ impl TableData {
     /// Parses a table written by [`TableData::to_bytes`] with this crate's grid.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, TableFileError> {
         let mut r = Reader(bytes);
-        if r.take(8)? != MAGIC {
-            return Err(TableFileError("not a table file (bad magic)"));
-        }
-        if r.u32()? != VERSION {
-            return Err(TableFileError("unsupported version"));
-        }
-        let (seed, photons) = (r.u64()?, r.u64()?);
-        let (planes, rows, bins) = (r.u32()? as usize, r.u32()? as usize, r.u32()? as usize);
-        if planes != ETAS.len() || rows != N_ALBEDO || bins != N_BINS {
-            return Err(TableFileError("grid differs from this crate's"));
-        }
-        let etas = r.f64s(planes)?;
-        if etas.iter().zip(ETAS).any(|(a, b)| *a != b) {
-            return Err(TableFileError(
-                "refractive indices differ from this crate's",
-            ));
-        }
+        let (seed, photons) = header(&[ETAS.len(), N_ALBEDO, N_BINS], &ETAS).read(&mut r)?;
         let n = 2 * N_ALBEDO * N_BINS;
-        let mut out = Vec::with_capacity(planes);
-        for eta in etas {
+        let mut out = Vec::with_capacity(ETAS.len());
+        for eta in ETAS {
             let capped = r.u64()?;
             let density = r.f32s(n)?;
             let density_se = r.f32s(n)?;
@@ -221,6 +252,19 @@ impl TableData {
             photons,
             planes: out,
         })
+    }
+}
+
+/// The half-space table's header for a grid of `dims` (planes, rows, bins) and η planes
+/// `etas`.
+fn header<'a>(dims: &'a [usize], etas: &'a [f64]) -> Header<'a> {
+    Header {
+        magic: MAGIC,
+        version: VERSION,
+        not_this_kind: "not a table file (bad magic)",
+        dims,
+        axes: etas,
+        axes_differ: "refractive indices differ from this crate's",
     }
 }
 

@@ -26,7 +26,8 @@
 //! bin.
 
 use super::file::{
-    Reader, TableFileError, all_valid, densities, mean_se, pool_sparse_bins, put_f32s, put_f64s,
+    Header, Reader, TableFileError, all_valid, densities, mean_se, pool_sparse_bins, put_f32s,
+    put_f64s,
 };
 use super::grid::{N_BINS, bin_of};
 use super::simulate::{ExitSums, Face, Stream, in_chunks, trace};
@@ -226,14 +227,8 @@ impl SlabData {
     /// Serialises the table (see the module docs).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
-        b.extend_from_slice(MAGIC);
-        b.extend_from_slice(&SLAB_VERSION.to_le_bytes());
-        b.extend_from_slice(&self.seed.to_le_bytes());
-        b.extend_from_slice(&self.photons.to_le_bytes());
-        for v in [SLAB_THICKNESSES.len(), SLAB_ETAS.len(), SLAB_ROWS, N_BINS] {
-            b.extend_from_slice(&(v as u32).to_le_bytes());
-        }
-        put_f64s(&mut b, SLAB_THICKNESSES.iter().chain(&SLAB_ETAS));
+        let axes = slab_axes();
+        slab_header(&axes).put(&mut b, self.seed, self.photons);
         for p in &self.planes {
             b.extend_from_slice(&p.capped.to_le_bytes());
             b.extend_from_slice(&p.mean_events.to_le_bytes());
@@ -248,24 +243,8 @@ impl SlabData {
     /// Parses a table written by [`SlabData::to_bytes`] with this crate's grid.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self, TableFileError> {
         let mut r = Reader(bytes);
-        if r.take(8)? != MAGIC {
-            return Err(TableFileError("not a slab table file (bad magic)"));
-        }
-        if r.u32()? != SLAB_VERSION {
-            return Err(TableFileError("unsupported version"));
-        }
-        let (seed, photons) = (r.u64()?, r.u64()?);
-        let dims = [r.u32()?, r.u32()?, r.u32()?, r.u32()?].map(|v| v as usize);
-        if dims != [SLAB_THICKNESSES.len(), SLAB_ETAS.len(), SLAB_ROWS, N_BINS] {
-            return Err(TableFileError("grid differs from this crate's"));
-        }
-        for want in SLAB_THICKNESSES.iter().chain(&SLAB_ETAS) {
-            if r.f64()? != *want {
-                return Err(TableFileError(
-                    "thicknesses or refractive indices differ from this crate's",
-                ));
-            }
-        }
+        let axes = slab_axes();
+        let (seed, photons) = slab_header(&axes).read(&mut r)?;
         let mut planes = Vec::with_capacity(SLAB_THICKNESSES.len() * SLAB_ETAS.len());
         for &thickness in &SLAB_THICKNESSES {
             for &eta in &SLAB_ETAS {
@@ -368,5 +347,25 @@ pub fn tabulate_slab(
         seed,
         photons,
         planes,
+    }
+}
+
+/// The slab table's axis values: its thicknesses, then its η planes.
+fn slab_axes() -> Vec<f64> {
+    SLAB_THICKNESSES.iter().chain(&SLAB_ETAS).copied().collect()
+}
+
+/// The slab table's grid dimensions: thicknesses, η planes, albedo rows, radial bins.
+const SLAB_DIMS: [usize; 4] = [SLAB_THICKNESSES.len(), SLAB_ETAS.len(), SLAB_ROWS, N_BINS];
+
+/// The slab table's header (`axes` from [`slab_axes`]).
+fn slab_header(axes: &[f64]) -> Header<'_> {
+    Header {
+        magic: MAGIC,
+        version: SLAB_VERSION,
+        not_this_kind: "not a slab table file (bad magic)",
+        dims: &SLAB_DIMS,
+        axes,
+        axes_differ: "thicknesses or refractive indices differ from this crate's",
     }
 }

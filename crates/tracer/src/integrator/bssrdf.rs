@@ -17,6 +17,13 @@
 //! the same rule ([`facing_normal`]), and the product of the two Fresnel factors is formed
 //! before it meets the profile, so the swap gives the same value bit for bit.
 //!
+//! Angular coupling ([`BssrdfObject::coupling`], docs/tabulated-profile.md "Angular
+//! coupling"): with the tabulated profile (unless the material sets `angular_coupling =
+//! false`), S is also multiplied by T(α', cos θ_i, cos θ_o), the exact half-space response per
+//! pair of directions over the separable one, per channel at the pair's reduced albedo. T is
+//! symmetric in its two cosines bit for bit, so reciprocity holds as above. Pairs weighed by
+//! the slab profile's transmission keep T = 1.
+//!
 //! Thin parts ([`BssrdfObject::profile`], docs/shapes.md "Thin parts: the slab profile"):
 //! with the tabulated profile, |g| ≤ [`SLAB_MAX_G`] and a material that is `thickness_aware`
 //! (the default), a pair
@@ -187,15 +194,13 @@ impl BssrdfObject {
             return Rgb::splat(1.0);
         };
         let g = self.family.g();
-        let mut out = Rgb::splat(1.0);
-        for ch in 0..3 {
+        // Reduced albedo per channel; a channel without extinction gets NaN, hence T = 1.
+        let alpha = std::array::from_fn(|ch| {
             let sp = (1.0 - g) * w.coeffs.sigma_s[ch];
             let tp = w.coeffs.sigma_a[ch] + sp;
-            if tp > 0.0 {
-                out[ch] = t.factor(sp / tp, cos_i, cos_o);
-            }
-        }
-        out
+            if tp > 0.0 { sp / tp } else { f64::NAN }
+        });
+        Rgb(t.factors(alpha, cos_i, cos_o))
     }
 
     /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium

@@ -962,8 +962,9 @@ impl<'s> PathIntegrator<'s> {
     /// probe rays ([`super::probe`]), and at each of them the estimated homogeneous
     /// coefficients, the profile at r = |x_i − x_o|, and irradiance through pbrt-v4's
     /// normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
-    /// (pbrt-v4 §11.4, `NormalizedFresnelBxDF`). The path continues from one of the x_i with a
-    /// cosine-sampled direction.
+    /// (pbrt-v4 §11.4, `NormalizedFresnelBxDF`), times the tabulated profile's angular
+    /// coupling where it applies ([`BssrdfObject::coupling`]). The path continues from one of
+    /// the x_i with a cosine-sampled direction.
     #[allow(clippy::too_many_arguments)]
     fn subsurface(
         &self,
