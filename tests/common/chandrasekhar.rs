@@ -43,21 +43,21 @@ pub fn h(omega: f64, mu: f64) -> f64 {
 /// quadrature sum.
 pub fn h_function(omega: f64) -> impl Fn(f64) -> f64 {
     let (x, w) = gauss_legendre(200);
+    let nodes = x.clone();
     let s = (1.0 - omega).sqrt();
-    let mut hk = vec![1.0; x.len()];
-    for _ in 0..10_000 {
-        let next: Vec<f64> = x
+    // The right-hand side 1/(√(1−ϖ) + (ϖ/2) ∫ μ' H(μ') / (μ + μ') dμ') for the nodal values `hk`.
+    let rhs = move |mu: f64, hk: &[f64]| -> f64 {
+        let integral: f64 = x
             .iter()
-            .map(|&m| {
-                let integral: f64 = x
-                    .iter()
-                    .zip(&w)
-                    .zip(&hk)
-                    .map(|((&mj, &wj), &hj)| wj * mj * hj / (m + mj))
-                    .sum();
-                1.0 / (s + 0.5 * omega * integral)
-            })
-            .collect();
+            .zip(&w)
+            .zip(hk)
+            .map(|((&mj, &wj), &hj)| wj * mj * hj / (mu + mj))
+            .sum();
+        1.0 / (s + 0.5 * omega * integral)
+    };
+    let mut hk = vec![1.0; nodes.len()];
+    for _ in 0..10_000 {
+        let next: Vec<f64> = nodes.iter().map(|&m| rhs(m, &hk)).collect();
         let diff = next
             .iter()
             .zip(&hk)
@@ -68,15 +68,7 @@ pub fn h_function(omega: f64) -> impl Fn(f64) -> f64 {
             break;
         }
     }
-    move |mu: f64| {
-        let integral: f64 = x
-            .iter()
-            .zip(&w)
-            .zip(&hk)
-            .map(|((&mj, &wj), &hj)| wj * mj * hj / (mu + mj))
-            .sum();
-        1.0 / (s + 0.5 * omega * integral)
-    }
+    move |mu: f64| rhs(mu, &hk)
 }
 
 /// Plane albedo of an isotropic, index-matched half-space at normal incidence.
