@@ -425,33 +425,40 @@ fn deferring_unlit_carriers_weights_leaves_the_image_unchanged_in_expectation() 
         min = [-60.0, -60.0, -3.0]
         max = [60.0, 60.0, -2.0]
     "#;
-    let scene = Scene::from_toml_str(toml, std::path::Path::new("."), "deferred").unwrap();
-    let options = PathOptions {
-        scattering: Scattering::Multiple,
-        max_depth: 8,
-    };
-    let method: Method = "sone".parse().unwrap();
-    let (spp, seeds) = (16, 12u64);
-    let run = |defer: bool| {
-        let integrator = PathIntegrator::new(&scene, method, options)
-            .unwrap()
-            .with_deferred_weights(defer);
-        let (m, se, counters) = image_mean_and_se(&integrator, spp, seeds);
-        (m[0], se[0], counters.estimates)
-    };
-    let (m_eager, se_eager, est_eager) = run(false);
-    let (m_defer, se_defer, est_defer) = run(true);
-    let se = (se_eager * se_eager + se_defer * se_defer).sqrt();
-    assert!(
-        m_eager > 0.0 && se < 0.03 * m_eager,
-        "test too weak: {m_eager} ± {se}"
-    );
-    assert!(
-        (m_defer - m_eager).abs() < 4.0 * se,
-        "deferred {m_defer} ± {se_defer}, eager {m_eager} ± {se_eager}"
-    );
-    assert!(
-        est_defer * 10 < est_eager * 9,
-        "deferring skipped too few estimates: {est_defer} of {est_eager}"
-    );
+    // The dipole, and the tabulated profile, whose angular coupling a deferred weight applies
+    // when it is settled. (Settling with the normal's cosine instead of the continuation's
+    // moves this image by about 1 %, 0.8 SE here: below what the test resolves.)
+    for profile in ["dipole", "tabulated"] {
+        let toml = toml.replace(r#"profile = "dipole""#, &format!("profile = \"{profile}\""));
+        let scene = Scene::from_toml_str(&toml, std::path::Path::new("."), "deferred").unwrap();
+        let options = PathOptions {
+            scattering: Scattering::Multiple,
+            max_depth: 8,
+        };
+        let method: Method = "sone".parse().unwrap();
+        let (spp, seeds) = (16, 12u64);
+        let run = |defer: bool| {
+            let integrator = PathIntegrator::new(&scene, method, options)
+                .unwrap()
+                .with_deferred_weights(defer);
+            let (m, se, counters) = image_mean_and_se(&integrator, spp, seeds);
+            (m[0], se[0], counters.estimates)
+        };
+        let (m_eager, se_eager, est_eager) = run(false);
+        let (m_defer, se_defer, est_defer) = run(true);
+        let se = (se_eager * se_eager + se_defer * se_defer).sqrt();
+        eprintln!("{profile}: deferred {m_defer} ± {se_defer}, eager {m_eager} ± {se_eager}");
+        assert!(
+            m_eager > 0.0 && se < 0.03 * m_eager,
+            "{profile}: test too weak: {m_eager} ± {se}"
+        );
+        assert!(
+            (m_defer - m_eager).abs() < 4.0 * se,
+            "{profile}: deferred {m_defer} ± {se_defer}, eager {m_eager} ± {se_eager}"
+        );
+        assert!(
+            est_defer * 10 < est_eager * 9,
+            "{profile}: deferring skipped too few estimates: {est_defer} of {est_eager}"
+        );
+    }
 }
