@@ -235,25 +235,8 @@ fn angular_coupling_data_matches_chandrasekhar_at_eta_one() {
     use bssrdf_core::tabulated::angular::angular_data;
     use bssrdf_core::tabulated::angular_file::{N_MU, index};
 
-    use crate::common::chandrasekhar::{gauss_legendre, h_function};
-
     let plane = &angular_data().planes[0];
     assert_eq!(plane.eta, 1.0);
-    // Gauss–Legendre in μ over each bin (d(μ²) = 2μ dμ keeps the integrand smooth).
-    let (x, w) = gauss_legendre(12);
-    let nodes = |j: usize| -> Vec<(f64, f64)> {
-        let (a, b) = (
-            (j as f64 / N_MU as f64).sqrt(),
-            ((j + 1) as f64 / N_MU as f64).sqrt(),
-        );
-        x.iter()
-            .zip(&w)
-            .map(|(&t, &wt)| {
-                let mu = a + (b - a) * t;
-                (mu, wt * (b - a) * 2.0 * mu)
-            })
-            .collect()
-    };
     let mut checked = 0;
     let mut worst: f64 = 0.0;
     for row in 0..N_ALBEDO {
@@ -261,17 +244,10 @@ fn angular_coupling_data_matches_chandrasekhar_at_eta_one() {
         if !(0.3..=0.999).contains(&alpha) {
             continue;
         }
-        let h = h_function(alpha);
+        let exact = ExactPairs::new(alpha);
         for j in 0..N_MU {
             for k in 0..N_MU {
-                let (mut all, mut single) = (0.0, 0.0);
-                for &(mu0, w0) in &nodes(j) {
-                    for &(mu, wk) in &nodes(k) {
-                        let s = alpha / (4.0 * (mu + mu0)) * w0 * wk * N_MU as f64;
-                        single += s;
-                        all += s * h(mu) * h(mu0);
-                    }
-                }
+                let (all, single) = exact.at(j, k);
                 let (ss, ms) = (index(0, row, j, k), index(1, row, j, k));
                 let got_ss = f64::from(plane.p[ss]);
                 let se_ss = f64::from(plane.p_se[ss]);
@@ -294,6 +270,128 @@ fn angular_coupling_data_matches_chandrasekhar_at_eta_one() {
         "only {checked} bin pairs checked"
     );
     eprintln!("angular coupling at η = 1: {checked} bin pairs, largest |z| {worst:.2}");
+}
+
+/// Chandrasekhar's bin-pair fractions at η = 1 for one albedo (see
+/// `angular_coupling_data_matches_chandrasekhar_at_eta_one`): per pair (j, k) of the coupling's
+/// cosine bins, all orders and single scattering.
+struct ExactPairs {
+    /// `[j·N + k]`: (all orders, single scattering).
+    p: Vec<(f64, f64)>,
+}
+
+impl ExactPairs {
+    fn new(alpha: f64) -> Self {
+        use bssrdf_core::tabulated::angular_file::N_MU;
+
+        use crate::common::chandrasekhar::{gauss_legendre, h_function};
+
+        // Gauss–Legendre in μ over each bin (d(μ²) = 2μ dμ keeps the integrand smooth).
+        let (x, w) = gauss_legendre(12);
+        let nodes = |j: usize| -> Vec<(f64, f64)> {
+            let (a, b) = (
+                (j as f64 / N_MU as f64).sqrt(),
+                ((j + 1) as f64 / N_MU as f64).sqrt(),
+            );
+            x.iter()
+                .zip(&w)
+                .map(|(&t, &wt)| {
+                    let mu = a + (b - a) * t;
+                    (mu, wt * (b - a) * 2.0 * mu)
+                })
+                .collect()
+        };
+        let h = h_function(alpha);
+        let mut p = Vec::with_capacity(N_MU * N_MU);
+        for j in 0..N_MU {
+            for k in 0..N_MU {
+                let (mut all, mut single) = (0.0, 0.0);
+                for &(mu0, w0) in &nodes(j) {
+                    for &(mu, wk) in &nodes(k) {
+                        let s = alpha / (4.0 * (mu + mu0)) * w0 * wk * N_MU as f64;
+                        single += s;
+                        all += s * h(mu) * h(mu0);
+                    }
+                }
+                p.push((all, single));
+            }
+        }
+        Self { p }
+    }
+
+    /// (all orders, single scattering) of bins (`j`, `k`).
+    fn at(&self, j: usize, k: usize) -> (f64, f64) {
+        self.p[j * bssrdf_core::tabulated::angular_file::N_MU + k]
+    }
+}
+
+/// The coupling as the renderer reads it (`AngularCoupling::factor`: symmetrised, normalised,
+/// interpolated) against Chandrasekhar at η = 1, where the separable lobes are uniform
+/// (c = 1, no Fresnel): at the bins' centres, T(j, k) / T(N−1, N−1) must equal the exact
+/// P_jk / P_(N−1)(N−1), the normalisation cancelling; for all orders and for multiple
+/// scattering alone (all − single), at every albedo row from 0.3 to 0.999, within 5 standard
+/// errors of the data. The exact ratios span more than 25 % at α = 0.9, so a coupling of ones
+/// fails.
+#[test]
+fn angular_coupling_as_read_matches_chandrasekhar_at_eta_one() {
+    use bssrdf_core::tabulated::AngularCoupling;
+    use bssrdf_core::tabulated::angular::angular_data;
+    use bssrdf_core::tabulated::angular_file::{N_MU, index};
+
+    let plane = &angular_data().planes[0];
+    let top = N_MU - 1;
+    let centre = |j: usize| ((j as f64 + 0.5) / N_MU as f64).sqrt();
+    let mut worst: f64 = 0.0;
+    let mut spread: f64 = 0.0;
+    for (single, kinds) in [(true, &[0, 1][..]), (false, &[1][..])] {
+        let coupling = AngularCoupling::new(1.0, single, true).unwrap();
+        for row in 0..N_ALBEDO {
+            let alpha = albedo_of_row(row);
+            if !(0.3..=0.999).contains(&alpha) {
+                continue;
+            }
+            let exact = ExactPairs::new(alpha);
+            let exact_at = |j, k| {
+                let (all, ss) = exact.at(j, k);
+                if single { all } else { all - ss }
+            };
+            // The data's value and variance of a symmetrised pair.
+            let data = |j: usize, k: usize| -> (f64, f64) {
+                let cell = |a, b| -> (f64, f64) {
+                    kinds.iter().fold((0.0, 0.0), |(v, var), &kind| {
+                        let i = index(kind, row, a, b);
+                        let se = f64::from(plane.p_se[i]);
+                        (v + f64::from(plane.p[i]), var + se * se)
+                    })
+                };
+                let ((v1, s1), (v2, s2)) = (cell(j, k), cell(k, j));
+                (0.5 * (v1 + v2), 0.25 * (s1 + s2))
+            };
+            let t_top = coupling.factor(alpha, centre(top), centre(top));
+            let (d_top, var_top) = data(top, top);
+            for j in 0..N_MU {
+                for k in j..N_MU {
+                    let got = coupling.factor(alpha, centre(j), centre(k)) / t_top;
+                    let want = exact_at(j, k) / exact_at(top, top);
+                    let (d, var) = data(j, k);
+                    let rel_se = (var / (d * d) + var_top / (d_top * d_top)).sqrt();
+                    let z = (got / want - 1.0).abs() / rel_se;
+                    worst = worst.max(z);
+                    spread = spread.max((want - 1.0).abs());
+                    assert!(
+                        z < 5.0,
+                        "α {alpha:.5}, single {single}, bins ({j}, {k}): T ratio {got:.4}, \
+                         exact {want:.4} (z {z:.2})"
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        spread > 0.25,
+        "the exact ratios barely vary ({spread}): the test is weak"
+    );
+    eprintln!("angular coupling as read at η = 1: largest |z| {worst:.2}");
 }
 
 /// Reciprocity in the angular coupling's raw data at η ≠ 1 (refraction and Fresnel both

@@ -144,14 +144,14 @@ impl ProfileFamily {
     /// profile. Cost: a few ns, no allocation.
     pub fn profile(&self, sigma_a: f64, sigma_s: f64) -> Result<Profile, ParamError> {
         let (sigma_a, sigma_s) = validate_sigmas(sigma_a, sigma_s)?;
-        let sigma_sp = (1.0 - self.g) * sigma_s;
-        let sigma_tp = sigma_a + sigma_sp;
+        let Reduced {
+            sigma_tp,
+            albedo: reduced_albedo,
+        } = self.reduced(sigma_a, sigma_s);
         let sigma_t = sigma_a + sigma_s;
-        let multiple = if self.scattering.includes_multiple()
-            && sigma_sp >= SIGMA_EPSILON
-            && sigma_tp >= SIGMA_EPSILON
+        let multiple = if let Some(alpha_p) =
+            reduced_albedo.filter(|_| self.scattering.includes_multiple())
         {
-            let alpha_p = sigma_sp / sigma_tp;
             Some(match self.model {
                 ProfileModel::Dipole => {
                     MultipleTerm::Dipole(Dipole::new(alpha_p, sigma_tp, self.a_dipole))
@@ -166,13 +166,11 @@ impl ProfileFamily {
                     return Ok(self.tabulated(alpha_p, sigma_tp));
                 }
             })
-        } else if self.model == ProfileModel::Tabulated
-            && self.scattering.includes_single()
-            && sigma_sp >= SIGMA_EPSILON
-            && sigma_tp >= SIGMA_EPSILON
+        } else if let Some(alpha_p) = reduced_albedo
+            .filter(|_| self.model == ProfileModel::Tabulated && self.scattering.includes_single())
         {
             // Single scattering only: the table holds it too.
-            return Ok(self.tabulated(sigma_sp / sigma_tp, sigma_tp));
+            return Ok(self.tabulated(alpha_p, sigma_tp));
         } else {
             None
         };
@@ -184,7 +182,34 @@ impl ProfileFamily {
     }
 }
 
+/// The reduced extinction of a medium under similarity theory, σt' = σa + σs' with σs' =
+/// (1 − g) σs (1/length), and its reduced albedo α' = σs'/σt', `None` unless both σs' and σt'
+/// reach [`SIGMA_EPSILON`] (the profiles treat such a medium as not scattering).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Reduced {
+    pub(crate) sigma_tp: f64,
+    pub(crate) albedo: Option<f64>,
+}
+
 impl ProfileFamily {
+    /// The reduced coefficients of validated `sigma_a`, `sigma_s` with this family's g: what
+    /// every radial and slab profile of the family is evaluated at.
+    pub(crate) fn reduced(&self, sigma_a: f64, sigma_s: f64) -> Reduced {
+        let sigma_sp = (1.0 - self.g) * sigma_s;
+        let sigma_tp = sigma_a + sigma_sp;
+        let albedo =
+            (sigma_sp >= SIGMA_EPSILON && sigma_tp >= SIGMA_EPSILON).then(|| sigma_sp / sigma_tp);
+        Reduced { sigma_tp, albedo }
+    }
+
+    /// The reduced albedo α' = σs'/σt' (similarity theory with this family's g) at which the
+    /// family's profiles read their tables, for absorption `sigma_a` and scattering `sigma_s`
+    /// (validated as [`ProfileFamily::profile`]); `Ok(None)` for a medium that does not scatter.
+    pub fn reduced_albedo(&self, sigma_a: f64, sigma_s: f64) -> Result<Option<f64>, ParamError> {
+        let (sigma_a, sigma_s) = validate_sigmas(sigma_a, sigma_s)?;
+        Ok(self.reduced(sigma_a, sigma_s).albedo)
+    }
+
     /// The tabulated profile at reduced albedo `alpha_p` and extinction `sigma_tp` (similarity
     /// theory for g ≠ 0, an approximation), counting the orders the family selects, both
     /// from the table.

@@ -3,7 +3,7 @@
 //! docs/shapes.md, "Thin parts: the slab profile"), for renderers that measure how thick an
 //! object is around a pair of points.
 
-use crate::error::{ParamError, SIGMA_EPSILON, validate_sigmas};
+use crate::error::{ParamError, validate_sigmas};
 use crate::family::ProfileFamily;
 use crate::model::ProfileModel;
 use crate::profile::RadialProfile;
@@ -74,14 +74,16 @@ impl ProfileFamily {
         if self.model() != ProfileModel::Tabulated {
             return Ok(None);
         }
-        let sigma_sp = (1.0 - self.g()) * sigma_s;
-        let sigma_tp = sigma_a + sigma_sp;
-        let scatters = sigma_sp >= SIGMA_EPSILON && sigma_tp >= SIGMA_EPSILON;
-        let alpha_p = if scatters { sigma_sp / sigma_tp } else { 0.0 };
-        let multiple = (scatters && self.scattering().includes_multiple())
-            .then(|| SlabTerm::new(sigma_tp, alpha_p, self.eta(), thickness));
-        let single = (scatters && self.scattering().includes_single())
-            .then(|| TabulatedTerm::new(sigma_tp, alpha_p, self.eta(), true, false));
+        let reduced = self.reduced(sigma_a, sigma_s);
+        let sigma_tp = reduced.sigma_tp;
+        let multiple = reduced
+            .albedo
+            .filter(|_| self.scattering().includes_multiple())
+            .map(|alpha_p| SlabTerm::new(sigma_tp, alpha_p, self.eta(), thickness));
+        let single = reduced
+            .albedo
+            .filter(|_| self.scattering().includes_single())
+            .map(|alpha_p| TabulatedTerm::new(sigma_tp, alpha_p, self.eta(), true, false));
         Ok(Some(SlabProfile { multiple, single }))
     }
 }

@@ -25,7 +25,7 @@
 
 use super::file::{Header, Reader, TableFileError, all_valid, mean_se, put_f32s};
 use super::grid::{N_ALBEDO, albedo_of_row};
-use super::simulate::{Face, Stream, in_chunks, trace_from};
+use super::simulate::{Face, Stream, add_into, for_each_row_weight, in_chunks, trace_from};
 use crate::fresnel::dielectric;
 
 /// Bins of external cosine, equal in μ² (equal projected solid angle), for incidence and exit.
@@ -128,15 +128,11 @@ fn chunk(eta: f64, plane: u64, seed: u64, start: u64, count: u64, ln_alpha: &[f6
                 let sin_o = eta * (1.0 - cos_in * cos_in).max(0.0).sqrt();
                 let mu_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
                 let (kind, k) = (usize::from(n >= 2), mu_bin(mu_o));
-                for (row, la) in ln_alpha.iter().enumerate() {
-                    let w = w0 * (f64::from(n) * la).exp();
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let at = index(kind, row, j, k);
+                for_each_row_weight(ln_alpha, n, |row, w| {
+                    let (at, w) = (index(kind, row, j, k), w0 * w);
                     s.sum[at] += w;
                     s.sum2[at] += w * w;
-                }
+                });
             },
         );
         s.capped += u64::from(!ok);
@@ -156,12 +152,8 @@ pub fn simulate_plane(plane: usize, seed: u64, photons: u64, threads: usize) -> 
     for c in in_chunks(total, threads, |start, count| {
         chunk(eta, plane as u64, seed, start, count, &ln_alpha)
     }) {
-        for (a, b) in sum.iter_mut().zip(&c.sum) {
-            *a += b;
-        }
-        for (a, b) in sum2.iter_mut().zip(&c.sum2) {
-            *a += b;
-        }
+        add_into(&mut sum, &c.sum);
+        add_into(&mut sum2, &c.sum2);
         capped += c.capped;
     }
     let n = photons as f64;

@@ -62,17 +62,29 @@ impl Tally {
     fn merge(&mut self, o: &Tally) {
         self.photons += o.photons;
         self.capped += o.capped;
-        for (a, b) in self.sum.iter_mut().zip(&o.sum) {
-            *a += b;
-        }
-        for (a, b) in self.sum2.iter_mut().zip(&o.sum2) {
-            *a += b;
-        }
-        for (a, b) in self.total.iter_mut().zip(&o.total) {
-            *a += b;
-        }
-        for (a, b) in self.total2.iter_mut().zip(&o.total2) {
-            *a += b;
+        add_into(&mut self.sum, &o.sum);
+        add_into(&mut self.sum2, &o.sum2);
+        add_into(&mut self.total, &o.total);
+        add_into(&mut self.total2, &o.total2);
+    }
+}
+
+/// `a[i] += b[i]` for every i: merging one chunk's sums into the running ones.
+pub(crate) fn add_into(a: &mut [f64], b: &[f64]) {
+    for (a, b) in a.iter_mut().zip(b) {
+        *a += b;
+    }
+}
+
+/// Calls `tally(row, w)` with the weight w = α_row^n = exp(n·ln α_row) of an exit after `n`
+/// scattering events, for every albedo row whose weight is not 0 (`ln_alpha[row] = ln α_row`):
+/// how one absorption-free path stands for every tabulated albedo.
+#[inline]
+pub(crate) fn for_each_row_weight(ln_alpha: &[f64], n: u32, mut tally: impl FnMut(usize, f64)) {
+    for (row, la) in ln_alpha.iter().enumerate() {
+        let w = (f64::from(n) * la).exp();
+        if w != 0.0 {
+            tally(row, w);
         }
     }
 }
@@ -224,11 +236,7 @@ impl ExitSums<'_> {
     /// skipped).
     #[inline]
     pub(super) fn add(&mut self, ln_alpha: &[f64], n: u32, bin: Option<usize>, first: usize) {
-        for (row, la) in ln_alpha.iter().enumerate() {
-            let w = (f64::from(n) * la).exp();
-            if w == 0.0 {
-                continue;
-            }
+        for_each_row_weight(ln_alpha, n, |row, w| {
             let k = first + row;
             self.total[k] += w;
             self.total2[k] += w * w;
@@ -236,7 +244,7 @@ impl ExitSums<'_> {
                 self.sum[k * N_BINS + b] += w;
                 self.sum2[k * N_BINS + b] += w * w;
             }
-        }
+        });
     }
 }
 

@@ -30,7 +30,7 @@ use super::file::{
     put_f64s,
 };
 use super::grid::{N_BINS, bin_of};
-use super::simulate::{ExitSums, Face, Stream, in_chunks, trace};
+use super::simulate::{ExitSums, Face, Stream, add_into, for_each_row_weight, in_chunks, trace};
 use super::slab::{SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, slab_albedo_of_row};
 
 const MAGIC: &[u8; 8] = b"HBSSRDFS";
@@ -89,9 +89,7 @@ impl SlabTally {
             (&mut self.single, &o.single),
             (&mut self.single2, &o.single2),
         ] {
-            for (x, y) in a.iter_mut().zip(b) {
-                *x += y;
-            }
+            add_into(a, b);
         }
     }
 }
@@ -116,11 +114,10 @@ fn slab_chunk(
                 return;
             }
             if n == 1 {
-                for (row, la) in ln_alpha.iter().enumerate() {
-                    let w = la.exp();
+                for_each_row_weight(ln_alpha, 1, |row, w| {
                     t.single[f * SLAB_ROWS + row] += w;
                     t.single2[f * SLAB_ROWS + row] += w * w;
-                }
+                });
                 return;
             }
             ExitSums {

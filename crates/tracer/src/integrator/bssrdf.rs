@@ -175,7 +175,7 @@ impl BssrdfObject {
     ) -> PairWeight {
         let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
         counters.record_estimate(&est.diagnostics);
-        let (rd, reflection) = self.weigh_pair(surface, est.coefficients, x_i, x_o, counters);
+        let (rd, reflection) = self.weigh(surface, est.coefficients, x_i, x_o, counters);
         PairWeight {
             rd,
             coeffs: est.coefficients,
@@ -193,12 +193,14 @@ impl BssrdfObject {
         let Some(t) = self.coupling.as_ref().filter(|_| w.reflection) else {
             return Rgb::splat(1.0);
         };
-        let g = self.family.g();
-        // Reduced albedo per channel; a channel without extinction gets NaN, hence T = 1.
+        // The reduced albedo per channel, as the profile reads its rows; a channel that does
+        // not scatter (its profile is 0) gets NaN, hence T = 1.
         let alpha = std::array::from_fn(|ch| {
-            let sp = (1.0 - g) * w.coeffs.sigma_s[ch];
-            let tp = w.coeffs.sigma_a[ch] + sp;
-            if tp > 0.0 { sp / tp } else { f64::NAN }
+            self.family
+                .reduced_albedo(w.coeffs.sigma_a[ch], w.coeffs.sigma_s[ch])
+                .ok()
+                .flatten()
+                .unwrap_or(f64::NAN)
         });
         Rgb(t.factors(alpha, cos_i, cos_o))
     }
@@ -213,22 +215,10 @@ impl BssrdfObject {
 
     /// The profile of the pair at the homogeneous coefficients `coeffs`: the half-space
     /// profile at |x_i − x_o|, or for a thickness-aware object the slab profile's reflection or
-    /// transmission where the pair sits as on a slab (module docs). Without the shape
-    /// correction.
+    /// transmission where the pair sits as on a slab (module docs); and whether it is a
+    /// reflection profile ([`PairWeight::reflection`]). Without the shape correction and the
+    /// angular coupling.
     pub(crate) fn weigh(
-        &self,
-        surface: &ObjectSurface<'_>,
-        coeffs: het_estimate::Coefficients,
-        x_i: &Hit,
-        x_o: &Hit,
-        counters: &mut PathCounters,
-    ) -> Rgb {
-        self.weigh_pair(surface, coeffs, x_i, x_o, counters).0
-    }
-
-    /// [`BssrdfObject::weigh`], and whether the profile used is a reflection one
-    /// ([`PairWeight::reflection`]).
-    fn weigh_pair(
         &self,
         surface: &ObjectSurface<'_>,
         coeffs: het_estimate::Coefficients,

@@ -1063,20 +1063,13 @@ impl<'s> PathIntegrator<'s> {
         let carried = match w {
             Ok((w, pw)) => {
                 st.beta *= w;
-                Some(pw)
+                Ok(pw)
             }
             Err(scale) => {
-                // One factor is owed at a time: settle an older one first.
+                // One factor is owed at a time: settle an older one first. The new one is
+                // owed once the continuation's direction is known (below).
                 self.settle(st, rng, counters);
-                st.deferred = Some(Deferred {
-                    object,
-                    x_i,
-                    x_o: *hit,
-                    scale,
-                    cos_i: 1.0,
-                    cos_o,
-                });
-                None
+                Err(scale)
             }
         };
         if st.beta.is_zero() {
@@ -1095,10 +1088,18 @@ impl<'s> PathIntegrator<'s> {
             st.beta *= f_i; // the shape correction's entry factor for the continuation
         }
         // The angular coupling for the continuation: now, or when the owed weight is settled.
-        match (carried, st.deferred.as_mut()) {
-            (Some(pw), _) => st.beta *= b.coupling(&pw, cos, cos_o),
-            (None, Some(d)) => d.cos_i = cos,
-            (None, None) => {}
+        match carried {
+            Ok(pw) => st.beta *= b.coupling(&pw, cos, cos_o),
+            Err(scale) => {
+                st.deferred = Some(Deferred {
+                    object,
+                    x_i,
+                    x_o: *hit,
+                    scale,
+                    cos_i: cos,
+                    cos_o,
+                })
+            }
         }
         st.prev = Prev::Sampled {
             p: x_i.p,

@@ -732,7 +732,7 @@ fn body_response(
     for k in 0..PROBES_PER_POINT as u64 {
         let mut rng = Rng::from_keys(SEED, &[surface.object as u64, index, 2, k]);
         for hit in bssrdf.probe_set(surface, x_o, coeffs, &mut rng).iter() {
-            let r = bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters);
+            let (r, _) = bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters);
             sum += r * g(&hit.hit) * hit.weight;
         }
     }
