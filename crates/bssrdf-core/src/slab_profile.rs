@@ -88,10 +88,72 @@ impl ProfileFamily {
     }
 }
 
+impl ProfileFamily {
+    /// Whether a slab of thickness `thickness` (length) is, for absorption `sigma_a` and
+    /// scattering `sigma_s`, as deep as the half-space: its reduced optical thickness σt'·d is
+    /// at least 2 d_max ([`SlabTerm::is_half_space`]), where the slab table hands over to the
+    /// half-space table entirely (reflection = the half-space profile, transmission 0; see
+    /// [`crate::tabulated::slab`]). Then a caller can evaluate [`ProfileFamily::profile`]
+    /// instead of building the slab profile. `false` for a model without a slab table, for
+    /// invalid input (so that [`ProfileFamily::slab`] reports it) and for a medium that does not
+    /// scatter.
+    pub fn slab_is_half_space(&self, sigma_a: f64, sigma_s: f64, thickness: f64) -> bool {
+        if self.model() != ProfileModel::Tabulated || thickness.is_nan() {
+            return false;
+        }
+        let Ok((sigma_a, sigma_s)) = validate_sigmas(sigma_a, sigma_s) else {
+            return false;
+        };
+        let reduced = self.reduced(sigma_a, sigma_s);
+        reduced.albedo.is_some() && SlabTerm::is_half_space(reduced.sigma_tp, thickness)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::Scattering;
+
+    /// From σt'·d = 2 d_max on, the slab profile is the half-space profile (reflection) and
+    /// nothing (transmission), which is what lets a renderer skip building it; just below,
+    /// it is not yet.
+    #[test]
+    fn a_slab_from_twice_the_last_thickness_is_the_half_space() {
+        let (sigma_a, sigma_s) = (0.002, 1.5);
+        for (g, scattering) in [(0.0, Scattering::Multiple), (0.4, Scattering::All)] {
+            let f = ProfileFamily::new(ProfileModel::Tabulated, scattering, g, 1.3).unwrap();
+            let sigma_tp = sigma_a + (1.0 - g) * sigma_s;
+            let deep = 32.0 / sigma_tp;
+            assert!(f.slab_is_half_space(sigma_a, sigma_s, deep * (1.0 + 1e-12)));
+            assert!(!f.slab_is_half_space(sigma_a, sigma_s, deep * 0.99));
+            let slab = f
+                .slab(sigma_a, sigma_s, deep * (1.0 + 1e-12))
+                .unwrap()
+                .unwrap();
+            let half_space = f.profile(sigma_a, sigma_s).unwrap();
+            for r in [0.0, 0.01, 0.3, 2.0, 9.0, 40.0] {
+                let (s, h) = (slab.eval(SlabFace::Reflection, r), half_space.eval(r));
+                // Equal but for how single and multiple scattering are summed (one
+                // interpolation of the sum, or the sum of two).
+                assert!(
+                    (s - h).abs() <= 2e-3 * h,
+                    "g {g}, r {r}: slab {s}, half-space {h}"
+                );
+                assert_eq!(slab.eval(SlabFace::Transmission, r), 0.0);
+            }
+            // Just below, the slab still transmits.
+            let thinner = f.slab(sigma_a, sigma_s, deep * 0.9).unwrap().unwrap();
+            assert!(thinner.eval(SlabFace::Transmission, 1.0) > 0.0);
+        }
+        // Other models, invalid input and media that do not scatter: no shortcut.
+        let f = ProfileFamily::new(ProfileModel::Dipole, Scattering::All, 0.0, 1.3).unwrap();
+        assert!(!f.slab_is_half_space(0.01, 1.0, 1e9));
+        let f = ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, 0.0, 1.3).unwrap();
+        assert!(!f.slab_is_half_space(-0.01, 1.0, 1e9));
+        assert!(!f.slab_is_half_space(0.01, 1.0, f64::NAN));
+        assert!(!f.slab_is_half_space(1.0, 0.0, 1e9));
+        assert!(f.slab_is_half_space(0.01, 1.0, f64::INFINITY));
+    }
 
     #[test]
     fn invalid_thickness_is_a_typed_error_and_other_models_have_no_slab() {

@@ -22,6 +22,25 @@ pub trait BinaryPattern {
 /// baseline x86-64 target and cost as much as the rest of a lookup. Beyond 2⁵² every `f64` is
 /// an integer (and beyond 2⁵³ an even one), so `⌊x⌋ = x` there; such coordinates, and NaN,
 /// take the slow exact path.
+/// ⌊v⌋ through `i64` below 2⁵² (see [`parity_of_floors`] for why), `f64::floor` beyond and
+/// for NaN. Equal to `v.floor()` for every `v`.
+#[inline]
+pub(crate) fn fast_floor(v: f64) -> f64 {
+    const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
+    if v.abs() < EXACT {
+        let i = v as i64;
+        (if (i as f64) > v { i - 1 } else { i }) as f64
+    } else {
+        v.floor()
+    }
+}
+
+/// Whether the integer-valued `k` is odd, without `rem_euclid` (a library call): `k − 2⌊k/2⌋`.
+#[inline]
+pub(crate) fn is_odd(k: f64) -> bool {
+    k - 2.0 * fast_floor(0.5 * k) == 1.0
+}
+
 #[inline]
 fn parity_of_floors(x: f64, y: f64) -> usize {
     const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
@@ -95,6 +114,35 @@ impl Ramp {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_floor_and_parity_are_the_library_ones() {
+        for v in [
+            -3.5,
+            -3.0,
+            -2.999_999,
+            -0.5,
+            -0.0,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            2.5,
+            7.0,
+            1e15 + 0.5,
+            4_503_599_627_370_495.5,
+            4.6e15,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+        ] {
+            assert_eq!(fast_floor(v), v.floor(), "{v}");
+        }
+        assert!(fast_floor(f64::NAN).is_nan());
+        for k in -9i64..=9 {
+            assert_eq!(is_odd(k as f64), k.rem_euclid(2) == 1, "{k}");
+        }
+    }
 
     #[test]
     fn origin_cell_has_value_zero_and_parity_alternates() {

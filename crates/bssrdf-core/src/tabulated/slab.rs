@@ -95,6 +95,14 @@ pub struct SlabTerm {
 }
 
 impl SlabTerm {
+    /// Whether the slab of thickness `thickness` (length) at extinction `sigma_t` is the
+    /// half-space as far as the table goes: σt·d ≥ 2 d_max, where [`SlabTerm::new`] gives the
+    /// half-space table's multiple scattering alone and no transmission (module docs).
+    #[inline]
+    pub fn is_half_space(sigma_t: f64, thickness: f64) -> bool {
+        thickness * sigma_t >= 2.0 * SLAB_THICKNESSES[SLAB_THICKNESSES.len() - 1]
+    }
+
     /// The slab profile for extinction `sigma_t` (> 0), albedo `alpha` ∈ [0, 1], `eta` ∈ [1,
     /// 1.6] (clamped) and thickness `thickness` (length, ≥ 0, +∞ for the half-space).
     pub fn new(sigma_t: f64, alpha: f64, eta: f64, thickness: f64) -> Self {

@@ -89,6 +89,8 @@ struct ObjectAccel {
     /// The bounds padded for the conservative box tests.
     plo: DVec3,
     phi: DVec3,
+    /// The extents when the mesh is its own bounding box ([`TriangleMesh::box_extent`]).
+    box_extent: Option<DVec3>,
 }
 
 /// Scene geometry: triangle meshes (object id = index) with their BVHs, and the ray queries.
@@ -217,6 +219,7 @@ impl ObjectAccel {
                 hi,
                 plo: lo - box_pad(lo, hi),
                 phi: hi + box_pad(lo, hi),
+                box_extent: None,
             };
         }
         let scaled: Vec<[Vec3A; 3]> = mesh
@@ -261,6 +264,7 @@ impl ObjectAccel {
             hi,
             plo: lo - box_pad(lo, hi),
             phi: hi + box_pad(lo, hi),
+            box_extent: mesh.box_extent(),
         }
     }
 
@@ -395,6 +399,12 @@ impl Geometry {
     pub fn object_bounds(&self, object: u32) -> (DVec3, DVec3) {
         let o = &self.objects[object as usize];
         (o.lo, o.hi)
+    }
+
+    /// The object's extents along x, y and z when its mesh is exactly its own axis-aligned
+    /// bounding box ([`TriangleMesh::box_extent`]), else `None`.
+    pub fn object_box_extent(&self, object: u32) -> Option<DVec3> {
+        self.objects[object as usize].box_extent
     }
 
     /// Bounds of every object together.

@@ -163,6 +163,56 @@ impl TriangleMesh {
         }
     }
 
+    /// The extents `max − min` of the bounds when the mesh is exactly its own axis-aligned
+    /// bounding box (the `box` and `half_space` primitives, or a file holding one), else
+    /// `None`. A box: every extent positive; every triangle lies in one face plane of the
+    /// bounds with its geometric normal facing out; shading normals, where there are any,
+    /// are that face's normal; and each face's triangles cover its area (to 1e-9 relative).
+    /// On such a mesh the distance from any surface point along the inward normal to the far
+    /// side is the extent along that normal's axis, which lets a renderer measure thickness
+    /// without tracing a ray.
+    pub fn box_extent(&self) -> Option<DVec3> {
+        let (lo, hi) = self.bounds();
+        let extent = hi - lo;
+        if self.triangles.is_empty() || !extent.is_finite() || extent.min_element() <= 0.0 {
+            return None;
+        }
+        let mut face_area = [0.0f64; 6];
+        for (i, t) in self.triangles.iter().enumerate() {
+            let v = self.triangle_vertices(i);
+            let n = (v[1] - v[0]).cross(v[2] - v[0]);
+            let face = (0..3).find_map(|a| {
+                let side = if v.iter().all(|p| p[a] == lo[a]) {
+                    -1.0
+                } else if v.iter().all(|p| p[a] == hi[a]) {
+                    1.0
+                } else {
+                    return None;
+                };
+                (n[a] * side > 0.0).then_some((a, side))
+            })?;
+            let (axis, side) = face;
+            if let Some(normals) = &self.normals {
+                let facing = t.iter().all(|&k| {
+                    let m = normals[k as usize].as_dvec3();
+                    let len = m.length();
+                    len > 0.0 && m[axis] * side >= len * (1.0 - 1e-6)
+                });
+                if !facing {
+                    return None;
+                }
+            }
+            face_area[2 * axis + usize::from(side > 0.0)] += 0.5 * n.length();
+        }
+        (0..6)
+            .all(|f| {
+                let a = f / 2;
+                let want = extent[(a + 1) % 3] * extent[(a + 2) % 3];
+                (face_area[f] - want).abs() <= 1e-9 * want
+            })
+            .then_some(extent)
+    }
+
     /// Total area (scene units²).
     pub fn surface_area(&self) -> f64 {
         (0..self.triangles.len())
@@ -406,6 +456,53 @@ impl TriangleMesh {
 mod tests {
     use super::*;
     use crate::geometry::primitives;
+
+    #[test]
+    fn box_extent_only_for_a_whole_outward_box() {
+        let (lo, hi) = (DVec3::new(-1.0, 2.0, 0.5), DVec3::new(3.0, 2.5, 4.0));
+        let want = Some(hi - lo);
+        assert_eq!(primitives::cuboid(lo, hi).box_extent(), want);
+        assert_eq!(
+            primitives::subdivided_cuboid(lo, hi, [3, 1, 5]).box_extent(),
+            want
+        );
+        assert_eq!(
+            primitives::half_space(0.0, [1.0, 2.0], 10.0, 4.0, 6).box_extent(),
+            Some(DVec3::new(10.0, 10.0, 4.0))
+        );
+        assert_eq!(
+            primitives::icosphere(DVec3::ZERO, 1.0, 2).box_extent(),
+            None
+        );
+        // A face missing: not a box (a ray through the hole would leave).
+        let mut open = primitives::cuboid(lo, hi);
+        open.triangles.truncate(10);
+        assert_eq!(open.box_extent(), None);
+        // Inside out.
+        let mut flipped = primitives::cuboid(lo, hi);
+        for t in &mut flipped.triangles {
+            t.swap(1, 2);
+        }
+        assert_eq!(flipped.box_extent(), None);
+        // A shading normal that is not the face's.
+        let mut bent = primitives::cuboid(lo, hi);
+        let n = bent.positions.len();
+        bent.normals = Some(vec![Vec3::new(0.3, 0.3, 0.9); n]);
+        assert_eq!(bent.box_extent(), None);
+        // A vertex moved inside: a triangle leaves the face planes.
+        let mut dented = primitives::subdivided_cuboid(lo, hi, [2, 2, 2]);
+        let mid = dented
+            .positions
+            .iter()
+            .position(|p| p.z == hi.z && p.x > lo.x && p.x < hi.x && p.y > lo.y && p.y < hi.y)
+            .unwrap();
+        dented.positions[mid].z -= 0.1;
+        assert_eq!(dented.box_extent(), None);
+        // Empty and flat meshes.
+        assert_eq!(TriangleMesh::default().box_extent(), None);
+        let flat = primitives::quad(DVec3::ZERO, DVec3::X, DVec3::Y);
+        assert_eq!(flat.box_extent(), None);
+    }
 
     #[test]
     fn cube_is_closed_and_outward() {

@@ -290,8 +290,26 @@ pub(crate) fn facing_normal(hit: &Hit, w: DVec3) -> Option<DVec3> {
 
 /// The object's thickness at `hit` (length): the distance along the inward shading normal −n_s
 /// to the object's surface on the far side, +∞ when the ray leaves without meeting it (an
-/// open mesh). One ray against the object's own BVH.
+/// open mesh). One ray against the object's own BVH; none on an object that is exactly its
+/// own bounding box (`box`, `half_space`), where it is the box's extent along the normal.
 pub(crate) fn thickness(surface: &ObjectSurface<'_>, hit: &Hit) -> f64 {
+    if let Some(extent) = surface.geometry.object_box_extent(surface.object) {
+        // A box's shading normal is its face's axis (`TriangleMesh::box_extent`).
+        let n = hit.ns.abs();
+        let axis = if n.x >= n.y && n.x >= n.z {
+            0
+        } else if n.y >= n.z {
+            1
+        } else {
+            2
+        };
+        return extent[axis];
+    }
+    thickness_by_ray(surface, hit)
+}
+
+/// [`thickness`] measured by its ray whatever the object's shape.
+fn thickness_by_ray(surface: &ObjectSurface<'_>, hit: &Hit) -> f64 {
     let dir = -hit.ns;
     let ray = Ray::new(hit.spawn_origin(dir), dir);
     surface
@@ -395,5 +413,48 @@ mod tests {
         assert!(slab_pair(&on_sphere(0.3), &north, 2.0).is_some()); // near x_o
         // An open mesh (no far side) keeps the half-space profile.
         assert!(slab_pair(&top(1.0), &top(0.0), f64::INFINITY).is_none());
+    }
+
+    /// On a box the thickness without a ray is the one its ray measures, at points all over
+    /// every face; a sphere has no box extent and keeps the ray.
+    #[test]
+    fn a_box_thickness_is_its_rays() {
+        use crate::geometry::{Geometry, Ray, primitives};
+        let (lo, hi) = (DVec3::new(-1.5, 0.25, -3.0), DVec3::new(2.0, 1.25, -0.5));
+        let geometry = Geometry::build(vec![
+            primitives::subdivided_cuboid(lo, hi, [3, 2, 4]),
+            primitives::icosphere(DVec3::new(10.0, 0.0, 0.0), 1.0, 3),
+        ]);
+        assert!(geometry.object_box_extent(0).is_some());
+        assert!(geometry.object_box_extent(1).is_none());
+        let surface = ObjectSurface::new(&geometry, 0);
+        let centre = 0.5 * (lo + hi);
+        let mut checked = 0;
+        for k in 0..500 {
+            // Rays from a sphere around the box toward random points inside it.
+            let t = k as f64;
+            let dir_out = DVec3::new((1.7 * t).sin(), (2.3 * t).cos(), (0.9 * t).sin()).normalize();
+            let target = centre
+                + (hi - lo) * 0.45 * DVec3::new((0.3 * t).sin(), (0.7 * t).cos(), (1.1 * t).sin());
+            let origin = centre + 20.0 * dir_out;
+            let Some(h) = geometry.intersect(&Ray::new(origin, (target - origin).normalize()))
+            else {
+                continue;
+            };
+            assert_eq!(h.object, 0);
+            let (fast, ray) = (thickness(&surface, &h), thickness_by_ray(&surface, &h));
+            assert!(
+                (fast - ray).abs() <= 1e-9 * fast,
+                "at {:?}: {fast} against {ray}",
+                h.p
+            );
+            checked += 1;
+        }
+        assert!(checked > 400, "{checked}");
+        let sphere = ObjectSurface::new(&geometry, 1);
+        let h = geometry
+            .intersect(&Ray::new(DVec3::new(10.0, 0.0, 5.0), DVec3::NEG_Z))
+            .unwrap();
+        assert!((thickness(&sphere, &h) - thickness_by_ray(&sphere, &h)).abs() == 0.0);
     }
 }

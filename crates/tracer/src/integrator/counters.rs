@@ -113,6 +113,16 @@ impl PathCounters {
     ) -> bssrdf_core::Rgb {
         let mut rd = bssrdf_core::Rgb::ZERO;
         for ch in 0..3 {
+            // As deep as the half-space: the slab table's own limit, without building it.
+            if family.slab_is_half_space(c.sigma_a[ch], c.sigma_s[ch], d) {
+                rd[ch] = match face {
+                    bssrdf_core::SlabFace::Reflection => {
+                        self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r)
+                    }
+                    bssrdf_core::SlabFace::Transmission => 0.0,
+                };
+                continue;
+            }
             rd[ch] = match family.slab(c.sigma_a[ch], c.sigma_s[ch], d) {
                 Ok(Some(slab)) => slab.eval(face, r),
                 Ok(None) => self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r),
