@@ -384,6 +384,22 @@ pub struct ProbeSet<P> {
     len: usize,
 }
 
+impl<P: Copy> ProbeSet<P> {
+    /// An empty set, to be filled by [`probe_within_into`].
+    pub fn new() -> Self {
+        Self {
+            hits: [None; 3 * MAX_PROBE_HITS],
+            len: 0,
+        }
+    }
+}
+
+impl<P: Copy> Default for ProbeSet<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl<P> ProbeSet<P> {
     /// The hits.
     pub fn iter(&self) -> impl Iterator<Item = &ProbeHit<P>> {
@@ -430,13 +446,27 @@ pub fn probe_within<C: ProbeChords, U: UniformSource>(
     max_radius: f64,
     rng: &mut U,
 ) -> ProbeSet<C::Point> {
+    let mut set = ProbeSet::new();
+    probe_within_into(&mut set, chords, x_o, coeffs, sampler, max_radius, rng);
+    set
+}
+
+/// [`probe_within`] into a set the caller owns (its previous hits are dropped): a renderer
+/// that keeps the set in its own frame avoids copying it (a set holds room for
+/// 3 × [`MAX_PROBE_HITS`] points) on every return.
+pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
+    set: &mut ProbeSet<C::Point>,
+    chords: &C,
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &ProbeSampler,
+    max_radius: f64,
+    rng: &mut U,
+) {
+    set.len = 0;
     let channels = sampler.channels(coeffs, max_radius);
     let origin = x_o.position();
     let frame = Frame::new(x_o.normal());
-    let mut set = ProbeSet {
-        hits: [None; 3 * MAX_PROBE_HITS],
-        len: 0,
-    };
     for axis in 0..3 {
         let ch = ((rng.next_f64() * 3.0) as usize).min(2);
         let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
@@ -477,7 +507,6 @@ pub fn probe_within<C: ProbeChords, U: UniformSource>(
             }
         });
     }
-    set
 }
 
 /// `p(x)` of the module docs (1/length²): the density with which [`probe`] around `x_o`, with

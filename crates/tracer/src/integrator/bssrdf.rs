@@ -146,6 +146,19 @@ impl BssrdfObject {
             .probe_chords(chords, x_o, coeffs, self.extent, rng)
     }
 
+    /// [`BssrdfObject::probe_set`] into `set`, which the caller keeps (no copy of the set).
+    pub(crate) fn probe_set_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
+        &self,
+        set: &mut crate::integrator::probe::ProbeSet,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: het_estimate::Coefficients,
+        rng: &mut Rng,
+    ) {
+        self.sampler
+            .probe_chords_into(set, chords, x_o, coeffs, self.extent, rng);
+    }
+
     /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
     /// (unitless; 1 for η = 1).
     #[inline]

@@ -1001,7 +1001,8 @@ impl<'s> PathIntegrator<'s> {
             object,
         };
         let at_xo = material.medium.coefficients(hit);
-        let set = b.probe_set(&surface, hit, at_xo, rng);
+        let mut set = crate::integrator::probe::ProbeSet::new();
+        b.probe_set_into(&mut set, &surface, hit, at_xo, rng);
         counters.probe_sets += 1;
         if set.is_empty() {
             counters.probe_misses += 1;

@@ -40,6 +40,19 @@ impl ProbeSampler {
     ) -> ProbeSet {
         lib::probe_within(chords, x_o, coeffs, &self.0, max_radius, rng)
     }
+
+    /// [`ProbeSampler::probe_chords`] into `set` ([`lib::probe_within_into`]).
+    pub(crate) fn probe_chords_into<C: ProbeChords<Point = Hit>>(
+        &self,
+        set: &mut ProbeSet,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: Coefficients,
+        max_radius: f64,
+        rng: &mut Rng,
+    ) {
+        lib::probe_within_into(set, chords, x_o, coeffs, &self.0, max_radius, rng);
+    }
 }
 
 /// A found incident point and its estimator weight `1/p(x)`.
