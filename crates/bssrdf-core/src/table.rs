@@ -66,7 +66,8 @@ pub struct ProfileTable {
     total: Vec<f64>,
     /// Guide table per row, `ROWS × (GUIDE + 1)`: entry k is the last node whose CDF is at
     /// most k / GUIDE, so that inverting the CDF at f searches only the nodes between the
-    /// entries around f (a few instead of all `COLS`; Chen & Asau's guide tables).
+    /// entries around f (a few instead of all `COLS`; the guide tables of CA74 in
+    /// docs/references.md).
     guide: Vec<u8>,
 }
 

@@ -74,9 +74,35 @@ impl PathCounters {
         c: het_estimate::Coefficients,
         r: f64,
     ) -> bssrdf_core::Rgb {
+        self.per_distinct_channel(c, |counters, sigma_a, sigma_s| {
+            counters.eval_profile_channel(family, sigma_a, sigma_s, r)
+        })
+    }
+
+    /// `eval(self, σa, σs)` for each channel of `c`, evaluated once per distinct pair of
+    /// coefficients (a grey material costs one evaluation, not three); a channel equal to an
+    /// earlier one repeats its value and, when that failed, its failure count.
+    #[inline]
+    fn per_distinct_channel(
+        &mut self,
+        c: het_estimate::Coefficients,
+        mut eval: impl FnMut(&mut Self, f64, f64) -> f64,
+    ) -> bssrdf_core::Rgb {
         let mut rd = bssrdf_core::Rgb::ZERO;
+        let mut failed = [0u64; 3];
         for ch in 0..3 {
-            rd[ch] = self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r);
+            let key = (c.sigma_a[ch].to_bits(), c.sigma_s[ch].to_bits());
+            if let Some(e) =
+                (0..ch).find(|&e| (c.sigma_a[e].to_bits(), c.sigma_s[e].to_bits()) == key)
+            {
+                rd[ch] = rd[e];
+                failed[ch] = failed[e];
+                self.profile_failures += failed[e];
+                continue;
+            }
+            let before = self.profile_failures;
+            rd[ch] = eval(self, c.sigma_a[ch], c.sigma_s[ch]);
+            failed[ch] = self.profile_failures - before;
         }
         rd
     }
@@ -111,28 +137,25 @@ impl PathCounters {
         face: bssrdf_core::SlabFace,
         r: f64,
     ) -> bssrdf_core::Rgb {
-        let mut rd = bssrdf_core::Rgb::ZERO;
-        for ch in 0..3 {
+        self.per_distinct_channel(c, |counters, sigma_a, sigma_s| {
             // As deep as the half-space: the slab table's own limit, without building it.
-            if family.slab_is_half_space(c.sigma_a[ch], c.sigma_s[ch], d) {
-                rd[ch] = match face {
+            if family.slab_is_half_space(sigma_a, sigma_s, d) {
+                return match face {
                     bssrdf_core::SlabFace::Reflection => {
-                        self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r)
+                        counters.eval_profile_channel(family, sigma_a, sigma_s, r)
                     }
                     bssrdf_core::SlabFace::Transmission => 0.0,
                 };
-                continue;
             }
-            rd[ch] = match family.slab(c.sigma_a[ch], c.sigma_s[ch], d) {
+            match family.slab(sigma_a, sigma_s, d) {
                 Ok(Some(slab)) => slab.eval(face, r),
-                Ok(None) => self.eval_profile_channel(family, c.sigma_a[ch], c.sigma_s[ch], r),
+                Ok(None) => counters.eval_profile_channel(family, sigma_a, sigma_s, r),
                 Err(_) => {
-                    self.profile_failures += 1;
+                    counters.profile_failures += 1;
                     0.0
                 }
-            };
-        }
-        rd
+            }
+        })
     }
 
     /// Adds tracking work.
@@ -184,5 +207,53 @@ mod tests {
         let mut merged = PathCounters::default();
         merged.merge(&c);
         assert_eq!(merged.profile_failures, 2, "merge drops the count");
+    }
+
+    /// Channels with equal coefficients are evaluated once but give, and count, what three
+    /// evaluations would: the same values, and a failure per failing channel.
+    #[test]
+    fn equal_channels_are_evaluated_once_with_the_same_result() {
+        let family =
+            ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, 0.0, 1.3).unwrap();
+        let coeffs = |a: [f64; 3], s: [f64; 3]| het_estimate::Coefficients {
+            sigma_a: bssrdf_core::Rgb(a),
+            sigma_s: bssrdf_core::Rgb(s),
+        };
+        for (c, failures) in [
+            (coeffs([0.01, 0.01, 0.2], [1.0, 1.0, 1.0]), 0),
+            (coeffs([0.01, 0.3, 0.01], [1.0, 2.0, 1.0]), 0),
+            (coeffs([-1.0, 0.05, -1.0], [1.0, 1.0, 1.0]), 2),
+            (coeffs([-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]), 3),
+        ] {
+            for d in [0.7, 3.0, 1e4, f64::INFINITY] {
+                for face in [
+                    bssrdf_core::SlabFace::Reflection,
+                    bssrdf_core::SlabFace::Transmission,
+                ] {
+                    let mut counters = PathCounters::default();
+                    let got = counters.eval_slab_profile(&family, c, d, face, 0.4);
+                    assert_eq!(counters.profile_failures, failures);
+                    for ch in 0..3 {
+                        let mut one = PathCounters::default();
+                        let want = one.eval_slab_profile(
+                            &family,
+                            coeffs([c.sigma_a[ch]; 3], [c.sigma_s[ch]; 3]),
+                            d,
+                            face,
+                            0.4,
+                        );
+                        assert_eq!(got[ch], want[0], "{c:?} d {d} {face:?} channel {ch}");
+                    }
+                }
+            }
+            let mut counters = PathCounters::default();
+            let got = counters.eval_profile(&family, c, 0.4);
+            assert_eq!(counters.profile_failures, failures);
+            for ch in 0..3 {
+                let mut one = PathCounters::default();
+                let want = one.eval_profile_channel(&family, c.sigma_a[ch], c.sigma_s[ch], 0.4);
+                assert_eq!(got[ch], want);
+            }
+        }
     }
 }

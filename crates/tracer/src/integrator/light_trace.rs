@@ -305,7 +305,8 @@ impl<'s> LightTracer<'s> {
             geometry,
             object: x_i.object,
         };
-        let set = b.probe_set(&surface, &x_i, at_xi, rng);
+        let mut set = crate::integrator::probe::ProbeSet::new();
+        b.probe_set_into(&mut set, &surface, &x_i, at_xi, rng);
         if set.is_empty() {
             counters.probe_misses += 1;
             return;
