@@ -460,6 +460,64 @@ impl Geometry {
         best.map(|(k, leaf, t)| self.make_hit(k, leaf, ray, t))
     }
 
+    /// For an object whose mesh is its own axis-aligned box ([`Geometry::object_box_extent`]):
+    /// the crossing of the whole line `origin + t·dir` (unit `dir`, `t` of either sign) nearest
+    /// to `origin`, the projection of Sone's estimators. The box's planes say where the line
+    /// enters and leaves it, so one ray over a short window around the nearer of the two
+    /// finds the triangle, where a general mesh needs a ray each way. `Some(None)`: the line
+    /// misses the box by a clear margin. `None`: not a box, or a case the planes do not settle
+    /// (the line grazes an edge or face, the origin lies on the surface or halfway between
+    /// the crossings, or the window finds no triangle): the caller traces the two rays.
+    /// The hit is the ray's own (the same `t`, point and normals as the two-ray projection's).
+    pub fn project_onto_box(&self, object: u32, origin: DVec3, dir: DVec3) -> Option<Option<Hit>> {
+        let o = &self.objects[object as usize];
+        let extent = o.box_extent?;
+        let (lo, hi) = (o.lo, o.hi);
+        // Margin (length): far above the f32 precision of the object's triangles (about 1e-7
+        // of the extent) and of the origin.
+        let m = 1e-5 * extent.max_element() + 1e-9 * origin.abs().max_element();
+        let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+        for a in 0..3 {
+            if dir[a].abs() < 1e-12 {
+                // Parallel to this pair of planes: inside them, or a clear miss.
+                if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
+                    return Some(None);
+                }
+                if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
+                    return None;
+                }
+                continue;
+            }
+            let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
+            t_in = t_in.max(t1.min(t2));
+            t_out = t_out.min(t1.max(t2));
+        }
+        if !(t_in.is_finite() && t_out.is_finite()) {
+            return None;
+        }
+        if t_in > t_out + m {
+            return Some(None);
+        }
+        if t_out - t_in < 4.0 * m {
+            return None;
+        }
+        let (near, far) = if t_in.abs() <= t_out.abs() {
+            (t_in, t_out)
+        } else {
+            (t_out, t_in)
+        };
+        if near.abs() <= m || far.abs() - near.abs() <= 2.0 * m {
+            return None;
+        }
+        let (d, t) = if near > 0.0 {
+            (dir, near)
+        } else {
+            (-dir, -near)
+        };
+        self.intersect_object(object, &Ray::with_range(origin, d, t - m, t + m))
+            .map(Some)
+    }
+
     /// The closest intersection with `object`'s triangles in `[ray.t_min, ray.t_max]`.
     #[inline]
     pub fn intersect_object(&self, object: u32, ray: &Ray) -> Option<Hit> {
