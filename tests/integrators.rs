@@ -164,6 +164,43 @@ fn prefiltered_and_monte_carlo_renders_agree_on_the_checker_slab() {
     );
 }
 
+/// The kernel's points read in the plane (the default on flat pairs of a field defined in
+/// space) are the values their projections would read: on the checker half-space, whose
+/// pairs are all flat, the two averagings render the same image to the bit (same seed, so the
+/// same points), the in-plane render traces no projection rays, and Monte Carlo averaging
+/// reads nothing in the plane. A lookup at the wrong point (say, the chord's other side)
+/// would change the image.
+#[test]
+fn kernel_points_read_in_the_plane_equal_their_projections() {
+    use het_estimate::Averaging;
+    let scene = Scene::from_toml_str(
+        include_str!("../examples/scenes/checker-halfspace.toml"),
+        std::path::Path::new("examples/scenes"),
+        "checker-halfspace.toml",
+    )
+    .unwrap()
+    .with_resolution(24, 24)
+    .unwrap();
+    let kernel = |averaging: Averaging| {
+        "kernel"
+            .parse::<Method>()
+            .unwrap()
+            .with_estimator_samples(Some(32))
+            .with_averaging(Some(averaging))
+    };
+    let (pre, mc) = (
+        render_multiple(&scene, kernel(Averaging::Prefiltered), 24, 2, 5),
+        render_multiple(&scene, kernel(Averaging::MonteCarlo), 24, 2, 5),
+    );
+    assert!(pre.pixels.iter().any(|p| p[0] > 0.0));
+    assert!(pre.pixels == mc.pixels, "the in-plane image differs");
+    let (a, b) = (pre.counters, mc.counters);
+    assert!(a.estimates > 0 && a.prefiltered == a.estimates, "{a:?}");
+    assert_eq!(a.prefilter_fallbacks, 0);
+    assert_eq!((b.prefiltered, b.prefilter_fallbacks), (0, 0));
+    assert!(a.estimator_samples == b.estimator_samples && a.estimator_samples > 0);
+}
+
 #[test]
 fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
     // The probes' multi-sample estimator satisfies E[Σ_hits f(x)/p(x)] = ∫ f dA over the

@@ -87,7 +87,8 @@ pub fn warn_counters(c: &PathCounters) {
     }
     if c.prefiltered + c.prefilter_fallbacks > 0 {
         eprintln!(
-            "averaging: {} of {} estimates prefiltered, {} sampled where the surface was too curved \
+            "averaging: {} of {} estimates prefiltered (sone: closed-form footprints; kernel: \
+             points read in the surface's plane), {} sampled where the surface was too curved \
              for a flat footprint",
             c.prefiltered, c.estimates, c.prefilter_fallbacks
         );

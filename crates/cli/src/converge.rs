@@ -64,8 +64,10 @@ pub struct Args {
     /// Averaging samples per region of the segment, Sone and kernel estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// Sone's averaging: `prefiltered` (default: constant-time closed forms where the field
-    /// has them and the surface is flat, sampling elsewhere) or `monte-carlo` (always sample).
+    /// Sone's and the kernel's averaging: `prefiltered` (default: Sone's constant-time closed
+    /// forms, and the kernel's points read in the surface's plane without projection rays,
+    /// where the field allows it and the surface is flat; sampling and projecting elsewhere)
+    /// or `monte-carlo` (always sample and project).
     #[arg(long, value_parser = crate::choices::averaging())]
     averaging: Option<het_estimate::Averaging>,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in

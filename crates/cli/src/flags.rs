@@ -77,22 +77,14 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
     Ok(())
 }
 
-/// Errors when `--averaging` was given but none of `methods` is the Sone estimator, the only
-/// one that averages over an ellipse.
+/// Errors when `--averaging` was given but none of `methods` is the Sone or kernel estimator,
+/// the two that read prefiltered or in-plane values where they can.
 pub fn check_averaging_flag(methods: &[Method], given: bool) -> anyhow::Result<()> {
-    let sone = |m: &Method| {
-        matches!(
-            m,
-            Method::Bssrdf {
-                estimator: Estimator::Sone(_),
-                ..
-            }
-        )
-    };
-    if given && !methods.iter().any(sone) {
+    if given && !methods.iter().any(|m| m.averaging().is_some()) {
         let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
         bail!(
-            "--averaging does not apply to `{}`: only the sone estimator averages over an ellipse",
+            "--averaging does not apply to `{}`: only the sone and kernel estimators have a \
+             prefiltered and a Monte Carlo averaging",
             names.join(", ")
         );
     }

@@ -130,6 +130,17 @@ impl<P: FootprintPattern> CoefficientField<PlanePoint> for PatternField<P> {
         self.values[self.pattern.select(p.x, p.y)]
     }
 
+    /// The pattern at (x, y): it is a function of position alone (constant along z), so the
+    /// kernel reads its points in the plane without projecting them.
+    #[inline]
+    fn averaged_at_point(&self, x: DVec3) -> Option<Coefficients> {
+        Some(self.values[self.pattern.select(x.x, x.y)])
+    }
+
+    fn has_point_lookup(&self) -> bool {
+        true
+    }
+
     /// Exact: the plane is flat, so projecting the ellipse along its normal onto z = 0 is
     /// affine and the closed forms of [`crate::prefilter`] apply.
     fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {

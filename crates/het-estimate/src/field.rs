@@ -108,6 +108,23 @@ pub trait CoefficientField<P> {
         false
     }
 
+    /// Optional capability: [`CoefficientField::averaged`] at a point `x` of space, for a field
+    /// that is a function of position alone (a planar projection, a procedural field: no
+    /// texture coordinates, so no surface query is needed). The `kernel` estimator reads it at
+    /// the points of its averaging plane instead of projecting each onto the surface, where
+    /// the pair is flat enough that the plane is the surface (`KernelParams::averaging`,
+    /// [`crate::Flatness`]): the same values without two rays per point. `None` means "project
+    /// this point"; the default always returns `None`. Values as for `averaged`.
+    fn averaged_at_point(&self, x: glam::DVec3) -> Option<Coefficients> {
+        let _ = x;
+        None
+    }
+
+    /// True when [`CoefficientField::averaged_at_point`] can answer. Default: false.
+    fn has_point_lookup(&self) -> bool {
+        false
+    }
+
     /// Optional averaging space: the values the estimators average at `p`, in the two slots
     /// of a [`Coefficients`]. The default is [`CoefficientField::coefficients`] itself (σa and
     /// σs are averaged). A field whose coefficients are a nonlinear function of other

@@ -51,11 +51,12 @@ use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
-use crate::known::Known;
+use crate::known::{Known, sanitise};
+use crate::prefilter::{Averaging, Flatness};
 use crate::region_average::Probe;
 use crate::sampler::UniformSource;
 use crate::sampling::{DiskPoints, PointSet};
-use crate::surface::SurfaceQuery;
+use crate::surface::{SurfacePoint, SurfaceQuery};
 
 /// Parameters of the `kernel` estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -74,6 +75,14 @@ pub struct KernelParams {
     /// averaging σtr ∝ √σa (the eikonal picture). Chosen by measurement
     /// (docs/kernel.md#measurements). σs is averaged arithmetically.
     pub exponent: f64,
+    /// `Prefiltered` (default): where the pair is flat ([`KernelParams::flatness`]) and the
+    /// field answers at points of space ([`CoefficientField::averaged_at_point`]), the points
+    /// are read in the averaging plane, which is then the surface, without projection rays;
+    /// elsewhere they are projected. `MonteCarlo`: always project (the estimator as derived).
+    /// The points and weights are the same either way.
+    pub averaging: Averaging,
+    /// When a pair counts as flat for [`KernelParams::averaging`] (Sone's criterion).
+    pub flatness: Flatness,
 }
 
 impl KernelParams {
@@ -90,7 +99,16 @@ impl KernelParams {
             iterations: 2,
             misses: MissPolicy::HitsOnly,
             exponent: 0.75,
+            averaging: Averaging::Prefiltered,
+            flatness: Flatness::DEFAULT,
         }
+    }
+
+    /// The same parameters with the points read in the plane where possible (`Prefiltered`)
+    /// or always projected (`MonteCarlo`): [`KernelParams::averaging`].
+    pub const fn with_averaging(mut self, averaging: Averaging) -> Self {
+        self.averaging = averaging;
+        self
     }
 
     /// The same parameters with `samples` points.
@@ -279,6 +297,20 @@ where
     };
     let n = params.sample_count() as usize;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
+    // Flat pairs of a field defined in space: the plane's points are the surface's.
+    let in_plane =
+        params.averaging == Averaging::Prefiltered && probe.field.has_point_lookup() && {
+            let flat = params.flatness.is_flat(
+                probe.x_i.normal().normalize(),
+                probe.x_o.normal().normalize(),
+                chord.x_hat,
+            );
+            probe.diag.prefilter_fallback = !flat;
+            flat
+        };
+    if in_plane {
+        probe.diag.field_averages += 1;
+    }
     let set = DiskPoints::new(rng);
     // Uninitialised storage: zeroing 72 KiB per estimate would cost more than the estimate.
     let mut store = [const { MaybeUninit::<Sample>::uninit() }; KernelParams::MAX_SAMPLES as usize];
@@ -286,9 +318,26 @@ where
     for k in 0..n {
         let p = proposal.sample(set.unit_square(k as u32));
         let origin = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
-        probe.diag.projections += 1;
-        let c = match probe.surface.project(origin, chord.normal) {
-            Some(hit) => probe.lookup(&hit),
+        let at_point = if in_plane {
+            probe.field.averaged_at_point(origin)
+        } else {
+            None
+        };
+        let found = match at_point {
+            Some(c) => {
+                probe.diag.lookups += 1;
+                Some(sanitise(c))
+            }
+            None => {
+                probe.diag.projections += 1;
+                probe
+                    .surface
+                    .project(origin, chord.normal)
+                    .map(|hit| probe.lookup(&hit))
+            }
+        };
+        let c = match found {
+            Some(c) => c,
             None => {
                 probe.diag.misses += 1;
                 if !miss_endpoints {

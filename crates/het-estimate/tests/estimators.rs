@@ -818,7 +818,13 @@ fn all_misses_fall_back_to_the_endpoints() {
     for e in [
         Estimator::Segment(segment(8)),
         Estimator::Sone(sone(8, 8)),
-        Estimator::Kernel(KernelParams::new().with_samples(fixed(8))),
+        // Projected points (the in-plane reading, like Sone's closed forms, takes the
+        // surface to be the plane and never misses).
+        Estimator::Kernel(
+            KernelParams::new()
+                .with_samples(fixed(8))
+                .with_averaging(Averaging::MonteCarlo),
+        ),
     ] {
         let est = run(e, 0.0, &Nowhere, &f, &x_i, &x_o, 0);
         assert_eq!(est.coefficients, ends);
@@ -1211,6 +1217,46 @@ fn averaging_space_means_are_mapped_back_everywhere() {
                 prepared.estimate(&Plane, &mapped, &x_i, &x_o, &mut SplitMix64::new(k as u64));
             assert_eq!(one.coefficients, two.coefficients, "{est:?} pair {k}");
             assert!(one.coefficients.is_valid());
+        }
+    }
+}
+
+/// The kernel's in-plane reading (its default on flat pairs of fields defined in space) reads
+/// the values its projections would: on the plane, every pair's estimate equals the
+/// Monte Carlo one to the bit (same seed, same points), with no projection at all; Monte
+/// Carlo averaging projects every point.
+#[test]
+fn kernel_in_plane_reading_equals_projection() {
+    let field = stripe_preset();
+    for k in 0..40 {
+        let t = k as f64;
+        let x_i = PlanePoint::new(0.0, 0.0);
+        let x_o = PlanePoint::new(12.0 * (0.7 * t).sin(), 9.0 * (1.3 * t).cos());
+        let kernel =
+            |averaging: Averaging| Estimator::Kernel(KernelParams::new().with_averaging(averaging));
+        let pre = run(
+            kernel(Averaging::Prefiltered),
+            0.0,
+            &Plane,
+            &field,
+            &x_i,
+            &x_o,
+            k,
+        );
+        let mc = run(
+            kernel(Averaging::MonteCarlo),
+            0.0,
+            &Plane,
+            &field,
+            &x_i,
+            &x_o,
+            k,
+        );
+        assert_eq!(pre.coefficients, mc.coefficients, "pair {k}");
+        if pre.diagnostics.region == Region::Kernel {
+            assert_eq!(pre.diagnostics.projections, 0, "pair {k}");
+            assert_eq!(pre.diagnostics.field_averages, 1, "pair {k}");
+            assert_eq!(mc.diagnostics.projections, 64, "pair {k}");
         }
     }
 }

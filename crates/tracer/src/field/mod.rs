@@ -634,6 +634,26 @@ impl CoefficientField<Hit> for MediumField {
         }
     }
 
+    /// [`CoefficientField::averaged`] at a point of space, for media that do not read texture
+    /// coordinates (every field but UV-mapped images): the same value a surface hit at `x`
+    /// would give.
+    #[inline]
+    fn averaged_at_point(&self, x: DVec3) -> Option<Coefficients> {
+        if !self.is_volumetric() {
+            return None;
+        }
+        let raw = self.raw_at_surface(x, DVec2::ZERO);
+        Some(match &self.artist {
+            None => raw,
+            Some(map) if map.invert() == InvertAt::After => raw,
+            Some(map) => map.coefficients_out_of_line(raw),
+        })
+    }
+
+    fn has_point_lookup(&self) -> bool {
+        self.is_volumetric()
+    }
+
     #[inline]
     fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         if self.inverts_after() {

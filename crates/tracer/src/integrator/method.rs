@@ -58,29 +58,31 @@ impl Method {
         }
     }
 
-    /// The method with Sone's averaging set to `averaging` (prefiltered or Monte Carlo); other
-    /// methods are unchanged.
+    /// The method with Sone's or the kernel's averaging set to `averaging` (prefiltered or
+    /// Monte Carlo); other methods are unchanged.
     pub fn with_averaging(self, averaging: Option<het_estimate::Averaging>) -> Self {
         match (self, averaging) {
-            (
-                Method::Bssrdf {
-                    estimator: Estimator::Sone(p),
-                    profile,
+            (Method::Bssrdf { estimator, profile }, Some(a)) => Method::Bssrdf {
+                estimator: match estimator {
+                    Estimator::Sone(p) => Estimator::Sone(p.with_averaging(a)),
+                    Estimator::Kernel(p) => Estimator::Kernel(p.with_averaging(a)),
+                    e => e,
                 },
-                Some(a),
-            ) => Method::Bssrdf {
-                estimator: Estimator::Sone(p.with_averaging(a)),
                 profile,
             },
             (m, _) => m,
         }
     }
 
-    /// Sone's averaging (`None` for other methods).
+    /// Sone's or the kernel's averaging (`None` for other methods).
     pub fn averaging(&self) -> Option<het_estimate::Averaging> {
         match self {
             Method::Bssrdf {
                 estimator: Estimator::Sone(p),
+                ..
+            } => Some(p.averaging),
+            Method::Bssrdf {
+                estimator: Estimator::Kernel(p),
                 ..
             } => Some(p.averaging),
             _ => None,
