@@ -56,7 +56,7 @@ use crate::prefilter::{Averaging, Flatness};
 use crate::region_average::Probe;
 use crate::sampler::UniformSource;
 use crate::sampling::{DiskPoints, PointSet};
-use crate::surface::{SurfacePoint, SurfaceQuery};
+use crate::surface::SurfaceQuery;
 
 /// Parameters of the `kernel` estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -298,16 +298,9 @@ where
     let n = params.sample_count() as usize;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
     // Flat pairs of a field defined in space: the plane's points are the surface's.
-    let in_plane =
-        params.averaging == Averaging::Prefiltered && probe.field.has_point_lookup() && {
-            let flat = params.flatness.is_flat(
-                probe.x_i.normal().normalize(),
-                probe.x_o.normal().normalize(),
-                chord.x_hat,
-            );
-            probe.diag.prefilter_fallback = !flat;
-            flat
-        };
+    let in_plane = params.averaging == Averaging::Prefiltered
+        && probe.field.has_point_lookup()
+        && probe.flat_for_prefilter(params.flatness, chord.x_hat);
     if in_plane {
         probe.diag.field_averages += 1;
     }

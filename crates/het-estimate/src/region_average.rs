@@ -254,6 +254,19 @@ where
         }
     }
 
+    /// Whether the pair is flat by `flatness` along the chord's direction `x_hat` (unit), so
+    /// that its averaging plane stands for the surface (Sone's closed forms, the kernel's
+    /// in-plane reading); a pair that is not is recorded as a prefilter fallback.
+    pub fn flat_for_prefilter(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
+        let flat = flatness.is_flat(
+            self.x_i.normal().normalize(),
+            self.x_o.normal().normalize(),
+            x_hat,
+        );
+        self.diag.prefilter_fallback = !flat;
+        flat
+    }
+
     /// ½(σ(x_i) + σ(x_o)) (in the averaging space), looked up once per pair (the d'Eon–Irving endpoint reading and the
     /// fallback of the region estimators).
     pub fn endpoints(&mut self) -> Coefficients {

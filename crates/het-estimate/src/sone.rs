@@ -52,7 +52,7 @@ use crate::prefilter::{Averaging, Flatness};
 use crate::region_average::{Accumulator, Channels, Probe, average};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
-use crate::surface::{SurfacePoint, SurfaceQuery};
+use crate::surface::SurfaceQuery;
 
 /// Parameters of the `sone` estimator. Defaults follow the paper's reading
 /// ([`SoneParams::paper`]).
@@ -230,16 +230,9 @@ where
     };
 
     // Prefiltered averages only where a flat footprint stands for the projected region.
-    let use_field_average =
-        params.averaging == Averaging::Prefiltered && probe.field.has_ellipse_average() && {
-            let flat = params.flatness.is_flat(
-                probe.x_i.normal().normalize(),
-                probe.x_o.normal().normalize(),
-                chord.x_hat,
-            );
-            probe.diag.prefilter_fallback = !flat;
-            flat
-        };
+    let use_field_average = params.averaging == Averaging::Prefiltered
+        && probe.field.has_ellipse_average()
+        && probe.flat_for_prefilter(params.flatness, chord.x_hat);
 
     // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
     let disk = chord.ellipse(chord.half_len);
