@@ -243,16 +243,9 @@ fn estimates_and_the_bssrdf_are_reciprocal_on_an_ellipsoid_mesh() {
 
 #[test]
 fn estimates_and_the_bssrdf_are_reciprocal_on_the_bunny() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let path = root.join("../shared/assets/bunny.obj");
-    if !path.is_file() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "shared asset `../shared/assets/bunny.obj` is missing in CI"
-        );
-        eprintln!("note: `../shared/assets/bunny.obj` is absent: test skipped");
+    let Some(path) = crate::common::harness::shared_bunny() else {
         return;
-    }
+    };
     let mut mesh = tracer::geometry::obj::load_obj(&path).unwrap();
     // Scaled to about 3 units, like the sphere (the fields' scales are ~0.4 units).
     for p in &mut mesh.positions {

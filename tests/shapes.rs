@@ -22,6 +22,7 @@
 use bssrdf_core::ProfileModel;
 use tracer::integrator::Method;
 
+use crate::common::harness::{bunny_path, shared_bunny};
 use crate::common::shapes::{
     Medium, Shape, bssrdf, mean_se, measure, outside_light, ratio, shape_scene_material,
     shape_scene_with,
@@ -41,6 +42,7 @@ const SEEDS: u64 = 4;
 /// Light through the medium (mean, SE) for the path tracer and the tabulated BSSRDF.
 /// `corrected`: the material's `shape_correction` is on (the path tracer ignores it).
 fn pair(shape: Shape, medium: Medium, seed0: u64, corrected: bool) -> ((f64, f64), (f64, f64)) {
+    // The bunny's path is read only by `Shape::Bunny`.
     let scene = shape_scene_with(shape, medium, &bunny_path(), true, corrected);
     let outside = outside_light(&scene, medium.eta, 16);
     let (spp_pt, spp_b) = if shape.pixels() <= 4 {
@@ -61,11 +63,6 @@ fn pair(shape: Shape, medium: Medium, seed0: u64, corrected: bool) -> ((f64, f64
         mean_se(pt.iter().map(|s| s.through)),
         mean_se(b.iter().map(|s| s.through)),
     )
-}
-
-/// `../shared/assets/bunny.obj` beside the repository's root (read only by [`Shape::Bunny`]).
-fn bunny_path() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bunny.obj")
 }
 
 fn check(medium: Medium, cases: &[(Shape, Tolerance)], seed0: u64) {
@@ -216,12 +213,7 @@ fn shapes_corrected_refractive_albedo_0_99() {
 /// `../shared/assets/bunny.obj`; skipped with a note where it is absent, and an error in CI.
 #[test]
 fn shapes_corrected_bunny() {
-    if !bunny_path().is_file() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "shared asset `../shared/assets/bunny.obj` is missing in CI"
-        );
-        eprintln!("note: `../shared/assets/bunny.obj` is absent: test skipped");
+    if shared_bunny().is_none() {
         return;
     }
     for (k, medium) in Medium::COLUMNS.iter().enumerate() {

@@ -35,3 +35,23 @@ pub fn sone(samples: u32, averaging: Averaging) -> Method {
         .with_estimator_samples(Some(samples))
         .with_averaging(Some(averaging))
 }
+
+/// The shared asset `../shared/assets/bunny.obj` (used by path, never copied), or `None` with
+/// a note when it is absent, so that a test can skip itself; absent in CI is an error.
+pub fn shared_bunny() -> Option<std::path::PathBuf> {
+    let path = bunny_path();
+    if path.is_file() {
+        return Some(path);
+    }
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "shared asset `../shared/assets/bunny.obj` is missing in CI"
+    );
+    eprintln!("note: `../shared/assets/bunny.obj` is absent: test skipped");
+    None
+}
+
+/// `../shared/assets/bunny.obj` beside the repository's root, whether it is there or not.
+pub fn bunny_path() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bunny.obj")
+}

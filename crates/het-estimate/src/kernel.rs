@@ -51,7 +51,7 @@ use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
-use crate::known::{Known, sanitise};
+use crate::known::Known;
 use crate::prefilter::{Averaging, Flatness};
 use crate::region_average::Probe;
 use crate::sampler::UniformSource;
@@ -311,24 +311,18 @@ where
     for k in 0..n {
         let p = proposal.sample(set.unit_square(k as u32));
         let origin = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
-        let at_point = if in_plane {
-            probe.field.averaged_at_point(origin)
+        let in_plane_value = if in_plane {
+            probe.lookup_at_point(origin)
         } else {
             None
         };
-        let found = match at_point {
-            Some(c) => {
-                probe.diag.lookups += 1;
-                Some(sanitise(c))
-            }
-            None => {
-                probe.diag.projections += 1;
-                probe
-                    .surface
-                    .project(origin, chord.normal)
-                    .map(|hit| probe.lookup(&hit))
-            }
-        };
+        let found = in_plane_value.or_else(|| {
+            probe.diag.projections += 1;
+            probe
+                .surface
+                .project(origin, chord.normal)
+                .map(|hit| probe.lookup(&hit))
+        });
         let c = match found {
             Some(c) => c,
             None => {

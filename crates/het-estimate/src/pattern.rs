@@ -16,23 +16,25 @@ pub trait BinaryPattern {
     fn select(&self, x: f64, y: f64) -> usize;
 }
 
-/// Parity (0 or 1) of ⌊x⌋ + ⌊y⌋, for the values of a pattern's cell coordinates.
+/// ⌊v⌋ as an `i64` for |v| < 2⁵², `None` beyond (where every `f64` is already an integer)
+/// and for NaN.
 ///
-/// Through `i64` rather than `floor` and `rem_euclid`, which are library calls on the
-/// baseline x86-64 target and cost as much as the rest of a lookup. Beyond 2⁵² every `f64` is
-/// an integer (and beyond 2⁵³ an even one), so `⌊x⌋ = x` there; such coordinates, and NaN,
-/// take the slow exact path.
-/// ⌊v⌋ through `i64` below 2⁵² (see [`parity_of_floors`] for why), `f64::floor` beyond and
-/// for NaN. Equal to `v.floor()` for every `v`.
+/// Through `i64` rather than `floor` and `rem_euclid`, which are library calls on the baseline
+/// x86-64 target and cost as much as the rest of a pattern lookup.
+#[inline]
+fn floor_i64(v: f64) -> Option<i64> {
+    const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
+    (v.abs() < EXACT).then(|| {
+        let i = v as i64;
+        if (i as f64) > v { i - 1 } else { i }
+    })
+}
+
+/// ⌊v⌋, equal to `v.floor()` for every `v`, without the library call below 2⁵²
+/// ([`floor_i64`]).
 #[inline]
 pub(crate) fn fast_floor(v: f64) -> f64 {
-    const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
-    if v.abs() < EXACT {
-        let i = v as i64;
-        (if (i as f64) > v { i - 1 } else { i }) as f64
-    } else {
-        v.floor()
-    }
+    floor_i64(v).map_or_else(|| v.floor(), |i| i as f64)
 }
 
 /// Whether the integer-valued `k` is odd, without `rem_euclid` (a library call): `k − 2⌊k/2⌋`.
@@ -41,17 +43,20 @@ pub(crate) fn is_odd(k: f64) -> bool {
     k - 2.0 * fast_floor(0.5 * k) == 1.0
 }
 
+/// The first odd integer at or after the integer-valued `k`.
+#[inline]
+pub(crate) fn first_odd(k: f64) -> f64 {
+    if is_odd(k) { k } else { k + 1.0 }
+}
+
+/// Parity (0 or 1) of ⌊x⌋ + ⌊y⌋, for the values of a pattern's cell coordinates: through
+/// [`floor_i64`]; coordinates beyond 2⁵² (integers, and beyond 2⁵³ even ones) and NaN take the
+/// slow exact path.
 #[inline]
 fn parity_of_floors(x: f64, y: f64) -> usize {
-    const EXACT: f64 = 4_503_599_627_370_496.0; // 2^52
-    if x.abs() < EXACT && y.abs() < EXACT {
-        let floor = |v: f64| {
-            let i = v as i64;
-            if (i as f64) > v { i - 1 } else { i }
-        };
-        ((floor(x) + floor(y)) & 1) as usize
-    } else {
-        ((x.floor() + y.floor()).rem_euclid(2.0) as usize) & 1
+    match (floor_i64(x), floor_i64(y)) {
+        (Some(i), Some(j)) => ((i + j) & 1) as usize,
+        _ => ((x.floor() + y.floor()).rem_euclid(2.0) as usize) & 1,
     }
 }
 
@@ -141,6 +146,8 @@ mod tests {
         assert!(fast_floor(f64::NAN).is_nan());
         for k in -9i64..=9 {
             assert_eq!(is_odd(k as f64), k.rem_euclid(2) == 1, "{k}");
+            let f = first_odd(k as f64);
+            assert!(is_odd(f) && f - k as f64 <= 1.0 && f >= k as f64, "{k}");
         }
     }
 

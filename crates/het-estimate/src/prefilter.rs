@@ -20,7 +20,9 @@
 //!   with `h = |Mᵀĝ|` and `z` distributed as the weight's 1-D marginal. The fraction of the
 //!   weight in value 1 is a sum of marginal-CDF differences over the bands that `[u_c − h,
 //!   u_c + h]` meets: O(1 + h/w).
-//! * Check: the area of the footprint in each odd cell is the area of the unit disk inside the
+//! * Check: value 1 is a + b − 2ab with a, b the parities of the cell's column and row. The
+//!   means of a and b are band fractions along x and y (as for stripes); the mean of ab is the
+//!   area of the footprint in the odd-odd cells, each the area of the unit disk inside the
 //!   cell's parallelogram image, exact by the polygon–circle formula (signed areas of the disk
 //!   inside the triangles spanned by the centre and each edge): O((1 + extent/w)²).
 //!
@@ -32,7 +34,7 @@ use glam::{DVec2, DVec3};
 
 use crate::ellipse::PlanarEllipse;
 use crate::names::Named;
-use crate::pattern::{BinaryPattern, Check, Stripe, fast_floor, is_odd};
+use crate::pattern::{BinaryPattern, Check, Stripe, fast_floor, first_odd, is_odd};
 
 /// Most stripe bands or check cells a closed form visits before it declines (`None`).
 pub const MAX_CELLS: usize = 4096;
@@ -186,34 +188,54 @@ pub fn stripe_fraction(stripe: &Stripe, fp: &PlaneFootprint) -> Option<f64> {
         return None;
     }
     let (sin, cos) = stripe.angle.sin_cos();
-    odd_band_fraction(fp, DVec2::new(cos, sin), stripe.width)
-        .map(|f| f.unwrap_or_else(|| stripe.select(fp.centre.x, fp.centre.y) as f64))
+    let bands = Bands::of(fp, DVec2::new(cos, sin), stripe.width);
+    (bands.count() <= MAX_CELLS as f64).then(|| bands.odd_fraction(fp))
 }
 
-/// The weighted fraction of `fp` in the odd bands along unit direction `g`, band k being
-/// `(k − ½) w ≤ g·p < (k + ½) w`: `Some(None)` when `fp` lies in one band (the caller knows
-/// its value), `None` beyond [`MAX_CELLS`] bands. The weight's marginal along `g` integrated
-/// band by band.
-fn odd_band_fraction(fp: &PlaneFootprint, g: DVec2, w: f64) -> Option<Option<f64>> {
-    let u_c = g.dot(fp.centre);
-    let h = fp.half_extent(g);
-    let band = |u: f64| fast_floor(u / w + 0.5);
-    let (k0, k1) = (band(u_c - h), band(u_c + h));
-    if k1 - k0 >= MAX_CELLS as f64 {
-        return None;
+/// The bands `(k − ½) w ≤ g·p < (k + ½) w` (unit direction `g`) that a footprint meets:
+/// `first..=last`, with the footprint's centre `u_c` and half extent `h` along `g`.
+struct Bands {
+    u_c: f64,
+    h: f64,
+    w: f64,
+    first: f64,
+    last: f64,
+}
+
+impl Bands {
+    fn of(fp: &PlaneFootprint, g: DVec2, w: f64) -> Self {
+        let (u_c, h) = (g.dot(fp.centre), fp.half_extent(g));
+        let band = |u: f64| fast_floor(u / w + 0.5);
+        Self {
+            u_c,
+            h,
+            w,
+            first: band(u_c - h),
+            last: band(u_c + h),
+        }
     }
-    if k0 == k1 || h == 0.0 {
-        return Some(None);
+
+    /// How many bands the footprint meets.
+    fn count(&self) -> f64 {
+        self.last - self.first + 1.0
     }
-    let cdf = |u: f64| fp.weight.marginal_cdf((u - u_c) / h);
-    let mut ones = 0.0;
-    // The first odd band at or after k0.
-    let mut k = if is_odd(k0) { k0 } else { k0 + 1.0 };
-    while k <= k1 {
-        ones += cdf((k + 0.5) * w) - cdf((k - 0.5) * w);
-        k += 2.0;
+
+    /// The weighted fraction of `fp` (the footprint the bands were found for) in odd bands:
+    /// the weight's marginal along `g` integrated band by band; the parity of the one band
+    /// that holds the whole footprint.
+    fn odd_fraction(&self, fp: &PlaneFootprint) -> f64 {
+        if self.first == self.last || self.h == 0.0 {
+            return if is_odd(self.first) { 1.0 } else { 0.0 };
+        }
+        let cdf = |u: f64| fp.weight.marginal_cdf((u - self.u_c) / self.h);
+        let mut ones = 0.0;
+        let mut k = first_odd(self.first);
+        while k <= self.last {
+            ones += cdf((k + 0.5) * self.w) - cdf((k - 0.5) * self.w);
+            k += 2.0;
+        }
+        ones.clamp(0.0, 1.0)
     }
-    Some(Some(ones.clamp(0.0, 1.0)))
 }
 
 /// The area fraction of `fp` where `check` selects value 1 (in [0, 1]); uniform weight only.
@@ -240,33 +262,27 @@ pub fn check_fraction(check: &Check, fp: &PlaneFootprint) -> Option<f64> {
         return None;
     }
     let w = check.width;
-    let (hx, hy) = (fp.half_extent(DVec2::X), fp.half_extent(DVec2::Y));
-    let cell = |v: f64| fast_floor(v / w + 0.5);
-    let (i0, i1) = (cell(fp.centre.x - hx), cell(fp.centre.x + hx));
-    let (j0, j1) = (cell(fp.centre.y - hy), cell(fp.centre.y + hy));
-    if (i1 - i0 + 1.0) * (j1 - j0 + 1.0) > MAX_CELLS as f64 {
+    // Columns i (bands along x) and rows j (along y).
+    let (cols, rows) = (Bands::of(fp, DVec2::X, w), Bands::of(fp, DVec2::Y, w));
+    if cols.count() * rows.count() > MAX_CELLS as f64 {
         return None;
     }
-    if i0 == i1 && j0 == j1 {
+    if cols.count() == 1.0 && rows.count() == 1.0 {
         return Some(check.select(fp.centre.x, fp.centre.y) as f64);
     }
-    let odd = is_odd;
-    // In one column (row) the band fraction is 0 or 1: that column's parity.
-    let f_a = odd_band_fraction(fp, DVec2::X, w)?.unwrap_or(if odd(i0) { 1.0 } else { 0.0 });
-    let f_b = odd_band_fraction(fp, DVec2::Y, w)?.unwrap_or(if odd(j0) { 1.0 } else { 0.0 });
+    let (f_a, f_b) = (cols.odd_fraction(fp), rows.odd_fraction(fp));
     // Unit-disk coordinates of a pattern point: M⁻¹ (p − c).
     let inv = |p: DVec2| {
         let d = p - fp.centre;
         DVec2::new(d.perp_dot(fp.axis_v), fp.axis_u.perp_dot(d)) / det
     };
     let cell_area = w * w / det.abs();
-    let first_odd = |k: f64| if odd(k) { k } else { k + 1.0 };
     let mut both = 0.0;
-    let mut i = first_odd(i0);
-    while i <= i1 {
+    let mut i = first_odd(cols.first);
+    while i <= cols.last {
         let (x0, x1) = ((i - 0.5) * w, (i + 0.5) * w);
-        let mut j = first_odd(j0);
-        while j <= j1 {
+        let mut j = first_odd(rows.first);
+        while j <= rows.last {
             let (y0, y1) = ((j - 0.5) * w, (j + 0.5) * w);
             let quad = [
                 inv(DVec2::new(x0, y0)),

@@ -225,6 +225,16 @@ where
         sanitise(self.field.averaged(p))
     }
 
+    /// [`Probe::lookup`] at a point of space, for fields defined there
+    /// ([`CoefficientField::averaged_at_point`]); `None`, uncounted, where the field has no
+    /// value without a surface point.
+    #[inline]
+    pub fn lookup_at_point(&mut self, x: DVec3) -> Option<Coefficients> {
+        let c = self.field.averaged_at_point(x)?;
+        self.diag.lookups += 1;
+        Some(sanitise(c))
+    }
+
     /// The coefficients of a mean in the averaging space
     /// ([`CoefficientField::coefficients_of_mean`]); the mean itself, at no cost, for fields
     /// that average their coefficients.

@@ -227,9 +227,7 @@ impl AngularData {
                 p_se,
             });
         }
-        if !r.0.is_empty() {
-            return Err(TableFileError("trailing bytes"));
-        }
+        r.finish()?;
         Ok(Self {
             seed,
             photons,

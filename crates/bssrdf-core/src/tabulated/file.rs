@@ -244,9 +244,7 @@ impl TableData {
                 total_se,
             });
         }
-        if !r.0.is_empty() {
-            return Err(TableFileError("trailing bytes"));
-        }
+        r.finish()?;
         Ok(Self {
             seed,
             photons,
@@ -271,6 +269,15 @@ fn header<'a>(dims: &'a [usize], etas: &'a [f64]) -> Header<'a> {
 pub(crate) struct Reader<'a>(pub(crate) &'a [u8]);
 
 impl<'a> Reader<'a> {
+    /// The end of the data: an error if any bytes are left over.
+    pub(crate) fn finish(self) -> Result<(), TableFileError> {
+        if self.0.is_empty() {
+            Ok(())
+        } else {
+            Err(TableFileError("trailing bytes"))
+        }
+    }
+
     pub(crate) fn take(&mut self, n: usize) -> Result<&'a [u8], TableFileError> {
         if self.0.len() < n {
             return Err(TableFileError("truncated"));

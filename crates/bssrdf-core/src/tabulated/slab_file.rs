@@ -285,9 +285,7 @@ impl SlabData {
                 });
             }
         }
-        if !r.0.is_empty() {
-            return Err(TableFileError("trailing bytes"));
-        }
+        r.finish()?;
         Ok(Self {
             seed,
             photons,

@@ -308,15 +308,7 @@ pub(crate) fn facing_normal(hit: &Hit, w: DVec3) -> Option<DVec3> {
 pub(crate) fn thickness(surface: &ObjectSurface<'_>, hit: &Hit) -> f64 {
     if let Some(extent) = surface.geometry.object_box_extent(surface.object) {
         // A box's shading normal is its face's axis (`TriangleMesh::box_extent`).
-        let n = hit.ns.abs();
-        let axis = if n.x >= n.y && n.x >= n.z {
-            0
-        } else if n.y >= n.z {
-            1
-        } else {
-            2
-        };
-        return extent[axis];
+        return extent[hit.ns.abs().max_position()];
     }
     thickness_by_ray(surface, hit)
 }
