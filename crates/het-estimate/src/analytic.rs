@@ -284,6 +284,24 @@ mod tests {
         assert!(Plane.project(DVec3::ONE, DVec3::X).is_none());
     }
 
+    /// A field behind a reference keeps its optional capabilities (an estimator handed
+    /// `&field` must not lose the point lookup or the closed forms).
+    #[test]
+    fn a_reference_answers_as_its_field() {
+        let field = PatternField {
+            pattern: Check { width: 4.0 },
+            values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
+        };
+        let by_ref = &field;
+        let x = DVec3::new(2.5, -1.0, 0.3);
+        assert!(CoefficientField::<PlanePoint>::has_point_lookup(&by_ref));
+        assert_eq!(
+            CoefficientField::<PlanePoint>::averaged_at_point(&by_ref, x),
+            CoefficientField::<PlanePoint>::averaged_at_point(&field, x)
+        );
+        assert!(CoefficientField::<PlanePoint>::has_ellipse_average(&by_ref));
+    }
+
     #[test]
     fn field_bounds() {
         let lo = Coefficients::grey(0.005, 1.0);

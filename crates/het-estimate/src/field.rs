@@ -181,4 +181,11 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     fn averages_coefficients(&self) -> bool {
         (**self).averages_coefficients()
     }
+    #[inline]
+    fn averaged_at_point(&self, x: glam::DVec3) -> Option<Coefficients> {
+        (**self).averaged_at_point(x)
+    }
+    fn has_point_lookup(&self) -> bool {
+        (**self).has_point_lookup()
+    }
 }

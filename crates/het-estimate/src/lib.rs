@@ -86,4 +86,4 @@ pub use sampler::SplitMix64;
 pub use sampler::UniformSource;
 pub use segment::SegmentParams;
 pub use sone::{SoneParams, WidthScattering};
-pub use surface::{SurfacePoint, SurfaceQuery};
+pub use surface::{Projected, SurfacePoint, SurfaceQuery};

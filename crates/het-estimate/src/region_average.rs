@@ -10,7 +10,7 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::known::sanitise;
 use crate::sampler::UniformSource;
 use crate::sampling::PointSet;
-use crate::surface::{SurfacePoint, SurfaceQuery};
+use crate::surface::{Projected, SurfacePoint, SurfaceQuery};
 
 /// Per-channel selection weights (1 = this channel takes the sample, 0 = it does not).
 pub(crate) type Channels = Rgb;
@@ -304,19 +304,40 @@ where
         acc: &mut Accumulator,
     ) {
         self.diag.projections += 1;
+        // Fields defined in space need only the position, which some surfaces give without
+        // building a point.
+        if self.field.has_point_lookup() {
+            match self.surface.project_position(origin, dir) {
+                Projected::At(x) => {
+                    if let Some(c) = self.lookup_at_point(x) {
+                        acc.add(&c, channels);
+                        return;
+                    }
+                }
+                Projected::Miss => {
+                    self.miss(channels, miss_endpoints, acc);
+                    return;
+                }
+                Projected::Undecided => {}
+            }
+        }
         match self.surface.project(origin, dir) {
             Some(hit) => {
                 debug_assert!(hit.position().is_finite());
                 let c = self.lookup(&hit);
                 acc.add(&c, channels);
             }
-            None => {
-                self.diag.misses += 1;
-                if miss_endpoints {
-                    let c = self.endpoints();
-                    acc.add(&c, channels);
-                }
-            }
+            None => self.miss(channels, miss_endpoints, acc),
+        }
+    }
+
+    /// A projection that found nothing: counted, and the endpoint mean added under
+    /// [`crate::MissPolicy::Endpoints`].
+    fn miss(&mut self, channels: Channels, miss_endpoints: bool, acc: &mut Accumulator) {
+        self.diag.misses += 1;
+        if miss_endpoints {
+            let c = self.endpoints();
+            acc.add(&c, channels);
         }
     }
 }

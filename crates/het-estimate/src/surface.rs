@@ -36,11 +36,38 @@ pub trait SurfaceQuery {
     /// vector: the normal of the averaging plane), and returns the nearer hit on the object
     /// being shaded; `None` when neither ray hits it (paper §3.2, Figure 3).
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point>;
+
+    /// Optional capability: where [`SurfaceQuery::project`]'s hit lies, when the surface can
+    /// say it without building a point (an analytic shape, such as a box, whose crossing is a
+    /// plane equation rather than a traversal). The estimators ask it for fields defined in
+    /// space ([`crate::CoefficientField::averaged_at_point`]), which need no more than the
+    /// position, and call `project` on [`Projected::Undecided`]. The position may sit a
+    /// rounding-sized step inside the surface, so that a face lying on a texture's cell
+    /// boundary reads the medium behind it. The default is always `Undecided`.
+    #[inline]
+    fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
+        let _ = (origin, dir);
+        Projected::Undecided
+    }
+}
+
+/// The answer of [`SurfaceQuery::project_position`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Projected {
+    /// The position of the nearer hit, scene units.
+    At(DVec3),
+    /// Neither ray hits the object.
+    Miss,
+    /// Not known without [`SurfaceQuery::project`].
+    Undecided,
 }
 
 impl<S: SurfaceQuery + ?Sized> SurfaceQuery for &S {
     type Point = S::Point;
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point> {
         (**self).project(origin, dir)
+    }
+    fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
+        (**self).project_position(origin, dir)
     }
 }

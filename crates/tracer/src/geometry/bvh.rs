@@ -462,60 +462,128 @@ impl Geometry {
 
     /// For an object whose mesh is its own axis-aligned box ([`Geometry::object_box_extent`]):
     /// the crossing of the whole line `origin + t·dir` (unit `dir`, `t` of either sign) nearest
-    /// to `origin`, the projection of Sone's estimators. The box's planes say where the line
-    /// enters and leaves it, so one ray over a short window around the nearer of the two
-    /// finds the triangle, where a general mesh needs a ray each way. `Some(None)`: the line
-    /// misses the box by a clear margin. `None`: not a box, or a case the planes do not settle
-    /// (the line grazes an edge or face, the origin lies on the surface or halfway between
-    /// the crossings, or the window finds no triangle): the caller traces the two rays.
-    /// The hit is the ray's own (the same `t`, point and normals as the two-ray projection's).
-    pub fn project_onto_box(&self, object: u32, origin: DVec3, dir: DVec3) -> Option<Option<Hit>> {
+    /// to `origin`, the projection of Sone's estimators, found from the box's planes alone.
+    /// [`BoxProjection::Undecided`]: not a box, or a case the planes do not settle within the
+    /// margin of the mesh's f32 triangles (the line grazes an edge or face, or the origin lies
+    /// halfway between the two crossings). An origin on the surface (|t| within the margin) is
+    /// a crossing here; tracing it is left to the caller.
+    fn box_crossing(&self, object: u32, origin: DVec3, dir: DVec3) -> BoxProjection<BoxCrossing> {
         let o = &self.objects[object as usize];
-        let extent = o.box_extent?;
+        let Some(extent) = o.box_extent else {
+            return BoxProjection::Undecided;
+        };
         let (lo, hi) = (o.lo, o.hi);
         // Margin (length): far above the f32 precision of the object's triangles (about 1e-7
         // of the extent) and of the origin.
         let m = 1e-5 * extent.max_element() + 1e-9 * origin.abs().max_element();
         let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+        let (mut axis_in, mut axis_out) = (0, 0);
         for a in 0..3 {
             if dir[a].abs() < 1e-12 {
                 // Parallel to this pair of planes: inside them, or a clear miss.
                 if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
-                    return Some(None);
+                    return BoxProjection::Miss;
                 }
                 if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
-                    return None;
+                    return BoxProjection::Undecided;
                 }
                 continue;
             }
             let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
-            t_in = t_in.max(t1.min(t2));
-            t_out = t_out.min(t1.max(t2));
+            if t1.min(t2) > t_in {
+                (t_in, axis_in) = (t1.min(t2), a);
+            }
+            if t1.max(t2) < t_out {
+                (t_out, axis_out) = (t1.max(t2), a);
+            }
         }
         if !(t_in.is_finite() && t_out.is_finite()) {
-            return None;
+            return BoxProjection::Undecided;
         }
         if t_in > t_out + m {
-            return Some(None);
+            return BoxProjection::Miss;
         }
         if t_out - t_in < 4.0 * m {
-            return None;
+            return BoxProjection::Undecided;
         }
-        let (near, far) = if t_in.abs() <= t_out.abs() {
-            (t_in, t_out)
+        let (near, far, axis, entering) = if t_in.abs() <= t_out.abs() {
+            (t_in, t_out, axis_in, true)
         } else {
-            (t_out, t_in)
+            (t_out, t_in, axis_out, false)
         };
-        if near.abs() <= m || far.abs() - near.abs() <= 2.0 * m {
-            return None;
+        if far.abs() - near.abs() <= 2.0 * m {
+            return BoxProjection::Undecided;
         }
-        let (d, t) = if near > 0.0 {
-            (dir, near)
+        // The line leaves the box along `dir` through the face whose outward normal has the
+        // sign of dir[axis]; it enters through the opposite one.
+        let sign = if (dir[axis] > 0.0) != entering {
+            1.0
         } else {
-            (-dir, -near)
+            -1.0
         };
-        self.intersect_object(object, &Ray::with_range(origin, d, t - m, t + m))
-            .map(Some)
+        BoxProjection::At(BoxCrossing {
+            t: near,
+            margin: m,
+            axis,
+            sign,
+            plane: if sign > 0.0 { hi[axis] } else { lo[axis] },
+            lo,
+            hi,
+        })
+    }
+
+    /// [`Geometry::box_crossing`] traced: one ray over a short window around the nearer
+    /// crossing finds the triangle, where a general mesh needs a ray each way. The hit is the
+    /// ray's own (the same `t`, point and normals as the two-ray projection's);
+    /// [`BoxProjection::Undecided`] also for an origin on the surface and when the window
+    /// finds no triangle.
+    pub fn project_onto_box(&self, object: u32, origin: DVec3, dir: DVec3) -> BoxProjection<Hit> {
+        let c = match self.box_crossing(object, origin, dir) {
+            BoxProjection::At(c) => c,
+            BoxProjection::Miss => return BoxProjection::Miss,
+            BoxProjection::Undecided => return BoxProjection::Undecided,
+        };
+        // An origin on the surface: a window about t = 0 would need rays both ways.
+        if c.t.abs() <= c.margin {
+            return BoxProjection::Undecided;
+        }
+        let (d, t) = if c.t > 0.0 { (dir, c.t) } else { (-dir, -c.t) };
+        match self.intersect_object(
+            object,
+            &Ray::with_range(origin, d, t - c.margin, t + c.margin),
+        ) {
+            Some(hit) => BoxProjection::At(hit),
+            None => BoxProjection::Undecided,
+        }
+    }
+
+    /// [`Geometry::box_crossing`] without a ray: the point where the line crosses the box's
+    /// face, computed from the planes in f64, moved inward by a hair (1e-9 of the coordinates'
+    /// magnitude, far below any texture's scale), with the crossing face's outward normal.
+    /// The hair matters where a face lies on a cell boundary of a field (the checker slab's
+    /// sides): the point then reads the medium behind the face, as the path tracer's volume
+    /// does, rather than whichever side rounding picks. An origin on the surface (the points
+    /// of an averaging ellipse that lies in a face) projects to itself, as the rays find. No
+    /// triangle is found, so there are no texture coordinates: for fields defined in space
+    /// only.
+    pub fn project_position_onto_box(
+        &self,
+        object: u32,
+        origin: DVec3,
+        dir: DVec3,
+    ) -> BoxProjection<(DVec3, DVec3)> {
+        let c = match self.box_crossing(object, origin, dir) {
+            BoxProjection::At(c) => c,
+            BoxProjection::Miss => return BoxProjection::Miss,
+            BoxProjection::Undecided => return BoxProjection::Undecided,
+        };
+        let mut p = (origin + c.t * dir).clamp(c.lo, c.hi);
+        p[c.axis] = c.plane;
+        let hair = 1e-9 * (1.0 + p.abs().max_element());
+        p[c.axis] -= c.sign * hair;
+        let mut n = DVec3::ZERO;
+        n[c.axis] = c.sign;
+        BoxProjection::At((p, n))
     }
 
     /// The closest intersection with `object`'s triangles in `[ray.t_min, ray.t_max]`.
@@ -681,6 +749,34 @@ impl CrossingBuf {
         s.sort_unstable_by(|a, b| a.t.total_cmp(&b.t));
         s
     }
+}
+
+/// What the planes of a box say about a projection ([`Geometry::project_onto_box`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BoxProjection<T> {
+    /// The nearer crossing.
+    At(T),
+    /// The line misses the box by a clear margin.
+    Miss,
+    /// Not a box, or a case the planes do not settle: trace the two rays.
+    Undecided,
+}
+
+/// The nearer crossing of a line with a box ([`Geometry::box_crossing`]).
+#[derive(Debug, Clone, Copy)]
+struct BoxCrossing {
+    /// Signed distance along the line.
+    t: f64,
+    /// The margin the crossing was settled with (length).
+    margin: f64,
+    /// The axis of the crossed face, and the sign of its outward normal on that axis.
+    axis: usize,
+    sign: f64,
+    /// The face's coordinate on `axis`.
+    plane: f64,
+    /// The box.
+    lo: DVec3,
+    hi: DVec3,
 }
 
 #[cfg(test)]

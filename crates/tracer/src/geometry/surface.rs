@@ -2,7 +2,9 @@
 
 use glam::DVec3;
 
-use super::{Geometry, Hit, Ray};
+use het_estimate::Projected;
+
+use super::{BoxProjection, Geometry, Hit, Ray};
 
 /// The surface of one object of a [`Geometry`], as the estimators see it.
 #[derive(Debug, Clone, Copy)]
@@ -30,10 +32,25 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
     #[inline]
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         // A box: one ray where its planes say the nearer crossing is.
-        if let Some(hit) = self.geometry.project_onto_box(self.object, origin, dir) {
-            return hit;
+        match self.geometry.project_onto_box(self.object, origin, dir) {
+            BoxProjection::At(hit) => Some(hit),
+            BoxProjection::Miss => None,
+            BoxProjection::Undecided => self.project_by_rays(origin, dir),
         }
-        self.project_by_rays(origin, dir)
+    }
+
+    /// On an object that is its own axis-aligned box, the crossing from the box's planes,
+    /// without a ray ([`Geometry::project_position_onto_box`]); `Undecided` on other meshes.
+    #[inline]
+    fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
+        match self
+            .geometry
+            .project_position_onto_box(self.object, origin, dir)
+        {
+            BoxProjection::At((p, _)) => Projected::At(p),
+            BoxProjection::Miss => Projected::Miss,
+            BoxProjection::Undecided => Projected::Undecided,
+        }
     }
 }
 
@@ -61,13 +78,14 @@ mod tests {
     use het_estimate::{SurfacePoint, SurfaceQuery};
 
     /// On boxes the one-ray projection finds what the two rays find: the same hit or none,
-    /// for lines from inside, outside and near the surface, in every direction.
+    /// for lines from inside, outside and near the surface, in every direction; and so does
+    /// the position from the planes alone, a hair inside the face.
     #[test]
     fn box_projection_equals_the_two_rays() {
         let (lo, hi) = (DVec3::new(-3.0, 1.0, -2.0), DVec3::new(4.0, 2.5, 0.0));
         let g = Geometry::build(vec![primitives::subdivided_cuboid(lo, hi, [4, 2, 3])]);
         let s = ObjectSurface::new(&g, 0);
-        let (mut fast, mut hits) = (0, 0);
+        let (mut fast, mut hits, mut positions) = (0, 0, 0);
         for k in 0..4000 {
             let t = k as f64;
             let u = DVec3::new((0.37 * t).sin(), (0.71 * t).cos(), (1.13 * t).sin());
@@ -86,7 +104,27 @@ mod tests {
             };
             let want = s.project_by_rays(origin, dir);
             let got = s.project(origin, dir);
-            fast += usize::from(g.project_onto_box(0, origin, dir).is_some());
+            // The position from the planes: the ray's hit to f32 precision, a hair inside the
+            // crossed face, with its outward normal; a miss where the rays miss.
+            match (g.project_position_onto_box(0, origin, dir), want) {
+                (BoxProjection::At((p, n)), Some(b)) => {
+                    positions += 1;
+                    assert!(
+                        (p - b.p).length() <= 1e-5,
+                        "line {k}: {p:?} against {:?}",
+                        b.p
+                    );
+                    assert_eq!(n, b.ng, "line {k}");
+                    let a = n.abs().max_position();
+                    let face = if n[a] > 0.0 { hi[a] } else { lo[a] };
+                    let inside = (face - p[a]) * n[a];
+                    assert!(inside > 0.0 && inside < 1e-7, "line {k}: {inside}");
+                    assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "line {k}: {p:?}");
+                }
+                (BoxProjection::Miss, None) | (BoxProjection::Undecided, _) => {}
+                (got, want) => panic!("line {k}: {got:?} against {want:?}"),
+            }
+            fast += usize::from(g.project_onto_box(0, origin, dir) != BoxProjection::Undecided);
             match (got, want) {
                 (Some(a), Some(b)) => {
                     hits += 1;
@@ -102,9 +140,13 @@ mod tests {
             }
         }
         assert!(hits > 800 && fast > 3500, "{hits} hits, {fast} by the box");
+        assert!(positions > hits * 9 / 10, "{positions} of {hits}");
         // Not a box: no shortcut.
         let sphere = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 1.0, 2)]);
-        assert!(sphere.project_onto_box(0, DVec3::ZERO, DVec3::Z).is_none());
+        assert_eq!(
+            sphere.project_onto_box(0, DVec3::ZERO, DVec3::Z),
+            BoxProjection::Undecided
+        );
     }
 
     #[test]
@@ -123,5 +165,80 @@ mod tests {
         assert!((h.position().z + 1.0).abs() < 1e-12);
         // Outside the slab's footprint: no hit.
         assert!(s.project(DVec3::new(7.0, 0.0, 0.0), DVec3::Z).is_none());
+    }
+
+    /// Sone's Monte Carlo averages on a box are the same whether each point is projected by a
+    /// ray or placed by the box's planes (a field defined in space, its cell boundaries off the
+    /// faces): the same points, so the same values, to the bit, for pairs on one face and
+    /// across edges. Placing the points on the farther crossing, or off the surface by a
+    /// texture cell, would change them.
+    #[test]
+    fn sone_on_a_box_reads_the_same_values_without_rays() {
+        use crate::field::{Axis, Field, MediumField, PlanarProjection};
+        use crate::rng::Rng;
+        use het_estimate::{Averaging, Estimator, SoneParams};
+
+        /// The same surface with only `project`: every point by rays.
+        struct ByRays<'a>(ObjectSurface<'a>);
+        impl SurfaceQuery for ByRays<'_> {
+            type Point = Hit;
+            fn project(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
+                self.0.project(origin, dir)
+            }
+        }
+
+        let (lo, hi) = (DVec3::new(-10.0, -10.0, -10.0), DVec3::new(10.0, 10.0, 0.0));
+        let g = Geometry::build(vec![primitives::cuboid(lo, hi)]);
+        let planes = ObjectSurface::new(&g, 0);
+        let rays = ByRays(planes);
+        let check = Field::check(
+            4.0,
+            [bssrdf_core::Rgb::splat(0.005), bssrdf_core::Rgb::splat(0.1)],
+            PlanarProjection::new(Axis::Z, DVec3::new(0.37, -0.61, 0.0)),
+        )
+        .unwrap();
+        let field = MediumField::new(check, Field::constant(bssrdf_core::Rgb::ONE).unwrap());
+        let sone = Estimator::Sone(SoneParams::paper().with_averaging(Averaging::MonteCarlo))
+            .prepare(0.0, 1.0)
+            .unwrap();
+        let mut rng = Rng::from_keys(5, &[]);
+        // Points on the top face and on the +x side, up to 8 apart.
+        let on_box = |rng: &mut Rng| {
+            let (u, v) = (rng.uniform(), rng.uniform());
+            let (origin, dir) = if rng.uniform() < 0.5 {
+                (DVec3::new(6.0 + 4.0 * u, -4.0 + 8.0 * v, 5.0), DVec3::NEG_Z)
+            } else {
+                (DVec3::new(15.0, -4.0 + 8.0 * v, -8.0 * u), DVec3::NEG_X)
+            };
+            g.intersect(&Ray::new(origin, dir)).unwrap()
+        };
+        let (mut across, mut lookups, mut planes_rays) = (0, 0, 0);
+        for k in 0..300 {
+            let (x_i, x_o) = (on_box(&mut rng), on_box(&mut rng));
+            across += usize::from(x_i.ns != x_o.ns);
+            let (mut r1, mut r2) = (Rng::from_keys(k, &[]), Rng::from_keys(k, &[]));
+            let before = g.rays_traced();
+            let a = sone.estimate(&planes, &field, &x_i, &x_o, &mut r1);
+            planes_rays += g.rays_traced() - before;
+            let b = sone.estimate(&rays, &field, &x_i, &x_o, &mut r2);
+            assert_eq!(a.coefficients, b.coefficients, "pair {k}");
+            let (da, db) = (a.diagnostics, b.diagnostics);
+            assert_eq!(
+                (da.projections, da.misses, da.lookups),
+                (db.projections, db.misses, db.lookups),
+                "pair {k}"
+            );
+            lookups += da.lookups;
+        }
+        assert!(
+            across > 100 && lookups > 10_000,
+            "{across} pairs across, {lookups} lookups"
+        );
+        // The planes settle nearly every point: a ray only where a line grazes an edge.
+        assert!(
+            planes_rays * 1000 < lookups as u64,
+            "{planes_rays} rays, {lookups} lookups, {:?}",
+            g.object_box_extent(0)
+        );
     }
 }
