@@ -129,8 +129,13 @@ where
         SampleBudget::TargetRelError { max: n, .. } | SampleBudget::Fixed(n) => {
             let set = P::new(rng);
             let mut acc = Accumulator::default();
-            for k in 0..n.get() {
-                sample(set.point(k), &mut acc);
+            for k in (0..n.get() / 2).map(|j| 2 * j) {
+                let [a, b] = set.point_pair(k);
+                sample(a, &mut acc);
+                sample(b, &mut acc);
+            }
+            if n.get() % 2 == 1 {
+                sample(set.point(n.get() - 1), &mut acc);
             }
             Averaged {
                 acc,

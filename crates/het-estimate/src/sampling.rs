@@ -60,6 +60,13 @@ pub trait PointSet: Sized {
     fn new<U: UniformSource + ?Sized>(rng: &mut U) -> Self;
     /// Point `k` of the set.
     fn point(&self, k: u32) -> Self::Point;
+
+    /// Points `k` and `k + 1`, for sets whose points come in pairs that share their work
+    /// (antithetic pairs, `k` even). The same values as two calls of [`PointSet::point`].
+    #[inline]
+    fn point_pair(&self, k: u32) -> [Self::Point; 2] {
+        [self.point(k), self.point(k + 1)]
+    }
 }
 
 /// Randomly shifted R2 points mapped to the unit disk by the concentric map, in antithetic
@@ -94,6 +101,16 @@ impl PointSet for DiskPoints {
     fn point(&self, k: u32) -> DVec2 {
         let u = concentric_disk(self.unit_square(k >> 1));
         if k & 1 == 0 { u } else { -u }
+    }
+    /// One concentric map for both points of an antithetic pair.
+    #[inline]
+    fn point_pair(&self, k: u32) -> [DVec2; 2] {
+        if k & 1 == 0 {
+            let u = concentric_disk(self.unit_square(k >> 1));
+            [u, -u]
+        } else {
+            [self.point(k), self.point(k + 1)]
+        }
     }
 }
 
@@ -176,6 +193,22 @@ mod tests {
         }
         let r = ChiSquareTest::SINGLE.check_uniform(&counts).unwrap();
         assert!(r.passes(), "{r}");
+    }
+
+    /// A pair is the two points, bit for bit, from either parity of k.
+    #[test]
+    fn point_pairs_are_the_points() {
+        let mut rng = SplitMix64::new(23);
+        for _ in 0..50 {
+            let set = DiskPoints::new(&mut rng);
+            for k in 0..64 {
+                assert_eq!(
+                    set.point_pair(k),
+                    [set.point(k), set.point(k + 1)],
+                    "k = {k}"
+                );
+            }
+        }
     }
 
     /// The same test for the points of one set (k = 0..N with a single shift): the

@@ -467,6 +467,7 @@ impl Geometry {
     /// margin of the mesh's f32 triangles (the line grazes an edge or face, or the origin lies
     /// halfway between the two crossings). An origin on the surface (|t| within the margin) is
     /// a crossing here; tracing it is left to the caller.
+    #[inline]
     fn box_crossing(&self, object: u32, origin: DVec3, dir: DVec3) -> BoxProjection<BoxCrossing> {
         let o = &self.objects[object as usize];
         let Some(extent) = o.box_extent else {
@@ -476,27 +477,41 @@ impl Geometry {
         // Margin (length): far above the f32 precision of the object's triangles (about 1e-7
         // of the extent) and of the origin.
         let m = 1e-5 * extent.max_element() + 1e-9 * origin.abs().max_element();
-        let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
-        let (mut axis_in, mut axis_out) = (0, 0);
-        for a in 0..3 {
-            if dir[a].abs() < 1e-12 {
-                // Parallel to this pair of planes: inside them, or a clear miss.
-                if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
-                    return BoxProjection::Miss;
+        let (t_in, axis_in, t_out, axis_out) = if dir.abs().min_element() >= 1e-12 {
+            // The slab test on all three axes at once (the common case).
+            let inv = dir.recip();
+            let (t1, t2) = ((lo - origin) * inv, (hi - origin) * inv);
+            let (near, far) = (t1.min(t2), t1.max(t2));
+            (
+                near.max_element(),
+                near.max_position(),
+                far.min_element(),
+                far.min_position(),
+            )
+        } else {
+            let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+            let (mut axis_in, mut axis_out) = (0, 0);
+            for a in 0..3 {
+                if dir[a].abs() < 1e-12 {
+                    // Parallel to this pair of planes: inside them, or a clear miss.
+                    if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
+                        return BoxProjection::Miss;
+                    }
+                    if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
+                        return BoxProjection::Undecided;
+                    }
+                    continue;
                 }
-                if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
-                    return BoxProjection::Undecided;
+                let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
+                if t1.min(t2) > t_in {
+                    (t_in, axis_in) = (t1.min(t2), a);
                 }
-                continue;
+                if t1.max(t2) < t_out {
+                    (t_out, axis_out) = (t1.max(t2), a);
+                }
             }
-            let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
-            if t1.min(t2) > t_in {
-                (t_in, axis_in) = (t1.min(t2), a);
-            }
-            if t1.max(t2) < t_out {
-                (t_out, axis_out) = (t1.max(t2), a);
-            }
-        }
+            (t_in, axis_in, t_out, axis_out)
+        };
         if !(t_in.is_finite() && t_out.is_finite()) {
             return BoxProjection::Undecided;
         }
@@ -559,19 +574,20 @@ impl Geometry {
 
     /// [`Geometry::box_crossing`] without a ray: the point where the line crosses the box's
     /// face, computed from the planes in f64, moved inward by a hair (1e-9 of the coordinates'
-    /// magnitude, far below any texture's scale), with the crossing face's outward normal.
+    /// magnitude, far below any texture's scale).
     /// The hair matters where a face lies on a cell boundary of a field (the checker slab's
     /// sides): the point then reads the medium behind the face, as the path tracer's volume
     /// does, rather than whichever side rounding picks. An origin on the surface (the points
     /// of an averaging ellipse that lies in a face) projects to itself, as the rays find. No
     /// triangle is found, so there are no texture coordinates: for fields defined in space
     /// only.
+    #[inline]
     pub fn project_position_onto_box(
         &self,
         object: u32,
         origin: DVec3,
         dir: DVec3,
-    ) -> BoxProjection<(DVec3, DVec3)> {
+    ) -> BoxProjection<DVec3> {
         let c = match self.box_crossing(object, origin, dir) {
             BoxProjection::At(c) => c,
             BoxProjection::Miss => return BoxProjection::Miss,
@@ -581,9 +597,7 @@ impl Geometry {
         p[c.axis] = c.plane;
         let hair = 1e-9 * (1.0 + p.abs().max_element());
         p[c.axis] -= c.sign * hair;
-        let mut n = DVec3::ZERO;
-        n[c.axis] = c.sign;
-        BoxProjection::At((p, n))
+        BoxProjection::At(p)
     }
 
     /// The closest intersection with `object`'s triangles in `[ray.t_min, ray.t_max]`.
