@@ -118,10 +118,7 @@ fn estimators() -> Vec<(String, Estimator)> {
 /// The Figure 4 stripe preset.
 fn stripe_preset() -> StripeField {
     StripeField {
-        pattern: Stripe {
-            width: 4.0,
-            angle: std::f64::consts::FRAC_PI_4,
-        },
+        pattern: Stripe::new(4.0, std::f64::consts::FRAC_PI_4),
         values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
     }
 }

@@ -351,10 +351,7 @@ fn probe_density_is_unbiased_at_edges_corners_and_on_spheres() {
 fn pattern_lookups_on_boundaries_follow_the_definition() {
     let parity = |k: i64| k.rem_euclid(2) as usize;
     for w in [1.0, 0.25, 3.0, 1e-3] {
-        let s = Stripe {
-            width: w,
-            angle: 0.0,
-        };
+        let s = Stripe::new(w, 0.0);
         let c = Check { width: w };
         for k in -6i64..=6 {
             let u = (k as f64 - 0.5) * w;
@@ -384,11 +381,8 @@ fn pattern_lookups_on_boundaries_follow_the_definition() {
         }
     }
     // Rotated stripes: the boundary through u = w/2 at 30°, approached from both sides.
-    let s = Stripe {
-        width: 0.7,
-        angle: 30f64.to_radians(),
-    };
-    let n = DVec3::new(s.angle.cos(), s.angle.sin(), 0.0);
+    let s = Stripe::new(0.7, 30f64.to_radians());
+    let n = DVec3::new(s.angle().cos(), s.angle().sin(), 0.0);
     let along = DVec3::new(-n.y, n.x, 0.0);
     for t in [-1e6, -3.0, 0.0, 2.5, 1e6] {
         for k in -3i64..=3 {
@@ -431,10 +425,7 @@ fn tracer_fields_and_estimators_on_pattern_boundaries() {
         (
             "stripe",
             &stripe,
-            &Stripe {
-                width: w,
-                angle: 0.0,
-            } as &dyn BinaryPattern,
+            &Stripe::new(w, 0.0) as &dyn BinaryPattern,
         ),
         ("check", &check, &Check { width: w } as &dyn BinaryPattern),
     ] {
@@ -487,10 +478,7 @@ fn tracer_fields_and_estimators_on_pattern_boundaries() {
     }
     // The analytic plane agrees with the same definitions on the boundary.
     let f = StripeField {
-        pattern: Stripe {
-            width: 1.0,
-            angle: 0.0,
-        },
+        pattern: Stripe::new(1.0, 0.0),
         values: [Coefficients::grey(0.0, 1.0), Coefficients::grey(1.0, 0.0)],
     };
     assert_eq!(f.coefficients(&PlanePoint::new(0.5, 0.0)).sigma_a[0], 1.0);

@@ -627,7 +627,7 @@ impl PlaneField {
     fn new(kind: FieldKind, values: [Coefficients; 2], angle: f64) -> Self {
         match kind {
             FieldKind::Stripe => PlaneField::Stripe(StripeField {
-                pattern: Stripe { width: 1.0, angle },
+                pattern: Stripe::new(1.0, angle),
                 values,
             }),
             FieldKind::Check => PlaneField::Check(het_estimate::analytic::CheckField {

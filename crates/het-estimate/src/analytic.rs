@@ -307,10 +307,7 @@ mod tests {
         let lo = Coefficients::grey(0.005, 1.0);
         let hi = Coefficients::grey(0.1, 1.0);
         let f = StripeField {
-            pattern: Stripe {
-                width: 4.0,
-                angle: 0.7,
-            },
+            pattern: Stripe::new(4.0, 0.7),
             values: [hi, lo],
         };
         let b = f.bounds().unwrap();

@@ -134,8 +134,11 @@ impl FootprintWeight {
     #[inline]
     pub fn marginal_cdf(self, z: f64) -> f64 {
         match self {
+            // Outside [−1, 1] without the library calls (the formula gives exactly 0 and 1
+            // at the ends).
+            FootprintWeight::Uniform if z <= -1.0 => 0.0,
+            FootprintWeight::Uniform if z >= 1.0 => 1.0,
             FootprintWeight::Uniform => {
-                let z = z.clamp(-1.0, 1.0);
                 0.5 + (z * (1.0 - z * z).sqrt() + z.asin()) / std::f64::consts::PI
             }
         }
@@ -184,11 +187,12 @@ impl PlaneFootprint {
 /// The weighted fraction of `fp` where `stripe` selects value 1 (in [0, 1]); `None` for a
 /// non-finite footprint or one that spans more than [`MAX_CELLS`] bands.
 pub fn stripe_fraction(stripe: &Stripe, fp: &PlaneFootprint) -> Option<f64> {
-    if !(fp.is_finite() && stripe.width > 0.0 && stripe.width.is_finite()) {
+    let w = stripe.width();
+    if !(fp.is_finite() && w > 0.0 && w.is_finite()) {
         return None;
     }
-    let (sin, cos) = stripe.angle.sin_cos();
-    let bands = Bands::of(fp, DVec2::new(cos, sin), stripe.width);
+    let (cos, sin) = stripe.direction();
+    let bands = Bands::of(fp, DVec2::new(cos, sin), w);
     (bands.count() <= MAX_CELLS as f64).then(|| bands.odd_fraction(fp))
 }
 

@@ -33,10 +33,7 @@ fn stripe_index(x: f64, y: f64, width: f64, angle: f64) -> usize {
 /// The paper's Figure 4 stripe preset: width 4, 45°, σa 0.005 / 0.1, σs = 1.
 fn stripe_preset() -> StripeField {
     StripeField {
-        pattern: Stripe {
-            width: 4.0,
-            angle: FRAC_PI_4,
-        },
+        pattern: Stripe::new(4.0, FRAC_PI_4),
         values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
     }
 }
@@ -647,10 +644,7 @@ fn segment_stripe_matches_quadrature() {
 fn zero_width_limit_is_the_semicircle_weighted_chord_average() {
     let sigma_a = [0.02, 0.3];
     let field_with = |ss: f64| StripeField {
-        pattern: Stripe {
-            width: 3.0,
-            angle: 0.3,
-        },
+        pattern: Stripe::new(3.0, 0.3),
         values: [
             Coefficients::grey(sigma_a[0], ss),
             Coefficients::grey(sigma_a[1], ss),
@@ -962,7 +956,7 @@ proptest! {
         semi in any::<bool>(),
         seed in any::<u64>(),
     ) {
-        let f = StripeField { pattern: Stripe { width, angle }, values: [v0, v1] };
+        let f = StripeField { pattern: Stripe::new(width, angle), values: [v0, v1] };
         let x_i = PlanePoint::new(a.0, a.1);
         let x_o = if same { x_i } else { PlanePoint::new(b.0, b.1) };
         let bounds = f.bounds().unwrap();
@@ -1166,10 +1160,7 @@ impl CoefficientField<PlanePoint> for Doubled {
 #[test]
 fn averaging_space_means_are_mapped_back_everywhere() {
     let stripes = StripeField {
-        pattern: Stripe {
-            width: 1.5,
-            angle: 0.4,
-        },
+        pattern: Stripe::new(1.5, 0.4),
         values: [
             Coefficients {
                 sigma_a: Rgb::new(0.01, 0.02, 0.03),

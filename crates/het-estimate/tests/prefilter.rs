@@ -67,10 +67,7 @@ fn footprints() -> Vec<PlaneFootprint> {
 #[test]
 fn stripe_closed_form_matches_monte_carlo() {
     for (k, fp) in footprints().iter().enumerate() {
-        let stripe = Stripe {
-            width: [4.0, 1.3][k % 2],
-            angle: 0.4 * k as f64,
-        };
+        let stripe = Stripe::new([4.0, 1.3][k % 2], 0.4 * k as f64);
         let exact = stripe_fraction(&stripe, fp).unwrap();
         let (mc, se) = mc_fraction(&stripe, fp, 100 + k as u64);
         assert!(
@@ -113,10 +110,7 @@ fn closed_forms_in_symmetric_cases() {
     );
     let f = check_fraction(&check, &disk(DVec2::new(2.0, 2.0), 1.5)).unwrap();
     assert!((f - 0.5).abs() < 1e-14, "{f}");
-    let stripe = Stripe {
-        width: 4.0,
-        angle: 0.0,
-    };
+    let stripe = Stripe::new(4.0, 0.0);
     let f = stripe_fraction(&stripe, &disk(DVec2::new(2.0, 5.0), 1.5)).unwrap();
     assert!((f - 0.5).abs() < 1e-14, "{f}");
     // A footprint much wider than the period sees half of each value (to ~ (w/h)^{3/2}).
@@ -236,10 +230,7 @@ impl CoefficientField<SpherePoint> for ProjectedStripe {
 #[test]
 fn fallback_triggers_on_a_small_sphere_and_is_counted() {
     let field = ProjectedStripe(StripeField {
-        pattern: Stripe {
-            width: 0.5,
-            angle: 0.7,
-        },
+        pattern: Stripe::new(0.5, 0.7),
         values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
     });
     let pre = Estimator::Sone(SoneParams::paper())

@@ -199,10 +199,7 @@ impl Field {
             )));
         }
         Ok(Field::Pattern {
-            pattern: Pattern::Stripe(Stripe {
-                width,
-                angle: angle_radians,
-            }),
+            pattern: Pattern::Stripe(Stripe::new(width, angle_radians)),
             values: [
                 check_value("values[0]", values[0])?,
                 check_value("values[1]", values[1])?,
@@ -678,10 +675,7 @@ mod tests {
         let a = Rgb::splat(0.1);
         let b = Rgb::new(1.0, 2.0, 3.0);
         let proj = PlanarProjection::new(Axis::Z, DVec3::new(0.5, -0.25, 7.0));
-        let stripe = Stripe {
-            width: 1.5,
-            angle: 0.3,
-        };
+        let stripe = Stripe::new(1.5, 0.3);
         let fs = Field::stripe(1.5, 0.3, [a, b], proj).unwrap();
         let fc = Field::check(0.7, [a, b], proj).unwrap();
         let check = Check { width: 0.7 };

@@ -267,10 +267,7 @@ fn full_scene_loads() {
     assert!(s.objects().iter().take(5).all(|o| o.report.is_closed()));
 
     // The stripe field read on the slab's surface is the shared pattern at (x, y).
-    let pat = het_estimate::pattern::Stripe {
-        width: 2.0,
-        angle: 45f64.to_radians(),
-    };
+    let pat = het_estimate::pattern::Stripe::new(2.0, 45f64.to_radians());
     use het_estimate::pattern::BinaryPattern;
     for (x, y) in [(0.3, 0.1), (1.2, 0.4), (-3.0, 2.2), (7.5, -1.0)] {
         let h = s
