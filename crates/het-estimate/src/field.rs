@@ -125,6 +125,21 @@ pub trait CoefficientField<P> {
         false
     }
 
+    /// [`CoefficientField::averaged_at_point`] at every point of `xs`, into `out` (as long as
+    /// `xs`): the estimators hand over a chunk of projected points together, so that a field
+    /// can decide what it is once per chunk. `false` (with `out` unspecified) where the field
+    /// has no point lookup. The default asks `averaged_at_point` for each.
+    #[inline]
+    fn averaged_at_points(&self, xs: &[glam::DVec3], out: &mut [Coefficients]) -> bool {
+        for (x, o) in xs.iter().zip(out.iter_mut()) {
+            match self.averaged_at_point(*x) {
+                Some(c) => *o = c,
+                None => return false,
+            }
+        }
+        true
+    }
+
     /// Optional averaging space: the values the estimators average at `p`, in the two slots
     /// of a [`Coefficients`]. The default is [`CoefficientField::coefficients`] itself (σa and
     /// σs are averaged). A field whose coefficients are a nonlinear function of other
@@ -187,5 +202,9 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn has_point_lookup(&self) -> bool {
         (**self).has_point_lookup()
+    }
+    #[inline]
+    fn averaged_at_points(&self, xs: &[glam::DVec3], out: &mut [Coefficients]) -> bool {
+        (**self).averaged_at_points(xs, out)
     }
 }

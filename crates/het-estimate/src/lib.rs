@@ -81,6 +81,7 @@ pub use kernel::KernelParams;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use prefilter::{Averaging, Flatness};
+pub use region_average::CHUNK;
 #[cfg(feature = "fixtures")]
 pub use sampler::SplitMix64;
 pub use sampler::UniformSource;

@@ -85,6 +85,9 @@ pub(crate) struct Averaged {
     pub rel_se: Option<f64>,
 }
 
+/// Most points handed to one call of a chunked sampler ([`average_chunks`]).
+pub const CHUNK: usize = 32;
+
 /// Averages over a region whose points come from the point set `P`.
 ///
 /// `sample(point, acc)` projects/looks up whatever it needs for one point and adds the results
@@ -98,8 +101,49 @@ pub(crate) fn average<P, U>(
 ) -> Averaged
 where
     P: PointSet,
+    P::Point: Default,
     U: UniformSource + ?Sized,
 {
+    average_chunks::<P, U>(budget, tracked, rng, |points, acc| {
+        for &p in points {
+            sample(p, acc);
+        }
+    })
+}
+
+/// [`average`] with the points handed over in order, up to [`CHUNK`] at a time, so that a
+/// sampler can project a chunk along one direction together
+/// ([`crate::SurfaceQuery::project_positions`]).
+pub(crate) fn average_chunks<P, U>(
+    budget: SampleBudget,
+    tracked: (Channels, Channels),
+    rng: &mut U,
+    mut sample: impl FnMut(&[P::Point], &mut Accumulator),
+) -> Averaged
+where
+    P: PointSet,
+    P::Point: Default,
+    U: UniformSource + ?Sized,
+{
+    // Points lo..hi of `set`, in chunks (antithetic pairs computed together).
+    let mut run = |set: &P, lo: u32, hi: u32, acc: &mut Accumulator| {
+        let mut buf = [P::Point::default(); CHUNK];
+        let mut k = lo;
+        while k < hi {
+            let mut n = 0;
+            while n < CHUNK && k < hi {
+                if k.is_multiple_of(2) && k + 1 < hi && n + 1 < CHUNK {
+                    let [a, b] = set.point_pair(k);
+                    (buf[n], buf[n + 1]) = (a, b);
+                    (n, k) = (n + 2, k + 2);
+                } else {
+                    buf[n] = set.point(k);
+                    (n, k) = (n + 1, k + 1);
+                }
+            }
+            sample(&buf[..n], acc);
+        }
+    };
     match budget {
         SampleBudget::TargetRelError { rel_se, max } if max.get() >= REPLICATES => {
             let per_max = max.get() / REPLICATES;
@@ -109,9 +153,7 @@ where
             loop {
                 let target = (2 * done).clamp(1, per_max);
                 for (set, acc) in sets.iter().zip(accs.iter_mut()) {
-                    for k in done..target {
-                        sample(set.point(k), acc);
-                    }
+                    run(set, done, target, acc);
                 }
                 done = target;
                 let err = relative_std_error(&accs, tracked);
@@ -129,14 +171,7 @@ where
         SampleBudget::TargetRelError { max: n, .. } | SampleBudget::Fixed(n) => {
             let set = P::new(rng);
             let mut acc = Accumulator::default();
-            for k in (0..n.get() / 2).map(|j| 2 * j) {
-                let [a, b] = set.point_pair(k);
-                sample(a, &mut acc);
-                sample(b, &mut acc);
-            }
-            if n.get() % 2 == 1 {
-                sample(set.point(n.get() - 1), &mut acc);
-            }
+            run(&set, 0, n.get(), &mut acc);
             Averaged {
                 acc,
                 samples: n.get(),
@@ -308,23 +343,102 @@ where
         miss_endpoints: bool,
         acc: &mut Accumulator,
     ) {
-        self.diag.projections += 1;
         // Fields defined in space need only the position, which some surfaces give without
         // building a point.
-        if self.field.has_point_lookup() {
-            match self.surface.project_position(origin, dir) {
-                Projected::At(x) => {
-                    if let Some(c) = self.lookup_at_point(x) {
-                        acc.add(&c, channels);
-                        return;
-                    }
+        let position = if self.field.has_point_lookup() {
+            self.surface.project_position(origin, dir)
+        } else {
+            Projected::Undecided
+        };
+        self.add_projected(origin, dir, position, channels, miss_endpoints, acc);
+    }
+
+    /// [`Probe::project_and_add`] for every origin of `origins` along one direction, in
+    /// order: the positions are asked for [`CHUNK`] at a time
+    /// ([`SurfaceQuery::project_positions`]), and the field read at them together
+    /// ([`CoefficientField::averaged_at_points`]).
+    #[inline]
+    pub fn project_and_add_all(
+        &mut self,
+        origins: &[DVec3],
+        dir: DVec3,
+        channels: Channels,
+        miss: bool,
+        acc: &mut Accumulator,
+    ) {
+        for chunk in origins.chunks(CHUNK) {
+            self.project_and_add_chunk(chunk, dir, channels, miss, acc);
+        }
+    }
+
+    /// [`Probe::project_and_add_all`] for at most [`CHUNK`] origins.
+    #[inline]
+    fn project_and_add_chunk(
+        &mut self,
+        origins: &[DVec3],
+        dir: DVec3,
+        channels: Channels,
+        miss: bool,
+        acc: &mut Accumulator,
+    ) {
+        let mut positions = [Projected::Undecided; CHUNK];
+        let positions = &mut positions[..origins.len()];
+        if !self.field.has_point_lookup() {
+            for &origin in origins {
+                self.add_projected(origin, dir, Projected::Undecided, channels, miss, acc);
+            }
+            return;
+        }
+        self.surface.project_positions(origins, dir, positions);
+        // The field at every position found, read together.
+        let mut xs = [DVec3::ZERO; CHUNK];
+        let mut n = 0;
+        for p in positions.iter() {
+            if let Projected::At(x) = *p {
+                xs[n] = x;
+                n += 1;
+            }
+        }
+        let mut values = [Coefficients::default(); CHUNK];
+        let read = n > 0 && self.field.averaged_at_points(&xs[..n], &mut values[..n]);
+        let mut next = 0;
+        for (&origin, &position) in origins.iter().zip(positions.iter()) {
+            match position {
+                Projected::At(_) if read => {
+                    self.diag.projections += 1;
+                    self.diag.lookups += 1;
+                    acc.add(&sanitise(values[next]), channels);
+                    next += 1;
                 }
-                Projected::Miss => {
-                    self.miss(channels, miss_endpoints, acc);
+                _ => self.add_projected(origin, dir, position, channels, miss, acc),
+            }
+        }
+    }
+
+    /// One projection, given what [`SurfaceQuery::project_position`] said about it.
+    #[inline]
+    fn add_projected(
+        &mut self,
+        origin: DVec3,
+        dir: DVec3,
+        position: Projected,
+        channels: Channels,
+        miss_endpoints: bool,
+        acc: &mut Accumulator,
+    ) {
+        self.diag.projections += 1;
+        match position {
+            Projected::At(x) => {
+                if let Some(c) = self.lookup_at_point(x) {
+                    acc.add(&c, channels);
                     return;
                 }
-                Projected::Undecided => {}
             }
+            Projected::Miss => {
+                self.miss(channels, miss_endpoints, acc);
+                return;
+            }
+            Projected::Undecided => {}
         }
         match self.surface.project(origin, dir) {
             Some(hit) => {
@@ -353,6 +467,62 @@ mod tests {
     use crate::sampler::SplitMix64;
     use crate::sampling::SegmentPoints;
     use std::num::NonZeroU32;
+
+    /// The chunks hand over every point of the budget once, in order, at most [`CHUNK`] at a
+    /// time, for fixed budgets of every length and for the replicates of an adaptive one
+    /// (whose rounds start at odd indices); antithetic pairs split across chunks included.
+    #[test]
+    fn chunks_are_the_points_in_order() {
+        use crate::sampling::{DiskPoints, PointSet};
+        for n in 1..=70u32 {
+            let mut rng = SplitMix64::new(u64::from(n));
+            let mut got = Vec::new();
+            average_chunks::<DiskPoints, _>(
+                SampleBudget::fixed(n),
+                (Rgb::ONE, Rgb::ONE),
+                &mut rng,
+                |pts, _| {
+                    assert!(!pts.is_empty() && pts.len() <= CHUNK);
+                    got.extend_from_slice(pts);
+                },
+            );
+            let set = DiskPoints::new(&mut SplitMix64::new(u64::from(n)));
+            let want: Vec<_> = (0..n).map(|k| set.point(k)).collect();
+            assert_eq!(got, want, "n = {n}");
+        }
+        // An unreachable target: every round up to max, replicate by replicate.
+        let max = 8 * 40;
+        let mut got = Vec::new();
+        average_chunks::<DiskPoints, _>(
+            SampleBudget::TargetRelError {
+                rel_se: 1e-300,
+                max: NonZeroU32::new(max).unwrap(),
+            },
+            (Rgb::ONE, Rgb::ONE),
+            &mut SplitMix64::new(9),
+            |pts, acc| {
+                got.extend_from_slice(pts);
+                // Values that vary (and do not cancel in antithetic pairs), so that the error
+                // stays above the target.
+                for p in pts {
+                    let c = Coefficients::grey(1.0 + p.x * p.x, 1.0);
+                    acc.add(&c, Rgb::ONE);
+                }
+            },
+        );
+        let mut rng = SplitMix64::new(9);
+        let sets: Vec<DiskPoints> = (0..REPLICATES).map(|_| DiskPoints::new(&mut rng)).collect();
+        let mut want = Vec::new();
+        let mut done = 0;
+        while done < max / REPLICATES {
+            let target = (2 * done).clamp(1, max / REPLICATES);
+            for set in &sets {
+                want.extend((done..target).map(|k| set.point(k)));
+            }
+            done = target;
+        }
+        assert_eq!(got, want);
+    }
 
     /// The adaptive budget stops at the target, or at `max` for an unreachable target, and
     /// its pooled mean agrees with the exact mean of t ↦ t² (1/3) within the claimed error.

@@ -42,6 +42,7 @@
 use std::num::NonZeroU32;
 
 use bssrdf_core::Rgb;
+use glam::DVec3;
 
 use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
@@ -49,7 +50,7 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::prefilter::{Averaging, Flatness};
-use crate::region_average::{Accumulator, Channels, Probe, average};
+use crate::region_average::{Accumulator, CHUNK, Channels, Probe, average_chunks};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
@@ -247,9 +248,15 @@ where
             sanitise(c)
         }
         None => {
-            let averaged = average::<DiskPoints, _>(params.disk, known.varying(), rng, |u, acc| {
-                probe.project_and_add(disk.point(u), disk.normal, Rgb::ONE, miss_endpoints, acc)
-            });
+            let averaged =
+                average_chunks::<DiskPoints, _>(params.disk, known.varying(), rng, |us, acc| {
+                    let mut origins = [DVec3::ZERO; CHUNK];
+                    for (o, &u) in origins.iter_mut().zip(us) {
+                        *o = disk.point(u);
+                    }
+                    let origins = &origins[..us.len()];
+                    probe.project_and_add_all(origins, disk.normal, Rgb::ONE, miss_endpoints, acc)
+                });
             probe.diag.samples += averaged.samples;
             note_se(averaged.rel_se);
             let (mean, fell_back) = averaged.acc.mean_or(wanted_rgb, || probe.endpoints());
@@ -297,15 +304,21 @@ where
         }
         let (va, vs) = known.varying();
         let ellipses: [_; 3] = std::array::from_fn(|g| chord.ellipse(groups.semi_minor[g]));
-        let averaged = average::<DiskPoints, _>(
+        // Group by group over each chunk: every channel is in one group, so each channel
+        // still sums its points in order.
+        let averaged = average_chunks::<DiskPoints, _>(
             params.ellipse,
             (va * tracked_channels, vs * tracked_channels),
             rng,
-            |u, acc| {
+            |us, acc| {
                 for g in (0..groups.len).filter(|&g| sampled[g]) {
                     let e = &ellipses[g];
-                    probe.project_and_add(
-                        e.point(u),
+                    let mut origins = [DVec3::ZERO; CHUNK];
+                    for (o, &u) in origins.iter_mut().zip(us) {
+                        *o = e.point(u);
+                    }
+                    probe.project_and_add_all(
+                        &origins[..us.len()],
                         e.normal,
                         groups.channels[g],
                         miss_endpoints,

@@ -49,6 +49,17 @@ pub trait SurfaceQuery {
         let _ = (origin, dir);
         Projected::Undecided
     }
+
+    /// [`SurfaceQuery::project_position`] for several origins along one direction, into `out`
+    /// (as long as `origins`): the estimators hand over a stage's points together, so that a
+    /// surface can do the direction's share of the work once. The default asks
+    /// `project_position` for each.
+    #[inline]
+    fn project_positions(&self, origins: &[DVec3], dir: DVec3, out: &mut [Projected]) {
+        for (o, r) in origins.iter().zip(out.iter_mut()) {
+            *r = self.project_position(*o, dir);
+        }
+    }
 }
 
 /// The answer of [`SurfaceQuery::project_position`].
@@ -69,5 +80,8 @@ impl<S: SurfaceQuery + ?Sized> SurfaceQuery for &S {
     }
     fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
         (**self).project_position(origin, dir)
+    }
+    fn project_positions(&self, origins: &[DVec3], dir: DVec3, out: &mut [Projected]) {
+        (**self).project_positions(origins, dir, out)
     }
 }

@@ -288,6 +288,29 @@ impl Field {
         }
     }
 
+    /// [`Field::eval`] at each of `ps` with no texture coordinates, into `out` (as long as
+    /// `ps`): for fields defined in space ([`Field::is_volumetric`]), the kind matched once.
+    pub fn eval_points(&self, ps: &[DVec3], out: &mut [Rgb]) {
+        match self {
+            Field::Constant(v) => out.fill(*v),
+            Field::Pattern {
+                pattern,
+                values,
+                projection,
+            } => {
+                for (p, o) in ps.iter().zip(out.iter_mut()) {
+                    let (s, t) = projection.st(*p);
+                    *o = values[pattern.select(s, t)];
+                }
+            }
+            Field::Image(f) => {
+                for (p, o) in ps.iter().zip(out.iter_mut()) {
+                    *o = f.at(*p, DVec2::ZERO);
+                }
+            }
+        }
+    }
+
     /// The value at a point of the volume. Meaningful only when [`Field::is_volumetric`]; a
     /// UV-mapped image returns the midpoint of its range instead (exact when it is constant;
     /// check [`MediumField::is_volumetric`] or `Scene::require_volumetric` before rendering).
@@ -651,6 +674,33 @@ impl CoefficientField<Hit> for MediumField {
         self.is_volumetric()
     }
 
+    /// Each field decides what it is once for all the points ([`Field::eval_points`]).
+    fn averaged_at_points(&self, xs: &[DVec3], out: &mut [Coefficients]) -> bool {
+        if !self.is_volumetric() {
+            return false;
+        }
+        let mut buf = [Rgb::ZERO; het_estimate::CHUNK];
+        for (xs, out) in xs.chunks(buf.len()).zip(out.chunks_mut(buf.len())) {
+            let b = &mut buf[..xs.len()];
+            self.sigma_a.eval_points(xs, b);
+            for (o, v) in out.iter_mut().zip(b.iter()) {
+                o.sigma_a = *v;
+            }
+            self.sigma_s.eval_points(xs, b);
+            for (o, v) in out.iter_mut().zip(b.iter()) {
+                o.sigma_s = *v;
+            }
+        }
+        match &self.artist {
+            None => {}
+            Some(map) if map.invert() == InvertAt::After => {}
+            Some(map) => out
+                .iter_mut()
+                .for_each(|c| *c = map.coefficients_out_of_line(*c)),
+        }
+        true
+    }
+
     #[inline]
     fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         if self.inverts_after() {
@@ -669,6 +719,86 @@ impl CoefficientField<Hit> for MediumField {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Reading many points together gives, bit for bit, what reading each gives: every kind
+    /// of field (constant, stripe, check, planar image, an artist's medium inverted before or
+    /// after averaging), and more points than one chunk.
+    #[test]
+    fn points_read_together_equal_points_read_alone() {
+        use crate::field::artist::{ArtistMap, InvertAt};
+        use bssrdf_core::{AlbedoInversion, ProfileModel};
+        let proj = PlanarProjection::new(Axis::Z, DVec3::new(0.2, -0.3, 0.0));
+        let lo_hi = [Rgb::new(0.01, 0.02, 0.03), Rgb::new(0.1, 0.2, 0.3)];
+        let texels = (0..16 * 16)
+            .map(|k| {
+                [
+                    0.1 + 0.05 * (k % 7) as f32,
+                    0.2,
+                    0.3 + 0.01 * (k % 5) as f32,
+                ]
+            })
+            .collect();
+        let tex = Arc::new(Texture::from_texels("t", 16, 16, texels).unwrap());
+        let image = Field::image(
+            tex,
+            ImageMapping::Planar {
+                projection: proj,
+                size: [7.0, 5.0],
+            },
+            Wrap::Repeat,
+            Filter::Bilinear,
+            Rgb::ONE,
+        )
+        .unwrap();
+        let fields = [
+            Field::constant(Rgb::new(0.5, 1.0, 2.0)).unwrap(),
+            Field::stripe(1.5, 0.4, lo_hi, proj).unwrap(),
+            Field::check(2.0, lo_hi, proj).unwrap(),
+            image,
+        ];
+        let inversion = Arc::new(AlbedoInversion::new(ProfileModel::Dipole, 0.0, 1.3).unwrap());
+        let mut media: Vec<MediumField> = fields
+            .iter()
+            .flat_map(|a| {
+                fields
+                    .iter()
+                    .map(|s| MediumField::new(a.clone(), s.clone()))
+            })
+            .collect();
+        for invert in [InvertAt::Before, InvertAt::After] {
+            let colour = Field::check(2.0, [Rgb::splat(0.3), Rgb::splat(0.8)], proj).unwrap();
+            let mfp = Field::stripe(1.5, 0.4, [Rgb::splat(0.5), Rgb::splat(2.0)], proj).unwrap();
+            let map = ArtistMap::new(inversion.clone(), invert);
+            media.push(MediumField::artist(colour, mfp, map).unwrap());
+        }
+        let xs: Vec<DVec3> = (0..77)
+            .map(|k| {
+                let t = k as f64;
+                DVec3::new(
+                    9.0 * (0.37 * t).sin(),
+                    7.0 * (0.71 * t).cos(),
+                    (1.3 * t).sin(),
+                )
+            })
+            .collect();
+        for (m, medium) in media.iter().enumerate() {
+            let mut out = vec![Coefficients::default(); xs.len()];
+            assert!(CoefficientField::<Hit>::averaged_at_points(
+                medium, &xs, &mut out
+            ));
+            for (k, x) in xs.iter().enumerate() {
+                let one = CoefficientField::<Hit>::averaged_at_point(medium, *x).unwrap();
+                assert_eq!(out[k], one, "medium {m}, point {k}");
+            }
+        }
+        for (f, field) in fields.iter().enumerate() {
+            let mut out = vec![Rgb::ZERO; xs.len()];
+            field.eval_points(&xs, &mut out);
+            for (k, x) in xs.iter().enumerate() {
+                assert_eq!(out[k], field.eval(*x, DVec2::ZERO), "field {f}, point {k}");
+            }
+        }
+    }
 
     #[test]
     fn stripe_and_check_read_the_shared_patterns() {

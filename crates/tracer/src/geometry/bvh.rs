@@ -22,6 +22,8 @@ use obvhs::{Boundable, BvhBuildParams};
 
 use super::tlas::{Tlas, slab};
 use super::watertight::{LeafTri, ShearedRay, refine_f64};
+use het_estimate::Projected;
+
 use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
 
 /// Target extent of an object in the BVH's scaled space (see the module docs of
@@ -462,88 +464,29 @@ impl Geometry {
 
     /// For an object whose mesh is its own axis-aligned box ([`Geometry::object_box_extent`]):
     /// the crossing of the whole line `origin + t·dir` (unit `dir`, `t` of either sign) nearest
-    /// to `origin`, the projection of Sone's estimators, found from the box's planes alone.
-    /// [`BoxProjection::Undecided`]: not a box, or a case the planes do not settle within the
-    /// margin of the mesh's f32 triangles (the line grazes an edge or face, or the origin lies
-    /// halfway between the two crossings). An origin on the surface (|t| within the margin) is
-    /// a crossing here; tracing it is left to the caller.
+    /// to `origin`, the projection of Sone's estimators, found from the box's planes alone
+    /// ([`BoxLine::crossing`]).
     #[inline]
     fn box_crossing(&self, object: u32, origin: DVec3, dir: DVec3) -> BoxProjection<BoxCrossing> {
+        match self.box_line(object, dir) {
+            Some(line) => line.crossing(origin),
+            None => BoxProjection::Undecided,
+        }
+    }
+
+    /// The lines along `dir` through `object`, when it is its own axis-aligned box.
+    #[inline]
+    fn box_line(&self, object: u32, dir: DVec3) -> Option<BoxLine> {
         let o = &self.objects[object as usize];
-        let Some(extent) = o.box_extent else {
-            return BoxProjection::Undecided;
-        };
-        let (lo, hi) = (o.lo, o.hi);
-        // Margin (length): far above the f32 precision of the object's triangles (about 1e-7
-        // of the extent) and of the origin.
-        let m = 1e-5 * extent.max_element() + 1e-9 * origin.abs().max_element();
-        let (t_in, axis_in, t_out, axis_out) = if dir.abs().min_element() >= 1e-12 {
-            // The slab test on all three axes at once (the common case).
-            let inv = dir.recip();
-            let (t1, t2) = ((lo - origin) * inv, (hi - origin) * inv);
-            let (near, far) = (t1.min(t2), t1.max(t2));
-            (
-                near.max_element(),
-                near.max_position(),
-                far.min_element(),
-                far.min_position(),
-            )
-        } else {
-            let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
-            let (mut axis_in, mut axis_out) = (0, 0);
-            for a in 0..3 {
-                if dir[a].abs() < 1e-12 {
-                    // Parallel to this pair of planes: inside them, or a clear miss.
-                    if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
-                        return BoxProjection::Miss;
-                    }
-                    if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
-                        return BoxProjection::Undecided;
-                    }
-                    continue;
-                }
-                let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
-                if t1.min(t2) > t_in {
-                    (t_in, axis_in) = (t1.min(t2), a);
-                }
-                if t1.max(t2) < t_out {
-                    (t_out, axis_out) = (t1.max(t2), a);
-                }
-            }
-            (t_in, axis_in, t_out, axis_out)
-        };
-        if !(t_in.is_finite() && t_out.is_finite()) {
-            return BoxProjection::Undecided;
-        }
-        if t_in > t_out + m {
-            return BoxProjection::Miss;
-        }
-        if t_out - t_in < 4.0 * m {
-            return BoxProjection::Undecided;
-        }
-        let (near, far, axis, entering) = if t_in.abs() <= t_out.abs() {
-            (t_in, t_out, axis_in, true)
-        } else {
-            (t_out, t_in, axis_out, false)
-        };
-        if far.abs() - near.abs() <= 2.0 * m {
-            return BoxProjection::Undecided;
-        }
-        // The line leaves the box along `dir` through the face whose outward normal has the
-        // sign of dir[axis]; it enters through the opposite one.
-        let sign = if (dir[axis] > 0.0) != entering {
-            1.0
-        } else {
-            -1.0
-        };
-        BoxProjection::At(BoxCrossing {
-            t: near,
-            margin: m,
-            axis,
-            sign,
-            plane: if sign > 0.0 { hi[axis] } else { lo[axis] },
-            lo,
-            hi,
+        let extent = o.box_extent?;
+        Some(BoxLine {
+            lo: o.lo,
+            hi: o.hi,
+            // Far above the f32 precision of the object's triangles (about 1e-7 of the
+            // extent).
+            margin: 1e-5 * extent.max_element(),
+            dir,
+            inv: (dir.abs().min_element() >= 1e-12).then(|| dir.recip()),
         })
     }
 
@@ -582,22 +525,30 @@ impl Geometry {
     /// triangle is found, so there are no texture coordinates: for fields defined in space
     /// only.
     #[inline]
-    pub fn project_position_onto_box(
+    pub fn project_position_onto_box(&self, object: u32, origin: DVec3, dir: DVec3) -> Projected {
+        match self.box_line(object, dir) {
+            Some(line) => line.position(origin),
+            None => Projected::Undecided,
+        }
+    }
+
+    /// [`Geometry::project_position_onto_box`] for several origins along one direction, into
+    /// `out` (the direction's share of the work done once).
+    pub fn project_positions_onto_box(
         &self,
         object: u32,
-        origin: DVec3,
+        origins: &[DVec3],
         dir: DVec3,
-    ) -> BoxProjection<DVec3> {
-        let c = match self.box_crossing(object, origin, dir) {
-            BoxProjection::At(c) => c,
-            BoxProjection::Miss => return BoxProjection::Miss,
-            BoxProjection::Undecided => return BoxProjection::Undecided,
-        };
-        let mut p = (origin + c.t * dir).clamp(c.lo, c.hi);
-        p[c.axis] = c.plane;
-        let hair = 1e-9 * (1.0 + p.abs().max_element());
-        p[c.axis] -= c.sign * hair;
-        BoxProjection::At(p)
+        out: &mut [Projected],
+    ) {
+        match self.box_line(object, dir) {
+            Some(line) => {
+                for (o, r) in origins.iter().zip(out.iter_mut()) {
+                    *r = line.position(*o);
+                }
+            }
+            None => out.fill(Projected::Undecided),
+        }
     }
 
     /// The closest intersection with `object`'s triangles in `[ray.t_min, ray.t_max]`.
@@ -776,6 +727,113 @@ pub enum BoxProjection<T> {
     Undecided,
 }
 
+/// Lines of one direction through an axis-aligned box ([`Geometry::box_crossing`]).
+#[derive(Debug, Clone, Copy)]
+struct BoxLine {
+    lo: DVec3,
+    hi: DVec3,
+    /// The box's share of the decision margin (length).
+    margin: f64,
+    /// The unit direction, and its reciprocal unless the lines run parallel to a face.
+    dir: DVec3,
+    inv: Option<DVec3>,
+}
+
+impl BoxLine {
+    /// The crossing of the line through `origin` nearest to `origin`.
+    /// [`BoxProjection::Undecided`]: a case the planes do not settle within the margin of the
+    /// mesh's f32 triangles (the line grazes an edge or face, or the origin lies halfway
+    /// between the two crossings). An origin on the surface (|t| within the margin) is a
+    /// crossing here; tracing it is left to the caller.
+    #[inline(always)]
+    fn crossing(&self, origin: DVec3) -> BoxProjection<BoxCrossing> {
+        let (lo, hi, dir) = (self.lo, self.hi, self.dir);
+        // Margin (length): the box's, and that of the origin's own precision.
+        let m = self.margin + 1e-9 * origin.abs().max_element();
+        let (t_in, axis_in, t_out, axis_out) = if let Some(inv) = self.inv {
+            // The slab test on all three axes at once (the common case).
+            let (t1, t2) = ((lo - origin) * inv, (hi - origin) * inv);
+            let (near, far) = (t1.min(t2), t1.max(t2));
+            (
+                near.max_element(),
+                near.max_position(),
+                far.min_element(),
+                far.min_position(),
+            )
+        } else {
+            let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+            let (mut axis_in, mut axis_out) = (0, 0);
+            for a in 0..3 {
+                if dir[a].abs() < 1e-12 {
+                    // Parallel to this pair of planes: inside them, or a clear miss.
+                    if origin[a] < lo[a] - m || origin[a] > hi[a] + m {
+                        return BoxProjection::Miss;
+                    }
+                    if origin[a] < lo[a] + m || origin[a] > hi[a] - m {
+                        return BoxProjection::Undecided;
+                    }
+                    continue;
+                }
+                let (t1, t2) = ((lo[a] - origin[a]) / dir[a], (hi[a] - origin[a]) / dir[a]);
+                if t1.min(t2) > t_in {
+                    (t_in, axis_in) = (t1.min(t2), a);
+                }
+                if t1.max(t2) < t_out {
+                    (t_out, axis_out) = (t1.max(t2), a);
+                }
+            }
+            (t_in, axis_in, t_out, axis_out)
+        };
+        if !(t_in.is_finite() && t_out.is_finite()) {
+            return BoxProjection::Undecided;
+        }
+        if t_in > t_out + m {
+            return BoxProjection::Miss;
+        }
+        if t_out - t_in < 4.0 * m {
+            return BoxProjection::Undecided;
+        }
+        let (near, far, axis, entering) = if t_in.abs() <= t_out.abs() {
+            (t_in, t_out, axis_in, true)
+        } else {
+            (t_out, t_in, axis_out, false)
+        };
+        if far.abs() - near.abs() <= 2.0 * m {
+            return BoxProjection::Undecided;
+        }
+        // The line leaves the box along `dir` through the face whose outward normal has the
+        // sign of dir[axis]; it enters through the opposite one.
+        let sign = if (dir[axis] > 0.0) != entering {
+            1.0
+        } else {
+            -1.0
+        };
+        BoxProjection::At(BoxCrossing {
+            t: near,
+            margin: m,
+            axis,
+            sign,
+            plane: if sign > 0.0 { hi[axis] } else { lo[axis] },
+        })
+    }
+
+    /// The crossing's position, a hair inside its face
+    /// ([`Geometry::project_position_onto_box`]).
+    #[inline]
+    fn position(&self, origin: DVec3) -> Projected {
+        let c = match self.crossing(origin) {
+            BoxProjection::At(c) => c,
+            BoxProjection::Miss => return Projected::Miss,
+            BoxProjection::Undecided => return Projected::Undecided,
+        };
+        let mut p = (origin + c.t * self.dir).clamp(self.lo, self.hi);
+        p[c.axis] = c.plane;
+        let hair = 1e-9 * (1.0 + p.abs().max_element());
+        p[c.axis] -= c.sign * hair;
+        Projected::At(p)
+    }
+}
+
 /// The nearer crossing of a line with a box ([`Geometry::box_crossing`]).
 #[derive(Debug, Clone, Copy)]
 struct BoxCrossing {
@@ -788,9 +846,6 @@ struct BoxCrossing {
     sign: f64,
     /// The face's coordinate on `axis`.
     plane: f64,
-    /// The box.
-    lo: DVec3,
-    hi: DVec3,
 }
 
 #[cfg(test)]

@@ -43,14 +43,15 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
     /// without a ray ([`Geometry::project_position_onto_box`]); `Undecided` on other meshes.
     #[inline]
     fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
-        match self
-            .geometry
+        self.geometry
             .project_position_onto_box(self.object, origin, dir)
-        {
-            BoxProjection::At(p) => Projected::At(p),
-            BoxProjection::Miss => Projected::Miss,
-            BoxProjection::Undecided => Projected::Undecided,
-        }
+    }
+
+    /// [`Geometry::project_positions_onto_box`]: the box's planes and the direction's
+    /// reciprocal once for all the origins.
+    fn project_positions(&self, origins: &[DVec3], dir: DVec3, out: &mut [Projected]) {
+        self.geometry
+            .project_positions_onto_box(self.object, origins, dir, out)
     }
 }
 
@@ -107,7 +108,7 @@ mod tests {
             // The position from the planes: the ray's hit to f32 precision, a hair inside the
             // face the ray crossed; a miss where the rays miss.
             match (g.project_position_onto_box(0, origin, dir), want) {
-                (BoxProjection::At(p), Some(b)) => {
+                (Projected::At(p), Some(b)) => {
                     positions += 1;
                     assert!(
                         (p - b.p).length() <= 1e-5,
@@ -121,7 +122,7 @@ mod tests {
                     assert!(inside > 0.0 && inside < 1e-7, "line {k}: {inside}");
                     assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "line {k}: {p:?}");
                 }
-                (BoxProjection::Miss, None) | (BoxProjection::Undecided, _) => {}
+                (Projected::Miss, None) | (Projected::Undecided, _) => {}
                 (got, want) => panic!("line {k}: {got:?} against {want:?}"),
             }
             fast += usize::from(g.project_onto_box(0, origin, dir) != BoxProjection::Undecided);
