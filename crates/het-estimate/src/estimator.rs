@@ -101,10 +101,6 @@ impl Estimator {
             Estimator::Sone(p) => {
                 p.disk.validate()?;
                 p.ellipse.validate()?;
-                crate::names::check_non_negative(
-                    "flatness.max_normal_angle",
-                    p.flatness.max_normal_angle,
-                )?;
                 theta2_of(Default::default())?;
                 let (g_theta, _) = p.width_scattering.resolve(g);
                 p.mean_square_angle.evaluate(g_theta)?

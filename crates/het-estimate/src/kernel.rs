@@ -217,7 +217,7 @@ impl Proposal {
             (self.half, 2.0 * u[0] - 1.0)
         };
         let rho = self.scale * v / (1.0 - v);
-        let (s, c) = (2.0 * PI * u[1]).sin_cos();
+        let (s, c) = crate::sampling::sin_cos_turn(u[1]);
         DVec2::new(centre + rho * c, rho * s)
     }
 

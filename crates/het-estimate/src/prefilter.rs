@@ -89,20 +89,43 @@ impl Averaging {
 /// endpoints' reach (a minor axis b ≫ d/2), is not detected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Flatness {
-    /// θ, radians (default 2° = 0.0349).
-    pub max_normal_angle: f64,
+    /// θ, radians (default 2° = 0.0349), with its sine and cosine.
+    max_normal_angle: f64,
+    sin: f64,
+    cos: f64,
 }
 
 impl Flatness {
-    /// θ = 2°.
+    /// θ = 2° (its sine and cosine are those `sin_cos` gives, checked by a test).
     pub const DEFAULT: Flatness = Flatness {
         max_normal_angle: 2.0 * std::f64::consts::PI / 180.0,
+        sin: 0.03489949670250097,
+        cos: 0.9993908270190958,
     };
+
+    /// The criterion with θ = `max_normal_angle` radians; a negative or non-finite angle is
+    /// an error.
+    pub fn new(max_normal_angle: f64) -> Result<Self, bssrdf_core::ParamError> {
+        let theta =
+            crate::names::check_non_negative("flatness.max_normal_angle", max_normal_angle)?;
+        let (sin, cos) = theta.sin_cos();
+        Ok(Self {
+            max_normal_angle: theta,
+            sin,
+            cos,
+        })
+    }
+
+    /// θ, radians.
+    pub fn max_normal_angle(&self) -> f64 {
+        self.max_normal_angle
+    }
 
     /// True when the pair with unit normals `n_i`, `n_o` and unit chord direction `x_hat`
     /// is flat by the criterion above. Non-finite input is not flat.
+    #[inline]
     pub fn is_flat(&self, n_i: DVec3, n_o: DVec3, x_hat: DVec3) -> bool {
-        let (sin, cos) = self.max_normal_angle.sin_cos();
+        let (sin, cos) = (self.sin, self.cos);
         n_i.dot(n_o) >= cos && n_i.dot(x_hat).abs() <= sin && n_o.dot(x_hat).abs() <= sin
     }
 }
@@ -352,6 +375,22 @@ fn disk_triangle_area(a: DVec2, b: DVec2) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn flatness_keeps_the_sine_and_cosine_of_its_angle() {
+        let two_degrees = Flatness::new(2.0 * std::f64::consts::PI / 180.0).unwrap();
+        assert_eq!(Flatness::DEFAULT, two_degrees);
+        assert_eq!(Flatness::default(), two_degrees);
+        assert!(Flatness::new(-0.1).is_err() && Flatness::new(f64::NAN).is_err());
+        let f = Flatness::new(0.5).unwrap();
+        let n = DVec3::Z;
+        // Normals 0.49 and 0.51 rad apart; a chord 0.49 rad out of the tangent plane.
+        let tilt = |a: f64| DVec3::new(a.sin(), 0.0, a.cos());
+        assert!(f.is_flat(n, tilt(0.49), DVec3::Y));
+        assert!(!f.is_flat(n, tilt(0.51), DVec3::Y));
+        assert!(f.is_flat(n, n, DVec3::new(0.49f64.cos(), 0.0, 0.49f64.sin())));
+        assert!(!f.is_flat(n, n, DVec3::new(0.51f64.cos(), 0.0, 0.51f64.sin())));
+    }
     use std::f64::consts::PI;
 
     #[test]

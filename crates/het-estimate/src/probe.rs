@@ -486,10 +486,10 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
         if r.is_nan() || r >= *r_max {
             continue;
         }
-        let phi = std::f64::consts::TAU * u_phi;
+        let (sin, cos) = crate::sampling::sin_cos_turn(u_phi);
         let (vx, vy, vz) = frame.axes(axis);
         let half = (r_max * r_max - r * r).sqrt();
-        let base = origin + r * (phi.cos() * vx + phi.sin() * vy) - half * vz;
+        let base = origin + r * (cos * vx + sin * vy) - half * vz;
         let mut kept = 0;
         chords.for_each_hit(base, vz, 2.0 * half, |h| {
             if kept < MAX_PROBE_HITS {

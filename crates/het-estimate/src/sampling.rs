@@ -149,13 +149,67 @@ pub fn concentric_disk(u: [f64; 2]) -> DVec2 {
     if x == 0.0 && y == 0.0 {
         return DVec2::ZERO;
     }
-    let (r, theta) = if x.abs() > y.abs() {
-        (x, FRAC_PI_4 * (y / x))
+    // θ = (π/4)(y/x), or π/2 − (π/4)(x/y), whose sine and cosine are the cosine and sine of
+    // (π/4)(x/y): both within [−π/4, π/4].
+    if x.abs() > y.abs() {
+        let (s, c) = sin_cos_eighth(FRAC_PI_4 * (y / x));
+        DVec2::new(x * c, x * s)
     } else {
-        (y, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (x / y))
-    };
-    let (s, c) = theta.sin_cos();
-    DVec2::new(r * c, r * s)
+        let (s, c) = sin_cos_eighth(FRAC_PI_4 * (x / y));
+        DVec2::new(y * s, y * c)
+    }
+}
+
+/// `(sin x, cos x)` for |x| ≤ π/4, by their Taylor series to x¹⁵ and x¹⁶ (the first omitted
+/// terms are below 5e-17 there), evaluated by Horner's rule in x²: within 2e-16 of the library
+/// functions, at a fraction of their cost (no range reduction). Outside that range the
+/// series is inaccurate; use [`sin_cos_turn`] or `f64::sin_cos`.
+#[inline]
+pub fn sin_cos_eighth(x: f64) -> (f64, f64) {
+    let z = x * x;
+    let s = 1.0
+        - z * (1.0 / 6.0)
+            * (1.0
+                - z * (1.0 / 20.0)
+                    * (1.0
+                        - z * (1.0 / 42.0)
+                            * (1.0
+                                - z * (1.0 / 72.0)
+                                    * (1.0
+                                        - z * (1.0 / 110.0)
+                                            * (1.0
+                                                - z * (1.0 / 156.0)
+                                                    * (1.0 - z * (1.0 / 210.0)))))));
+    let c = 1.0
+        - z * (1.0 / 2.0)
+            * (1.0
+                - z * (1.0 / 12.0)
+                    * (1.0
+                        - z * (1.0 / 30.0)
+                            * (1.0
+                                - z * (1.0 / 56.0)
+                                    * (1.0
+                                        - z * (1.0 / 90.0)
+                                            * (1.0
+                                                - z * (1.0 / 132.0)
+                                                    * (1.0
+                                                        - z * (1.0 / 182.0)
+                                                            * (1.0 - z * (1.0 / 240.0))))))));
+    (x * s, c)
+}
+
+/// `(sin 2πu, cos 2πu)` for any finite `u` (an azimuth given as a fraction of a turn): the
+/// nearest quarter turn is taken out exactly, and [`sin_cos_eighth`] does the rest.
+#[inline]
+pub fn sin_cos_turn(u: f64) -> (f64, f64) {
+    let q = (4.0 * u).round();
+    let (s, c) = sin_cos_eighth(std::f64::consts::TAU * (u - 0.25 * q));
+    match (q as i64).rem_euclid(4) {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
 }
 
 #[cfg(test)]
@@ -193,6 +247,32 @@ mod tests {
         }
         let r = ChiSquareTest::SINGLE.check_uniform(&counts).unwrap();
         assert!(r.passes(), "{r}");
+    }
+
+    /// The series against the library functions: within 2e-16 over their range, and the turn
+    /// version over several turns of either sign (within the rounding of the library's own
+    /// argument 2πu).
+    #[test]
+    fn fast_sine_and_cosine_are_the_library_ones() {
+        let n = 100_000;
+        for k in 0..=n {
+            let x = FRAC_PI_4 * (2.0 * k as f64 / n as f64 - 1.0);
+            let (s, c) = sin_cos_eighth(x);
+            assert!(
+                (s - x.sin()).abs() <= 2e-16 && (c - x.cos()).abs() <= 2e-16,
+                "{x}"
+            );
+        }
+        for k in 0..=n {
+            let u = 6.0 * (k as f64 / n as f64) - 3.0;
+            let (s, c) = sin_cos_turn(u);
+            // The library's own argument 2πu is rounded: half an ulp of it.
+            let (ls, lc) = (std::f64::consts::TAU * u).sin_cos();
+            let tol = 2e-16 * (1.0 + std::f64::consts::TAU * u.abs());
+            assert!((s - ls).abs() <= tol && (c - lc).abs() <= tol, "{u}");
+        }
+        assert_eq!(sin_cos_turn(0.0), (0.0, 1.0));
+        assert_eq!(sin_cos_turn(0.25), (1.0, -0.0));
     }
 
     /// A pair is the two points, bit for bit, from either parity of k.
