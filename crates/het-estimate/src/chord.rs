@@ -73,10 +73,18 @@ impl Chord {
         }
         let perpendicular = |n: DVec3| n.is_finite() && n.dot(x_hat).abs() <= NOT_PERPENDICULAR;
         // The same plane whichever point is x_i: the modified normal of n_i + n_o (commutative,
-        // so bit-identical under the swap), with a canonical sign.
-        let mut normal = canonical(modified_normal(n_i + n_o, x_i, x_o));
+        // so bit-identical under the swap), with a canonical sign. With x̂ at hand it is the
+        // sum's component perpendicular to x̂, normalised (what `modified_normal` computes,
+        // without normalising twice and measuring the chord again); undefined where the sum
+        // has no direction or lies along the chord.
+        let sum = n_i + n_o;
+        let sum_len2 = sum.length_squared();
+        let proj = sum - sum.dot(x_hat) * x_hat;
+        let proj_len2 = proj.length_squared();
+        let mut normal = canonical(proj / proj_len2.sqrt());
         let mut normal_fallback = false;
-        if !perpendicular(normal) || (n_i + n_o).length_squared() < NORMALS_CANCEL {
+        // (A NaN sum gives a NaN normal, which is not perpendicular.)
+        if sum_len2 < NORMALS_CANCEL || proj_len2 <= 1e-18 * sum_len2 || !perpendicular(normal) {
             // n_i + n_o ∥ x̂, or the normals (nearly) cancel, as on the two faces of a slab:
             // the modified normal of n_i − n_o (≈ 2n_i there; negated by the swap, which the
             // canonical sign undoes).
@@ -86,7 +94,8 @@ impl Chord {
                 normal = x_hat.any_orthonormal_vector();
             }
         }
-        let minor_dir = normal.cross(x_hat).normalize();
+        // Unit to rounding: the cross product of two orthogonal unit vectors.
+        let minor_dir = normal.cross(x_hat);
         Some(Self {
             mid: 0.5 * (x_i + x_o),
             half_len: 0.5 * d,
@@ -182,6 +191,32 @@ mod tests {
         }
         let paper = canonical(modified_normal(n_i, x_i, x_o));
         assert!((paper - a.normal).length() > 1e-3);
+    }
+
+    /// The plane normal is FHK14's modified normal of n_i + n_o (computed here without its
+    /// own normalisations), on random pairs to rounding.
+    #[test]
+    fn the_normal_is_the_modified_normal_of_the_sum() {
+        let mut k = 0.0f64;
+        let mut next = || {
+            k += 1.0;
+            DVec3::new((1.3 * k).sin(), (2.1 * k).cos(), (0.7 * k).sin())
+        };
+        for _ in 0..1000 {
+            let (x_i, x_o) = (5.0 * next(), 5.0 * next());
+            let (n_i, n_o) = (next().normalize(), next().normalize());
+            let c = Chord::new(x_i, n_i, x_o, n_o).unwrap();
+            if c.normal_fallback {
+                continue;
+            }
+            let want = canonical(modified_normal(n_i + n_o, x_i, x_o));
+            assert!(
+                (c.normal - want).length() < 1e-13,
+                "{:?} {want:?}",
+                c.normal
+            );
+            assert!((c.minor_dir.length() - 1.0).abs() < 1e-15);
+        }
     }
 
     #[test]

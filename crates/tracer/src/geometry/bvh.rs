@@ -827,9 +827,13 @@ impl BoxLine {
             BoxProjection::Undecided => return Projected::Undecided,
         };
         let mut p = (origin + c.t * self.dir).clamp(self.lo, self.hi);
-        p[c.axis] = c.plane;
         let hair = 1e-9 * (1.0 + p.abs().max_element());
-        p[c.axis] -= c.sign * hair;
+        let on_face = c.plane - c.sign * hair;
+        match c.axis {
+            0 => p.x = on_face,
+            1 => p.y = on_face,
+            _ => p.z = on_face,
+        }
         Projected::At(p)
     }
 }
