@@ -315,6 +315,8 @@ impl ProfileTable {
     /// the trapezoid cumulative to the cell, the linear density's area within it, and the
     /// exponential tail beyond the last radius.
     fn mixture_cdf(&self, rows: [(usize, f64); 2], x: f64) -> f64 {
+        // The cell, once for both rows.
+        let j = if x >= XLAST { 0 } else { self.cell(x) };
         let mut f = 0.0;
         for (i, w) in rows {
             if w <= 0.0 {
@@ -326,7 +328,6 @@ impl ProfileTable {
                 let tail = p[COLS - 1] * XLAST / z;
                 last + tail * (-(-(x - XLAST) / XLAST).exp_m1())
             } else {
-                let j = self.cell(x);
                 let (x0, x1) = (self.x[j], self.x[j + 1]);
                 let tau = (x - x0).clamp(0.0, x1 - x0);
                 let slope = (p[j + 1] - p[j]) / (x1 - x0);
