@@ -13,18 +13,22 @@ impl Rgb {
     pub const ONE: Rgb = Rgb([1.0; 3]);
 
     /// The same value in every channel.
+    #[inline]
     pub const fn splat(v: f64) -> Self {
         Rgb([v, v, v])
     }
     /// From three channels.
+    #[inline]
     pub const fn new(r: f64, g: f64, b: f64) -> Self {
         Rgb([r, g, b])
     }
     /// Applies `f` to every channel.
+    #[inline]
     pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
         Rgb([f(self.0[0]), f(self.0[1]), f(self.0[2])])
     }
     /// Combines two triples channel by channel.
+    #[inline]
     pub fn zip_map(self, o: Rgb, f: impl Fn(f64, f64) -> f64) -> Self {
         Rgb([
             f(self.0[0], o.0[0]),
@@ -33,26 +37,32 @@ impl Rgb {
         ])
     }
     /// Arithmetic mean of the channels.
+    #[inline]
     pub fn mean(self) -> f64 {
         (self.0[0] + self.0[1] + self.0[2]) / 3.0
     }
     /// Largest channel.
+    #[inline]
     pub fn max_component(self) -> f64 {
         self.0[0].max(self.0[1]).max(self.0[2])
     }
     /// Smallest channel.
+    #[inline]
     pub fn min_component(self) -> f64 {
         self.0[0].min(self.0[1]).min(self.0[2])
     }
     /// True when every channel is finite.
+    #[inline]
     pub fn is_finite(self) -> bool {
         self.0.iter().all(|v| v.is_finite())
     }
     /// True when every channel is exactly zero.
+    #[inline]
     pub fn is_zero(self) -> bool {
         self.0.iter().all(|&v| v == 0.0)
     }
     /// Rec. 709 luminance of a linear RGB value.
+    #[inline]
     pub fn luminance(self) -> f64 {
         0.2126 * self.0[0] + 0.7152 * self.0[1] + 0.0722 * self.0[2]
     }
@@ -60,56 +70,66 @@ impl Rgb {
 
 impl Index<usize> for Rgb {
     type Output = f64;
+    #[inline]
     fn index(&self, i: usize) -> &f64 {
         &self.0[i]
     }
 }
 impl IndexMut<usize> for Rgb {
+    #[inline]
     fn index_mut(&mut self, i: usize) -> &mut f64 {
         &mut self.0[i]
     }
 }
 impl Add for Rgb {
     type Output = Rgb;
+    #[inline]
     fn add(self, o: Rgb) -> Rgb {
         self.zip_map(o, |a, b| a + b)
     }
 }
 impl AddAssign for Rgb {
+    #[inline]
     fn add_assign(&mut self, o: Rgb) {
         *self = *self + o;
     }
 }
 impl Sub for Rgb {
     type Output = Rgb;
+    #[inline]
     fn sub(self, o: Rgb) -> Rgb {
         self.zip_map(o, |a, b| a - b)
     }
 }
 impl Mul for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, o: Rgb) -> Rgb {
         self.zip_map(o, |a, b| a * b)
     }
 }
 impl Mul<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, s: f64) -> Rgb {
         self.map(|a| a * s)
     }
 }
 impl MulAssign<f64> for Rgb {
+    #[inline]
     fn mul_assign(&mut self, s: f64) {
         *self = *self * s;
     }
 }
 impl MulAssign for Rgb {
+    #[inline]
     fn mul_assign(&mut self, o: Rgb) {
         *self = *self * o;
     }
 }
 impl Div<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn div(self, s: f64) -> Rgb {
         self.map(|a| a / s)
     }
