@@ -85,7 +85,8 @@ pub(crate) struct Averaged {
     pub rel_se: Option<f64>,
 }
 
-/// Most points handed to one call of a chunked sampler ([`average_chunks`]).
+/// Most points handed at once to a sampler of the averaging loop, and to
+/// [`crate::SurfaceQuery::project_positions`] and [`crate::CoefficientField::averaged_at_points`].
 pub const CHUNK: usize = 32;
 
 /// Averages over a region whose points come from the point set `P`.

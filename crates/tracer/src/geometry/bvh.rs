@@ -490,8 +490,12 @@ impl Geometry {
         })
     }
 
-    /// [`Geometry::box_crossing`] traced: one ray over a short window around the nearer
-    /// crossing finds the triangle, where a general mesh needs a ray each way. The hit is the
+    /// For an object whose mesh is its own axis-aligned box ([`Geometry::object_box_extent`]):
+    /// the hit of Sone's projection, the crossing of the whole line `origin + t·dir` (unit
+    /// `dir`, `t` of either sign) nearest to `origin`. The box's planes say where that
+    /// crossing is (or that the line misses the box, or that they cannot settle it within the
+    /// f32 margin of the triangles: [`BoxProjection::Undecided`]), and one ray over a short
+    /// window around it finds the triangle, where a general mesh needs a ray each way. The hit is the
     /// ray's own (the same `t`, point and normals as the two-ray projection's);
     /// [`BoxProjection::Undecided`] also for an origin on the surface and when the window
     /// finds no triangle.
@@ -515,9 +519,9 @@ impl Geometry {
         }
     }
 
-    /// [`Geometry::box_crossing`] without a ray: the point where the line crosses the box's
-    /// face, computed from the planes in f64, moved inward by a hair (1e-9 of the coordinates'
-    /// magnitude, far below any texture's scale).
+    /// [`Geometry::project_onto_box`] without a ray: the point where the line crosses the
+    /// box's face, computed from the planes in f64, moved inward by a hair (1e-9 of the
+    /// coordinates' magnitude, far below any texture's scale).
     /// The hair matters where a face lies on a cell boundary of a field (the checker slab's
     /// sides): the point then reads the medium behind the face, as the path tracer's volume
     /// does, rather than whichever side rounding picks. An origin on the surface (the points
