@@ -17,7 +17,7 @@ use crate::common::chandrasekhar::emergent_radiance;
 use crate::common::half_space::{
     half_space_scene, half_space_scene_with, image_mean_and_se, mean_and_se,
 };
-use crate::common::harness::{render_multiple, sone};
+use crate::common::harness::{example_scene, render_multiple, sone};
 
 #[test]
 fn path_tracer_emergent_radiance_matches_chandrasekhar() {
@@ -93,12 +93,7 @@ fn bssrdf_render_of_a_half_space_matches_the_dipole_closed_form() {
 
 #[test]
 fn renders_are_identical_whatever_the_thread_count() {
-    let scene = Scene::from_toml_str(
-        include_str!("../examples/scenes/checker-slab.toml"),
-        std::path::Path::new("examples/scenes"),
-        "checker-slab.toml",
-    )
-    .unwrap();
+    let scene = example_scene("checker-slab.toml");
     let small = |threads: usize, method: Method| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -137,14 +132,9 @@ fn renders_are_identical_whatever_the_thread_count() {
 #[test]
 fn prefiltered_and_monte_carlo_renders_agree_on_the_checker_slab() {
     use het_estimate::Averaging;
-    let scene = Scene::from_toml_str(
-        include_str!("../examples/scenes/checker-slab.toml"),
-        std::path::Path::new("examples/scenes"),
-        "checker-slab.toml",
-    )
-    .unwrap()
-    .with_resolution(32, 32)
-    .unwrap();
+    let scene = example_scene("checker-slab.toml")
+        .with_resolution(32, 32)
+        .unwrap();
     let run = |averaging: Averaging| render_multiple(&scene, sone(64, averaging), 32, 2, 9);
     let (pre, mc) = (run(Averaging::Prefiltered), run(Averaging::MonteCarlo));
     let (mut diff, mut norm) = (0.0, 0.0);
@@ -173,14 +163,9 @@ fn prefiltered_and_monte_carlo_renders_agree_on_the_checker_slab() {
 #[test]
 fn kernel_points_read_in_the_plane_equal_their_projections() {
     use het_estimate::Averaging;
-    let scene = Scene::from_toml_str(
-        include_str!("../examples/scenes/checker-halfspace.toml"),
-        std::path::Path::new("examples/scenes"),
-        "checker-halfspace.toml",
-    )
-    .unwrap()
-    .with_resolution(24, 24)
-    .unwrap();
+    let scene = example_scene("checker-halfspace.toml")
+        .with_resolution(24, 24)
+        .unwrap();
     let kernel = |averaging: Averaging| {
         "kernel"
             .parse::<Method>()

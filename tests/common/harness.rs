@@ -27,6 +27,13 @@ pub fn render_multiple(
     render(n, n, &integrator, &RenderOptions::samples(spp, seed))
 }
 
+/// The example scene `examples/scenes/<file>` as shipped.
+pub fn example_scene(file: &str) -> Scene {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes");
+    let text = std::fs::read_to_string(dir.join(file)).unwrap();
+    Scene::from_toml_str(&text, &dir, file).unwrap()
+}
+
 /// Sone with `samples` per averaging stage and the given averaging.
 pub fn sone(samples: u32, averaging: Averaging) -> Method {
     "sone"

@@ -1,6 +1,5 @@
 //! The chord x_i–x_o and the averaging plane through it (paper §3.1, Figure 3).
 
-use bssrdf_core::directional_dipole::modified_normal;
 use glam::DVec3;
 
 use crate::ellipse::PlanarEllipse;
@@ -71,29 +70,32 @@ impl Chord {
         {
             x_hat = -x_hat;
         }
-        let perpendicular = |n: DVec3| n.is_finite() && n.dot(x_hat).abs() <= NOT_PERPENDICULAR;
-        // The same plane whichever point is x_i: the modified normal of n_i + n_o (commutative,
-        // so bit-identical under the swap), with a canonical sign. With x̂ at hand it is the
-        // sum's component perpendicular to x̂, normalised (what `modified_normal` computes,
-        // without normalising twice and measuring the chord again); undefined where the sum
-        // has no direction or lies along the chord.
-        let sum = n_i + n_o;
-        let sum_len2 = sum.length_squared();
-        let proj = sum - sum.dot(x_hat) * x_hat;
-        let proj_len2 = proj.length_squared();
-        let mut normal = canonical(proj / proj_len2.sqrt());
-        let mut normal_fallback = false;
-        // (A NaN sum gives a NaN normal, which is not perpendicular.)
-        if sum_len2 < NORMALS_CANCEL || proj_len2 <= 1e-18 * sum_len2 || !perpendicular(normal) {
-            // n_i + n_o ∥ x̂, or the normals (nearly) cancel, as on the two faces of a slab:
-            // the modified normal of n_i − n_o (≈ 2n_i there; negated by the swap, which the
-            // canonical sign undoes).
-            normal_fallback = true;
-            normal = canonical(modified_normal(n_i - n_o, x_i, x_o));
-            if !perpendicular(normal) {
-                normal = x_hat.any_orthonormal_vector();
-            }
-        }
+        // FHK14's modified normal of n (n's component perpendicular to the chord, normalised,
+        // with a canonical sign), computed from x̂ at hand; `None` where n has no direction
+        // or lies along the chord (a NaN n has neither).
+        let modified = |n: DVec3| {
+            let n_len2 = n.length_squared();
+            let proj = n - n.dot(x_hat) * x_hat;
+            let proj_len2 = proj.length_squared();
+            let m = canonical(proj / proj_len2.sqrt());
+            (n_len2 >= NORMALS_CANCEL
+                && proj_len2 > 1e-18 * n_len2
+                && m.is_finite()
+                && m.dot(x_hat).abs() <= NOT_PERPENDICULAR)
+                .then_some(m)
+        };
+        // The same plane whichever point is x_i: the modified normal of n_i + n_o
+        // (commutative, so bit-identical under the swap). Where that is undefined (n_i + n_o
+        // ∥ x̂, or the normals nearly cancel, as on the two faces of a slab), that of n_i − n_o
+        // (≈ 2n_i there; negated by the swap, which the canonical sign undoes); failing that,
+        // any unit vector ⟂ x̂.
+        let (normal, normal_fallback) = match modified(n_i + n_o) {
+            Some(m) => (m, false),
+            None => (
+                modified(n_i - n_o).unwrap_or_else(|| x_hat.any_orthonormal_vector()),
+                true,
+            ),
+        };
         // Unit to rounding: the cross product of two orthogonal unit vectors.
         let minor_dir = normal.cross(x_hat);
         Some(Self {
@@ -132,6 +134,7 @@ impl Chord {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bssrdf_core::directional_dipole::modified_normal;
 
     #[test]
     fn frame_is_orthonormal_and_contains_the_chord() {

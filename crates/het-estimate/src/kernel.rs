@@ -316,22 +316,11 @@ where
         } else {
             None
         };
-        let found = in_plane_value.or_else(|| {
-            probe.diag.projections += 1;
-            probe
-                .surface
-                .project(origin, chord.normal)
-                .map(|hit| probe.lookup(&hit))
-        });
+        let found = in_plane_value.or_else(|| probe.project_value(origin, chord.normal));
         let c = match found {
             Some(c) => c,
-            None => {
-                probe.diag.misses += 1;
-                if !miss_endpoints {
-                    continue;
-                }
-                probe.endpoints()
-            }
+            None if miss_endpoints => probe.endpoints(),
+            None => continue,
         };
         let rho = proposal.distances(p);
         let q = proposal.pdf(rho);

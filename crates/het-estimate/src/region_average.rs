@@ -262,8 +262,15 @@ where
     /// ([`CoefficientField::averaged`]: σa and σs unless the field says otherwise).
     #[inline]
     pub fn lookup(&mut self, p: &S::Point) -> Coefficients {
+        let c = self.field.averaged(p);
+        self.counted(c)
+    }
+
+    /// A value the field returned, counted as a lookup and sanitised.
+    #[inline]
+    fn counted(&mut self, c: Coefficients) -> Coefficients {
         self.diag.lookups += 1;
-        sanitise(self.field.averaged(p))
+        sanitise(c)
     }
 
     /// [`Probe::lookup`] at a point of space, for fields defined there
@@ -272,8 +279,7 @@ where
     #[inline]
     pub fn lookup_at_point(&mut self, x: DVec3) -> Option<Coefficients> {
         let c = self.field.averaged_at_point(x)?;
-        self.diag.lookups += 1;
-        Some(sanitise(c))
+        Some(self.counted(c))
     }
 
     /// The coefficients of a mean in the averaging space
@@ -344,120 +350,134 @@ where
         miss_endpoints: bool,
         acc: &mut Accumulator,
     ) {
-        // Fields defined in space need only the position, which some surfaces give without
-        // building a point.
+        let value = self.project_value(origin, dir);
+        self.add_or_miss(value, channels, miss_endpoints, acc);
+    }
+
+    /// The coefficients at the projection of `origin` along ±`dir` (the nearer hit), counted;
+    /// `None` on a miss (counted too). Fields defined in space need only the hit's position,
+    /// which some surfaces give without building a point
+    /// ([`SurfaceQuery::project_position`]).
+    #[inline]
+    pub fn project_value(&mut self, origin: DVec3, dir: DVec3) -> Option<Coefficients> {
         let position = if self.field.has_point_lookup() {
             self.surface.project_position(origin, dir)
         } else {
             Projected::Undecided
         };
-        self.add_projected(origin, dir, position, channels, miss_endpoints, acc);
+        self.value_at(origin, dir, position)
     }
 
-    /// [`Probe::project_and_add`] for every origin of `origins` along one direction, in
-    /// order: the positions are asked for [`CHUNK`] at a time
-    /// ([`SurfaceQuery::project_positions`]), and the field read at them together
-    /// ([`CoefficientField::averaged_at_points`]).
-    #[inline]
-    pub fn project_and_add_all(
+    /// [`Probe::project_and_add`] at the points `centre + u.x·semi_major + u.y·semi_minor` of
+    /// the ellipse `e` for the unit-disk points `us`, in order, projected along its normal: the
+    /// positions are asked for [`CHUNK`] at a time ([`SurfaceQuery::project_positions`]) and
+    /// the field read at them together ([`CoefficientField::averaged_at_points`]).
+    pub fn project_ellipse_points(
         &mut self,
-        origins: &[DVec3],
-        dir: DVec3,
-        channels: Channels,
-        miss: bool,
-        acc: &mut Accumulator,
-    ) {
-        for chunk in origins.chunks(CHUNK) {
-            self.project_and_add_chunk(chunk, dir, channels, miss, acc);
-        }
-    }
-
-    /// [`Probe::project_and_add_all`] for at most [`CHUNK`] origins.
-    #[inline]
-    fn project_and_add_chunk(
-        &mut self,
-        origins: &[DVec3],
-        dir: DVec3,
-        channels: Channels,
-        miss: bool,
-        acc: &mut Accumulator,
-    ) {
-        let mut positions = [Projected::Undecided; CHUNK];
-        let positions = &mut positions[..origins.len()];
-        if !self.field.has_point_lookup() {
-            for &origin in origins {
-                self.add_projected(origin, dir, Projected::Undecided, channels, miss, acc);
-            }
-            return;
-        }
-        self.surface.project_positions(origins, dir, positions);
-        // The field at every position found, read together.
-        let mut xs = [DVec3::ZERO; CHUNK];
-        let mut n = 0;
-        for p in positions.iter() {
-            if let Projected::At(x) = *p {
-                xs[n] = x;
-                n += 1;
-            }
-        }
-        let mut values = [Coefficients::default(); CHUNK];
-        let read = n > 0 && self.field.averaged_at_points(&xs[..n], &mut values[..n]);
-        let mut next = 0;
-        for (&origin, &position) in origins.iter().zip(positions.iter()) {
-            match position {
-                Projected::At(_) if read => {
-                    self.diag.projections += 1;
-                    self.diag.lookups += 1;
-                    acc.add(&sanitise(values[next]), channels);
-                    next += 1;
-                }
-                _ => self.add_projected(origin, dir, position, channels, miss, acc),
-            }
-        }
-    }
-
-    /// One projection, given what [`SurfaceQuery::project_position`] said about it.
-    #[inline]
-    fn add_projected(
-        &mut self,
-        origin: DVec3,
-        dir: DVec3,
-        position: Projected,
+        e: &crate::PlanarEllipse,
+        us: &[glam::DVec2],
         channels: Channels,
         miss_endpoints: bool,
         acc: &mut Accumulator,
     ) {
-        self.diag.projections += 1;
-        match position {
-            Projected::At(x) => {
-                if let Some(c) = self.lookup_at_point(x) {
-                    acc.add(&c, channels);
-                    return;
-                }
+        for us in us.chunks(CHUNK) {
+            let mut origins = [DVec3::ZERO; CHUNK];
+            for (o, &u) in origins.iter_mut().zip(us) {
+                *o = e.point(u);
             }
-            Projected::Miss => {
-                self.miss(channels, miss_endpoints, acc);
-                return;
-            }
-            Projected::Undecided => {}
-        }
-        match self.surface.project(origin, dir) {
-            Some(hit) => {
-                debug_assert!(hit.position().is_finite());
-                let c = self.lookup(&hit);
-                acc.add(&c, channels);
-            }
-            None => self.miss(channels, miss_endpoints, acc),
+            self.project_chunk(
+                &origins[..us.len()],
+                e.normal,
+                channels,
+                miss_endpoints,
+                acc,
+            );
         }
     }
 
-    /// A projection that found nothing: counted, and the endpoint mean added under
-    /// [`crate::MissPolicy::Endpoints`].
-    fn miss(&mut self, channels: Channels, miss_endpoints: bool, acc: &mut Accumulator) {
-        self.diag.misses += 1;
-        if miss_endpoints {
-            let c = self.endpoints();
-            acc.add(&c, channels);
+    /// [`Probe::project_and_add`] for at most [`CHUNK`] origins along one direction.
+    #[inline]
+    fn project_chunk(
+        &mut self,
+        origins: &[DVec3],
+        dir: DVec3,
+        channels: Channels,
+        miss_endpoints: bool,
+        acc: &mut Accumulator,
+    ) {
+        let mut positions = [Projected::Undecided; CHUNK];
+        let positions = &mut positions[..origins.len()];
+        let mut values = [Coefficients::default(); CHUNK];
+        let mut read = false;
+        if self.field.has_point_lookup() {
+            self.surface.project_positions(origins, dir, positions);
+            // The field at every position found, read together.
+            let mut xs = [DVec3::ZERO; CHUNK];
+            let mut n = 0;
+            for p in positions.iter() {
+                if let Projected::At(x) = *p {
+                    xs[n] = x;
+                    n += 1;
+                }
+            }
+            read = n > 0 && self.field.averaged_at_points(&xs[..n], &mut values[..n]);
+        }
+        let mut next = 0;
+        for (&origin, &position) in origins.iter().zip(positions.iter()) {
+            let value = match position {
+                Projected::At(_) if read => {
+                    self.diag.projections += 1;
+                    next += 1;
+                    Some(self.counted(values[next - 1]))
+                }
+                _ => self.value_at(origin, dir, position),
+            };
+            self.add_or_miss(value, channels, miss_endpoints, acc);
+        }
+    }
+
+    /// One counted projection, given what [`SurfaceQuery::project_position`] said about it.
+    #[inline]
+    fn value_at(&mut self, origin: DVec3, dir: DVec3, position: Projected) -> Option<Coefficients> {
+        self.diag.projections += 1;
+        let value = match position {
+            Projected::At(x) => self
+                .lookup_at_point(x)
+                .or_else(|| self.lookup_projected(origin, dir)),
+            Projected::Miss => None,
+            Projected::Undecided => self.lookup_projected(origin, dir),
+        };
+        if value.is_none() {
+            self.diag.misses += 1;
+        }
+        value
+    }
+
+    /// The coefficients at [`SurfaceQuery::project`]'s hit, `None` on a miss (uncounted).
+    #[inline]
+    fn lookup_projected(&mut self, origin: DVec3, dir: DVec3) -> Option<Coefficients> {
+        let hit = self.surface.project(origin, dir)?;
+        debug_assert!(hit.position().is_finite());
+        Some(self.lookup(&hit))
+    }
+
+    /// Adds `value` to `acc` for `channels`; a miss adds the endpoint mean under
+    /// [`crate::MissPolicy::Endpoints`], else nothing.
+    #[inline]
+    fn add_or_miss(
+        &mut self,
+        value: Option<Coefficients>,
+        channels: Channels,
+        miss_endpoints: bool,
+        acc: &mut Accumulator,
+    ) {
+        match value {
+            Some(c) => acc.add(&c, channels),
+            None if miss_endpoints => {
+                let c = self.endpoints();
+                acc.add(&c, channels);
+            }
+            None => {}
         }
     }
 }
@@ -492,7 +512,7 @@ mod tests {
             assert_eq!(got, want, "n = {n}");
         }
         // An unreachable target: every round up to max, replicate by replicate.
-        let max = 8 * 40;
+        let max = REPLICATES * 40;
         let mut got = Vec::new();
         average_chunks::<DiskPoints, _>(
             SampleBudget::TargetRelError {

@@ -42,7 +42,6 @@
 use std::num::NonZeroU32;
 
 use bssrdf_core::Rgb;
-use glam::DVec3;
 
 use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
@@ -50,7 +49,7 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::prefilter::{Averaging, Flatness};
-use crate::region_average::{Accumulator, CHUNK, Channels, Probe, average_chunks};
+use crate::region_average::{Accumulator, Channels, Probe, average_chunks};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
@@ -250,12 +249,7 @@ where
         None => {
             let averaged =
                 average_chunks::<DiskPoints, _>(params.disk, known.varying(), rng, |us, acc| {
-                    let mut origins = [DVec3::ZERO; CHUNK];
-                    for (o, &u) in origins.iter_mut().zip(us) {
-                        *o = disk.point(u);
-                    }
-                    let origins = &origins[..us.len()];
-                    probe.project_and_add_all(origins, disk.normal, Rgb::ONE, miss_endpoints, acc)
+                    probe.project_ellipse_points(&disk, us, Rgb::ONE, miss_endpoints, acc)
                 });
             probe.diag.samples += averaged.samples;
             note_se(averaged.rel_se);
@@ -313,17 +307,7 @@ where
             |us, acc| {
                 for g in (0..groups.len).filter(|&g| sampled[g]) {
                     let e = &ellipses[g];
-                    let mut origins = [DVec3::ZERO; CHUNK];
-                    for (o, &u) in origins.iter_mut().zip(us) {
-                        *o = e.point(u);
-                    }
-                    probe.project_and_add_all(
-                        &origins[..us.len()],
-                        e.normal,
-                        groups.channels[g],
-                        miss_endpoints,
-                        acc,
-                    );
+                    probe.project_ellipse_points(e, us, groups.channels[g], miss_endpoints, acc);
                 }
             },
         );

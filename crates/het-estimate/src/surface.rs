@@ -62,11 +62,13 @@ pub trait SurfaceQuery {
     }
 }
 
-/// The answer of [`SurfaceQuery::project_position`].
+/// The answer of [`SurfaceQuery::project_position`] (a position, by default), or of any
+/// shortcut to [`SurfaceQuery::project`] that may not settle every line (the tracer's boxes
+/// answer with their hits too).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Projected {
-    /// The position of the nearer hit, scene units.
-    At(DVec3),
+pub enum Projected<T = DVec3> {
+    /// The nearer hit (for `project_position`, its position, scene units).
+    At(T),
     /// Neither ray hits the object.
     Miss,
     /// Not known without [`SurfaceQuery::project`].

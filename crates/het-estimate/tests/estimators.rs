@@ -1223,25 +1223,21 @@ fn kernel_in_plane_reading_equals_projection() {
         let t = k as f64;
         let x_i = PlanePoint::new(0.0, 0.0);
         let x_o = PlanePoint::new(12.0 * (0.7 * t).sin(), 9.0 * (1.3 * t).cos());
-        let kernel =
-            |averaging: Averaging| Estimator::Kernel(KernelParams::new().with_averaging(averaging));
-        let pre = run(
+        let kernel = |averaging: Averaging| {
+            let params = KernelParams::new().with_averaging(averaging);
+            run(
+                Estimator::Kernel(params),
+                0.0,
+                &Plane,
+                &field,
+                &x_i,
+                &x_o,
+                k,
+            )
+        };
+        let (pre, mc) = (
             kernel(Averaging::Prefiltered),
-            0.0,
-            &Plane,
-            &field,
-            &x_i,
-            &x_o,
-            k,
-        );
-        let mc = run(
             kernel(Averaging::MonteCarlo),
-            0.0,
-            &Plane,
-            &field,
-            &x_i,
-            &x_o,
-            k,
         );
         assert_eq!(pre.coefficients, mc.coefficients, "pair {k}");
         if pre.diagnostics.region == Region::Kernel {

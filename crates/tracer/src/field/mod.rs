@@ -552,6 +552,18 @@ impl MediumField {
         }
     }
 
+    /// The raw values at a point in the estimators' averaging space: σa and σs (an artist's
+    /// colour and mean free path inverted here), unless they average the colour and mean
+    /// free path themselves ([`InvertAt::After`]).
+    #[inline]
+    fn in_averaging_space(&self, raw: Coefficients) -> Coefficients {
+        match &self.artist {
+            None => raw,
+            Some(map) if map.invert() == InvertAt::After => raw,
+            Some(map) => map.coefficients_out_of_line(raw),
+        }
+    }
+
     /// True when the estimators average an artist's colour and mean free path and invert the
     /// means ([`InvertAt::After`]).
     #[inline]
@@ -646,12 +658,7 @@ impl CoefficientField<Hit> for MediumField {
     /// otherwise.
     #[inline]
     fn averaged(&self, p: &Hit) -> Coefficients {
-        let raw = self.raw_at_surface(p.p, p.uv);
-        match &self.artist {
-            None => raw,
-            Some(map) if map.invert() == InvertAt::After => raw,
-            Some(map) => map.coefficients_out_of_line(raw),
-        }
+        self.in_averaging_space(self.raw_at_surface(p.p, p.uv))
     }
 
     /// [`CoefficientField::averaged`] at a point of space, for media that do not read texture
@@ -662,12 +669,7 @@ impl CoefficientField<Hit> for MediumField {
         if !self.is_volumetric() {
             return None;
         }
-        let raw = self.raw_at_surface(x, DVec2::ZERO);
-        Some(match &self.artist {
-            None => raw,
-            Some(map) if map.invert() == InvertAt::After => raw,
-            Some(map) => map.coefficients_out_of_line(raw),
-        })
+        Some(self.in_averaging_space(self.raw_at_surface(x, DVec2::ZERO)))
     }
 
     fn has_point_lookup(&self) -> bool {
@@ -691,12 +693,9 @@ impl CoefficientField<Hit> for MediumField {
                 o.sigma_s = *v;
             }
         }
-        match &self.artist {
-            None => {}
-            Some(map) if map.invert() == InvertAt::After => {}
-            Some(map) => out
-                .iter_mut()
-                .for_each(|c| *c = map.coefficients_out_of_line(*c)),
+        if self.artist.is_some() {
+            out.iter_mut()
+                .for_each(|c| *c = self.in_averaging_space(*c));
         }
         true
     }

@@ -39,7 +39,7 @@ pub mod surface;
 mod tlas;
 mod watertight;
 
-pub use bvh::{BoxProjection, Geometry};
+pub use bvh::Geometry;
 pub use mesh::{MeshReport, Transform, TriangleMesh};
 pub use surface::ObjectSurface;
 

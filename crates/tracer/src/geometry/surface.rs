@@ -4,7 +4,7 @@ use glam::DVec3;
 
 use het_estimate::Projected;
 
-use super::{BoxProjection, Geometry, Hit, Ray};
+use super::{Geometry, Hit, Ray};
 
 /// The surface of one object of a [`Geometry`], as the estimators see it.
 #[derive(Debug, Clone, Copy)]
@@ -33,9 +33,9 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         // A box: one ray where its planes say the nearer crossing is.
         match self.geometry.project_onto_box(self.object, origin, dir) {
-            BoxProjection::At(hit) => Some(hit),
-            BoxProjection::Miss => None,
-            BoxProjection::Undecided => self.project_by_rays(origin, dir),
+            Projected::At(hit) => Some(hit),
+            Projected::Miss => None,
+            Projected::Undecided => self.project_by_rays(origin, dir),
         }
     }
 
@@ -125,7 +125,7 @@ mod tests {
                 (Projected::Miss, None) | (Projected::Undecided, _) => {}
                 (got, want) => panic!("line {k}: {got:?} against {want:?}"),
             }
-            fast += usize::from(g.project_onto_box(0, origin, dir) != BoxProjection::Undecided);
+            fast += usize::from(g.project_onto_box(0, origin, dir) != Projected::Undecided);
             match (got, want) {
                 (Some(a), Some(b)) => {
                     hits += 1;
@@ -146,7 +146,7 @@ mod tests {
         let sphere = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 1.0, 2)]);
         assert_eq!(
             sphere.project_onto_box(0, DVec3::ZERO, DVec3::Z),
-            BoxProjection::Undecided
+            Projected::Undecided
         );
     }
 
@@ -168,16 +168,15 @@ mod tests {
         assert!(s.project(DVec3::new(7.0, 0.0, 0.0), DVec3::Z).is_none());
     }
 
-    /// Sone's Monte Carlo averages on a box are the same whether each point is projected by a
-    /// ray or placed by the box's planes (a field defined in space, its cell boundaries off the
-    /// faces): the same points, so the same values, to the bit, for pairs on one face and
-    /// across edges. Placing the points on the farther crossing, or off the surface by a
-    /// texture cell, would change them.
+    /// The sampled averages on a box (Sone's and the kernel's, both projecting every point) are
+    /// the same whether each point is projected by a ray or placed by the box's planes (a
+    /// field defined in space, its cell boundaries off the faces): the same points, so the
+    /// same values, to the bit, for pairs on one face and across edges. Placing the points on
+    /// the farther crossing, or off the surface by a texture cell, would change them.
     #[test]
-    fn sone_on_a_box_reads_the_same_values_without_rays() {
+    fn sampled_averages_on_a_box_read_the_same_values_without_rays() {
         use crate::field::{Axis, Field, MediumField, PlanarProjection};
-        use crate::rng::Rng;
-        use het_estimate::{Averaging, Estimator, SoneParams};
+        use het_estimate::{Averaging, Estimator, KernelParams, SoneParams};
 
         /// The same surface with only `project`: every point by rays.
         struct ByRays<'a>(ObjectSurface<'a>);
@@ -199,9 +198,25 @@ mod tests {
         )
         .unwrap();
         let field = MediumField::new(check, Field::constant(bssrdf_core::Rgb::ONE).unwrap());
-        let sone = Estimator::Sone(SoneParams::paper().with_averaging(Averaging::MonteCarlo))
-            .prepare(0.0, 1.0)
-            .unwrap();
+        for estimator in [
+            Estimator::Sone(SoneParams::paper().with_averaging(Averaging::MonteCarlo)),
+            Estimator::Kernel(KernelParams::new().with_averaging(Averaging::MonteCarlo)),
+        ] {
+            let prepared = estimator.prepare(0.0, 1.0).unwrap();
+            same_values_without_rays(&g, &planes, &rays, &field, &prepared);
+        }
+    }
+
+    /// The comparison of [`sampled_averages_on_a_box_read_the_same_values_without_rays`] for
+    /// one estimator on the box `g` ([-10, 10]² × [-10, 0]).
+    fn same_values_without_rays(
+        g: &Geometry,
+        planes: &ObjectSurface<'_>,
+        rays: &impl SurfaceQuery<Point = Hit>,
+        field: &crate::field::MediumField,
+        estimator: &het_estimate::PreparedEstimator,
+    ) {
+        use crate::rng::Rng;
         let mut rng = Rng::from_keys(5, &[]);
         // Points on the top face and on the +x side, up to 8 apart.
         let on_box = |rng: &mut Rng| {
@@ -219,9 +234,9 @@ mod tests {
             across += usize::from(x_i.ns != x_o.ns);
             let (mut r1, mut r2) = (Rng::from_keys(k, &[]), Rng::from_keys(k, &[]));
             let before = g.rays_traced();
-            let a = sone.estimate(&planes, &field, &x_i, &x_o, &mut r1);
+            let a = estimator.estimate(planes, field, &x_i, &x_o, &mut r1);
             planes_rays += g.rays_traced() - before;
-            let b = sone.estimate(&rays, &field, &x_i, &x_o, &mut r2);
+            let b = estimator.estimate(rays, field, &x_i, &x_o, &mut r2);
             assert_eq!(a.coefficients, b.coefficients, "pair {k}");
             let (da, db) = (a.diagnostics, b.diagnostics);
             assert_eq!(
@@ -233,7 +248,7 @@ mod tests {
         }
         assert!(
             across > 100 && lookups > 10_000,
-            "{across} pairs across, {lookups} lookups"
+            "{across} pairs across, {lookups} lookups, {estimator:?}"
         );
         // The planes settle nearly every point: a ray only where a line grazes an edge.
         assert!(

@@ -142,8 +142,9 @@ impl BssrdfObject {
         coeffs: het_estimate::Coefficients,
         rng: &mut Rng,
     ) -> crate::integrator::probe::ProbeSet {
-        self.sampler
-            .probe_chords(chords, x_o, coeffs, self.extent, rng)
+        let mut set = crate::integrator::probe::ProbeSet::new();
+        self.probe_set_into(&mut set, chords, x_o, coeffs, rng);
+        set
     }
 
     /// [`BssrdfObject::probe_set`] into `set`, which the caller keeps (no copy of the set).
