@@ -45,7 +45,7 @@ use std::f64::consts::PI;
 use std::mem::MaybeUninit;
 
 use bssrdf_core::ParamError;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
@@ -53,7 +53,7 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::prefilter::{Averaging, Flatness};
-use crate::region_average::Probe;
+use crate::region_average::{CHUNK, Probe};
 use crate::sampler::UniformSource;
 use crate::sampling::{DiskPoints, PointSet};
 use crate::surface::SurfaceQuery;
@@ -308,35 +308,46 @@ where
     // Uninitialised storage: zeroing 72 KiB per estimate would cost more than the estimate.
     let mut store = [const { MaybeUninit::<Sample>::uninit() }; KernelParams::MAX_SAMPLES as usize];
     let mut len = 0usize;
-    for k in 0..n {
-        let p = proposal.sample(set.unit_square(k as u32));
-        let origin = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
-        let in_plane_value = if in_plane {
-            probe.lookup_at_point(origin)
+    // The points a chunk at a time: read together in the plane, or projected together.
+    let mut ps = [DVec2::ZERO; CHUNK];
+    let mut origins = [DVec3::ZERO; CHUNK];
+    let mut found = [None; CHUNK];
+    let mut read = [Coefficients::default(); CHUNK];
+    for first in (0..n).step_by(CHUNK) {
+        let m = CHUNK.min(n - first);
+        for j in 0..m {
+            ps[j] = proposal.sample(set.unit_square((first + j) as u32));
+            origins[j] = chord.mid + ps[j].x * chord.x_hat + ps[j].y * chord.minor_dir;
+        }
+        if in_plane && probe.lookup_at_points(&origins[..m], &mut read[..m]) {
+            for (f, &c) in found[..m].iter_mut().zip(&read[..m]) {
+                *f = Some(c);
+            }
         } else {
-            None
-        };
-        let found = in_plane_value.or_else(|| probe.project_value(origin, chord.normal));
-        let c = match found {
-            Some(c) => c,
-            None if miss_endpoints => probe.endpoints(),
-            None => continue,
-        };
-        let rho = proposal.distances(p);
-        let q = proposal.pdf(rho);
-        let inv_q = if q.is_finite() && q > 0.0 {
-            1.0 / q
-        } else {
-            0.0
-        };
-        let a_p = power(c.sigma_a.0, exponent);
-        store[len].write(Sample {
-            rho,
-            inv_q,
-            a_p,
-            s: c.sigma_s.0,
-        });
-        len += 1;
+            probe.project_values(&origins[..m], chord.normal, &mut found[..m]);
+        }
+        for (&p, &value) in ps[..m].iter().zip(&found[..m]) {
+            let c = match value {
+                Some(c) => c,
+                None if miss_endpoints => probe.endpoints(),
+                None => continue,
+            };
+            let rho = proposal.distances(p);
+            let q = proposal.pdf(rho);
+            let inv_q = if q.is_finite() && q > 0.0 {
+                1.0 / q
+            } else {
+                0.0
+            };
+            let a_p = power(c.sigma_a.0, exponent);
+            store[len].write(Sample {
+                rho,
+                inv_q,
+                a_p,
+                s: c.sigma_s.0,
+            });
+            len += 1;
+        }
     }
     probe.diag.samples += n as u32;
     // SAFETY: the first `len` elements were initialised by `write` above (and `Sample` is

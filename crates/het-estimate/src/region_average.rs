@@ -405,6 +405,25 @@ where
         miss_endpoints: bool,
         acc: &mut Accumulator,
     ) {
+        let mut values = [None; CHUNK];
+        let values = &mut values[..origins.len()];
+        self.project_values(origins, dir, values);
+        for &value in values.iter() {
+            self.add_or_miss(value, channels, miss_endpoints, acc);
+        }
+    }
+
+    /// [`Probe::project_value`] for at most [`CHUNK`] origins along one direction, into `out`
+    /// (as long as `origins`), with the same counts: the positions are asked for together
+    /// ([`SurfaceQuery::project_positions`]) and the field read at them together
+    /// ([`CoefficientField::averaged_at_points`]).
+    pub fn project_values(
+        &mut self,
+        origins: &[DVec3],
+        dir: DVec3,
+        out: &mut [Option<Coefficients>],
+    ) {
+        debug_assert!(origins.len() <= CHUNK && out.len() == origins.len());
         let mut positions = [Projected::Undecided; CHUNK];
         let positions = &mut positions[..origins.len()];
         let mut values = [Coefficients::default(); CHUNK];
@@ -423,8 +442,8 @@ where
             read = n > 0 && self.field.averaged_at_points(&xs[..n], &mut values[..n]);
         }
         let mut next = 0;
-        for (&origin, &position) in origins.iter().zip(positions.iter()) {
-            let value = match position {
+        for ((&origin, &position), o) in origins.iter().zip(positions.iter()).zip(out) {
+            *o = match position {
                 Projected::At(_) if read => {
                     self.diag.projections += 1;
                     next += 1;
@@ -432,8 +451,20 @@ where
                 }
                 _ => self.value_at(origin, dir, position),
             };
-            self.add_or_miss(value, channels, miss_endpoints, acc);
         }
+    }
+
+    /// [`Probe::lookup_at_point`] at every point of `xs` (at most [`CHUNK`]), read together
+    /// ([`CoefficientField::averaged_at_points`]), into `out`; `false` (nothing counted, `out`
+    /// unspecified) where the field has no value at some point without a surface point.
+    pub fn lookup_at_points(&mut self, xs: &[DVec3], out: &mut [Coefficients]) -> bool {
+        if !self.field.averaged_at_points(xs, out) {
+            return false;
+        }
+        for o in out.iter_mut() {
+            *o = self.counted(*o);
+        }
+        true
     }
 
     /// One counted projection, given what [`SurfaceQuery::project_position`] said about it.
