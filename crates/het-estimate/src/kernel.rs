@@ -238,6 +238,32 @@ impl Proposal {
         let radial = |r: f64| c / (2.0 * PI * r * (r + c) * (r + c));
         0.5 * (radial(distances.0) + radial(distances.1))
     }
+
+    /// 1/[`Proposal::pdf`], and 0 where the pdf is infinite (at an end) or 0. In units of c
+    /// (xₖ = ρₖ/c, Dₖ = xₖ(xₖ + 1)²), 1/q = 4πc²·D₀D₁/(D₀ + D₁): one division where the pdf
+    /// takes three, and no overflow (xₖ ≤ 2⁵³ + 1 for the proposal's own points).
+    #[inline]
+    pub fn inv_pdf(&self, distances: (f64, f64)) -> f64 {
+        let c = self.scale;
+        let inv_c = 1.0 / c;
+        let cube = |r: f64| {
+            let x = r * inv_c;
+            x * (x + 1.0) * (x + 1.0)
+        };
+        let (d0, d1) = (cube(distances.0), cube(distances.1));
+        let v = (4.0 * PI * c * c) * (d0 * d1 / (d0 + d1));
+        if v.is_finite() {
+            v
+        } else {
+            // Both ends at once (0/0), or c² out of range: through the pdf itself.
+            let q = self.pdf(distances);
+            if q.is_finite() && q > 0.0 {
+                1.0 / q
+            } else {
+                0.0
+            }
+        }
+    }
 }
 
 /// One looked-up sample point.
@@ -313,6 +339,7 @@ where
     let mut origins = [DVec3::ZERO; CHUNK];
     let mut found = [None; CHUNK];
     let mut read = [Coefficients::default(); CHUNK];
+    let (mut rho, mut inv_q) = ([(0.0, 0.0); CHUNK], [0.0; CHUNK]);
     for first in (0..n).step_by(CHUNK) {
         let m = CHUNK.min(n - first);
         for j in 0..m {
@@ -326,27 +353,31 @@ where
         } else {
             probe.project_values(&origins[..m], chord.normal, &mut found[..m]);
         }
-        for (&p, &value) in ps[..m].iter().zip(&found[..m]) {
-            let c = match value {
-                Some(c) => c,
-                None if miss_endpoints => probe.endpoints(),
-                None => continue,
-            };
-            let rho = proposal.distances(p);
-            let q = proposal.pdf(rho);
-            let inv_q = if q.is_finite() && q > 0.0 {
-                1.0 / q
-            } else {
-                0.0
-            };
-            let a_p = power(c.sigma_a.0, exponent);
-            store[len].write(Sample {
-                rho,
-                inv_q,
-                a_p,
-                s: c.sigma_s.0,
-            });
-            len += 1;
+        // In passes with no dependency from one point to the next (the processor overlaps
+        // the points' square roots): the proposal's density, σa^p, then the stored samples.
+        for (j, &p) in ps[..m].iter().enumerate() {
+            rho[j] = proposal.distances(p);
+            inv_q[j] = proposal.inv_pdf(rho[j]);
+        }
+        if miss_endpoints {
+            for f in &mut found[..m] {
+                f.get_or_insert_with(|| probe.endpoints());
+            }
+        }
+        // σa^p in place of σa.
+        for c in found[..m].iter_mut().flatten() {
+            c.sigma_a.0 = power(c.sigma_a.0, exponent);
+        }
+        for j in 0..m {
+            if let Some(c) = found[j] {
+                store[len].write(Sample {
+                    rho: rho[j],
+                    inv_q: inv_q[j],
+                    a_p: c.sigma_a.0,
+                    s: c.sigma_s.0,
+                });
+                len += 1;
+            }
         }
     }
     probe.diag.samples += n as u32;
@@ -424,7 +455,7 @@ fn power(a: [f64; 3], p: f64) -> [f64; 3] {
 }
 
 /// The W₂/q-weighted means (σa as the power mean of exponent `exponent`, σs arithmetic) of
-/// the channels selected by `group` of `samples`, with
+/// the channels selected by `group` of `samples` (the other channels' entries are 0), with
 /// the kernel of a homogeneous medium (`sigma_a`, `sigma_s`, `g`) for a chord of length `d`;
 /// `None` when that medium has no diffusion length (σt' = 0) or every weight is 0.
 #[inline]
@@ -443,37 +474,55 @@ fn weighted_means(
     let kappa = (3.0 * sigma_a / st).sqrt();
     let d_t = d * st;
     let mask = group.map(|b| if b { 1.0 } else { 0.0 });
+    let table = table.at_kappa(kappa);
     let (mut wa, mut ws, mut w) = ([0.0; 3], [0.0; 3], 0.0);
-    for s in samples {
-        let (ri, ro) = (s.rho.0 * st, s.rho.1 * st);
-        // W₂ relative to its exponential factor on the chord: ρ_i + ρ_o ≥ d, so the exponent
-        // is ≤ h and nothing underflows near the chord whatever σt·d.
-        let log_w = table.log_weight(ri, ro, kappa) - kappa * ((ri + ro) - d_t);
-        let weight = log_w.exp() * s.inv_q;
-        // A subnormal weight has lost its precision: weight·σ / weight would be off by up to
-        // ~1e-9 relative (outside the field's range). Such a point carries nothing next to
-        // any normal one, so it is dropped (all dropped: the caller's fallback).
-        if weight < f64::MIN_POSITIVE {
-            continue;
+    // A batch at a time, in three passes (log-weights, weights, sums): the passes have no
+    // dependency from one point to the next, so the processor overlaps the points (the sums
+    // are in the points' order, as in one pass).
+    let mut weights = [0.0; CHUNK];
+    for batch in samples.chunks(CHUNK) {
+        let weights = &mut weights[..batch.len()];
+        for (l, s) in weights.iter_mut().zip(batch) {
+            let (ri, ro) = (s.rho.0 * st, s.rho.1 * st);
+            // W₂ relative to its exponential factor on the chord: ρ_i + ρ_o ≥ d, so the
+            // exponent is ≤ h and nothing underflows near the chord whatever σt·d.
+            *l = table.log_weight(ri, ro) - kappa * ((ri + ro) - d_t);
         }
-        for k in 0..3 {
-            wa[k] += weight * mask[k] * s.a_p[k];
-            ws[k] += weight * mask[k] * s.s[k];
+        for (l, s) in weights.iter_mut().zip(batch) {
+            *l = l.exp() * s.inv_q;
         }
-        w += weight;
+        for (&weight, s) in weights.iter().zip(batch) {
+            // A subnormal weight has lost its precision: weight·σ / weight would be off by
+            // up to ~1e-9 relative (outside the field's range). Such a point carries nothing
+            // next to any normal one, so it is dropped (all dropped: the caller's fallback);
+            // as a zero, which adds nothing, rather than by a branch.
+            let weight = if weight < f64::MIN_POSITIVE {
+                0.0
+            } else {
+                weight
+            };
+            for k in 0..3 {
+                wa[k] += weight * mask[k] * s.a_p[k];
+                ws[k] += weight * mask[k] * s.s[k];
+            }
+            w += weight;
+        }
     }
     if !(w > 0.0 && w.is_finite()) {
         return None;
     }
-    Some(std::array::from_fn(|k| {
+    let mut means = [(0.0, 0.0); 3];
+    for k in (0..3).filter(|&k| group[k]) {
         let (a_p, s) = (wa[k] / w, ws[k] / w);
-        let a = if exponent == 1.0 {
-            a_p
-        } else {
-            a_p.powf(1.0 / exponent)
+        // Grey fields: the channels' sums are equal, and the root is taken once.
+        let a = match (0..k).find(|&j| group[j] && wa[j] == wa[k]) {
+            Some(j) => means[j].0,
+            None if exponent == 1.0 => a_p,
+            None => a_p.powf(1.0 / exponent),
         };
-        (a, s)
-    }))
+        means[k] = (a, s);
+    }
+    Some(means)
 }
 
 #[cfg(test)]
@@ -495,6 +544,37 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// `inv_pdf` is 1/`pdf` (to rounding) over twelve decades of distance, 0 at an end, and
+    /// finite where the products overflow.
+    #[test]
+    fn inverse_pdf_is_the_pdfs_inverse() {
+        for scale in [1e-3, 1.5, 1e4] {
+            let prop = Proposal { half: 0.7, scale };
+            for r0 in [1e-6, 0.01, 0.7, 1.4, 3.0, 1e3, 1e6] {
+                for r1 in [1e-6, 0.3, 1.4, 50.0, 1e6] {
+                    let (got, want) = (prop.inv_pdf((r0, r1)), 1.0 / prop.pdf((r0, r1)));
+                    assert!((got - want).abs() <= 1e-13 * want, "{got} against {want}");
+                }
+            }
+            assert_eq!(prop.inv_pdf((0.0, 1.4)), 0.0);
+            assert_eq!(prop.inv_pdf((1.4, 0.0)), 0.0);
+        }
+        // Scene units far from 1: the same relation.
+        let huge = Proposal {
+            half: 1e150,
+            scale: 1e150,
+        };
+        let unit = Proposal {
+            half: 1.0,
+            scale: 1.0,
+        };
+        let (got, want) = (huge.inv_pdf((1e150, 3e150)), 1e300 / unit.pdf((1.0, 3.0)));
+        assert!(
+            want.is_finite() && (got - want).abs() <= 1e-13 * want,
+            "{got} against {want}"
+        );
     }
 
     /// The proposal's points follow its pdf: chi-square over polar cells around the first

@@ -82,8 +82,8 @@ pub fn kappa_node(j: usize) -> f64 {
 /// `h = ln W̃₂(ρ_i, ρ_o; κ, A)` for one boundary coefficient A (see the module docs).
 pub struct KernelTable {
     a: f64,
-    /// `h[(j·RHO_NODES + i)·RHO_NODES + o]` for κ node j and distance nodes i, o.
-    h: Box<[f32]>,
+    /// `h[j][i·RHO_NODES + o]` for κ node j and distance nodes i, o.
+    h: Box<[Slice; KAPPA_NODES]>,
 }
 
 impl std::fmt::Debug for KernelTable {
@@ -105,7 +105,10 @@ impl KernelTable {
         let zb = 2.0 * a / 3.0;
         let depth = depth_nodes();
         let n = RHO_NODES;
-        let mut h = vec![0f32; KAPPA_NODES * n * n].into_boxed_slice();
+        let mut h: Box<[Slice; KAPPA_NODES]> = vec![[0f64; RHO_NODES * RHO_NODES]; KAPPA_NODES]
+            .into_boxed_slice()
+            .try_into()
+            .expect("KAPPA_NODES slices");
         let mut g = vec![0f64; n * depth.len()];
         for j in 0..KAPPA_NODES {
             let kappa = kappa_node(j);
@@ -123,9 +126,9 @@ impl KernelTable {
                         .enumerate()
                         .map(|(z, &(_, w))| w * (gi[z] * go[z]))
                         .sum();
-                    let v = w2.ln() as f32;
-                    h[(j * n + i) * n + o] = v;
-                    h[(j * n + o) * n + i] = v;
+                    let v = w2.ln();
+                    h[j][i * n + o] = v;
+                    h[j][o * n + i] = v;
                 }
             }
         }
@@ -134,7 +137,7 @@ impl KernelTable {
 
     /// The shared table for boundary coefficient `a`: built on first use and kept for the
     /// life of the process (one per distinct A, i.e. per distinct η among the materials;
-    /// 256 KiB each).
+    /// 512 KiB each: f64, which reads faster than f32 and its conversions).
     pub fn shared(a: f64) -> &'static KernelTable {
         static TABLES: OnceLock<Mutex<Vec<&'static KernelTable>>> = OnceLock::new();
         let mut tables = TABLES
@@ -158,10 +161,48 @@ impl KernelTable {
     /// out-of-range arguments are clamped to the grid). Finite for every input, NaN included.
     #[inline]
     pub fn log_weight(&self, rho_i: f64, rho_o: f64, kappa: f64) -> f64 {
-        let h = self.log_weight_on_grid(rho_i, rho_o, kappa);
+        self.at_kappa(kappa).log_weight(rho_i, rho_o)
+    }
+
+    /// The table at one κ (clamped to [0, √3]; NaN reads as 0): the two κ slices around it
+    /// and the blend between them, found once for the many lookups of one weighted average.
+    #[inline]
+    pub fn at_kappa(&self, kappa: f64) -> KappaSlice<'_> {
+        let top = (KAPPA_NODES - 1) as f64;
+        let f = (kappa / KAPPA_MAX * top).min(top).max(0.0);
+        let j = (f as usize).min(KAPPA_NODES - 2);
+        KappaSlice {
+            lo: &self.h[j],
+            hi: &self.h[j + 1],
+            t: f - j as f64,
+        }
+    }
+}
+
+/// The table at one κ ([`KernelTable::at_kappa`]): bilinear in the two distances on each of
+/// the two κ slices around it, linear between them.
+#[derive(Clone, Copy)]
+pub struct KappaSlice<'a> {
+    lo: &'a Slice,
+    hi: &'a Slice,
+    t: f64,
+}
+
+impl std::fmt::Debug for KappaSlice<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("KappaSlice").field("t", &self.t).finish()
+    }
+}
+
+impl KappaSlice<'_> {
+    /// `h = ln W̃₂` at distances `rho_i`, `rho_o` ≥ 0 (transport units), as
+    /// [`KernelTable::log_weight`] at this slice's κ.
+    #[inline]
+    pub fn log_weight(&self, rho_i: f64, rho_o: f64) -> f64 {
+        let h = self.on_grid(rho_i, rho_o);
         let last = rho_node(RHO_NODES - 1);
         if rho_i > last || rho_o > last {
-            self.extrapolate(h, rho_i, rho_o, kappa)
+            self.extrapolate(h, rho_i, rho_o)
         } else {
             h
         }
@@ -171,18 +212,17 @@ impl KernelTable {
     /// axis that is out of range (the far field is a power law in ρ times the exact
     /// exponential; holding h constant would over-weight it without bound).
     #[cold]
-    fn extrapolate(&self, mut h: f64, rho_i: f64, rho_o: f64, kappa: f64) -> f64 {
+    fn extrapolate(&self, mut h: f64, rho_i: f64, rho_o: f64) -> f64 {
         let n = RHO_NODES;
         let (last, prev) = (rho_node(n - 1), rho_node(n - 2));
         let step = last.ln() - prev.ln();
         let (ci, co) = (rho_i.min(last), rho_o.min(last));
-        let grid = |ri: f64, ro: f64| self.log_weight_on_grid(ri, ro, kappa);
         if rho_i > last {
-            let slope = (grid(last, co) - grid(prev, co)) / step;
+            let slope = (self.on_grid(last, co) - self.on_grid(prev, co)) / step;
             h += slope * (rho_i.min(1e300).ln() - last.ln());
         }
         if rho_o > last {
-            let slope = (grid(ci, last) - grid(ci, prev)) / step;
+            let slope = (self.on_grid(ci, last) - self.on_grid(ci, prev)) / step;
             h += slope * (rho_o.min(1e300).ln() - last.ln());
         }
         h
@@ -190,39 +230,36 @@ impl KernelTable {
 
     /// Trilinear interpolation of the grid, clamped to it.
     #[inline]
-    fn log_weight_on_grid(&self, rho_i: f64, rho_o: f64, kappa: f64) -> f64 {
-        let n = RHO_NODES;
-        let top = (n - 1) as f64;
+    fn on_grid(&self, rho_i: f64, rho_o: f64) -> f64 {
+        const N: usize = RHO_NODES;
         // 1 − s/(ρ + s) rather than ρ/(ρ + s): ρ = ∞ maps to 1, not NaN.
-        let axis = |rho: f64| {
-            ((1.0 - RHO_SCALE / (rho + RHO_SCALE)) * n as f64)
-                .min(top)
-                .max(0.0)
-        };
-        let split = |f: f64, last: usize| {
-            let k = (f as usize).min(last - 1);
+        let cell = |rho: f64| {
+            let f = ((1.0 - RHO_SCALE / (rho + RHO_SCALE)) * N as f64)
+                .min((N - 1) as f64)
+                .max(0.0);
+            let k = (f as usize).min(N - 2);
             (k, f - k as f64)
         };
-        let (i, ti) = split(axis(rho_i), n - 1);
-        let (o, to) = split(axis(rho_o), n - 1);
-        let fk = (kappa / KAPPA_MAX * (KAPPA_NODES - 1) as f64)
-            .min((KAPPA_NODES - 1) as f64)
-            .max(0.0);
-        let (j, tk) = split(fk, KAPPA_NODES - 1);
-        let at = |j: usize| {
-            let base = (j * n + i) * n + o;
-            let v00 = self.h[base] as f64;
-            let v01 = self.h[base + 1] as f64;
-            let v10 = self.h[base + n] as f64;
-            let v11 = self.h[base + n + 1] as f64;
+        let (i, ti) = cell(rho_i);
+        let (o, to) = cell(rho_o);
+        // The cell's four corners are `base`, `base + 1`, `base + N` and `base + N + 1`,
+        // all inside the slice since i, o ≤ N − 2.
+        let base = i * N + o;
+        let bilinear = |s: &Slice| {
+            let c = &s[base..base + N + 2];
+            let (v00, v01) = (c[0], c[1]);
+            let (v10, v11) = (c[N], c[N + 1]);
             let lo = v00 + to * (v01 - v00);
             let hi = v10 + to * (v11 - v10);
             lo + ti * (hi - lo)
         };
-        let (a, b) = (at(j), at(j + 1));
-        a + tk * (b - a)
+        let (a, b) = (bilinear(self.lo), bilinear(self.hi));
+        a + self.t * (b - a)
     }
 }
+
+/// One κ slice of the table: `h[i·RHO_NODES + o]` for distance nodes i, o.
+type Slice = [f64; RHO_NODES * RHO_NODES];
 
 #[cfg(test)]
 mod tests {
@@ -325,6 +362,6 @@ mod tests {
                 assert!((a - b).abs() < 1e-6);
             }
         }
-        assert!(t.h.iter().all(|v| v.is_finite()));
+        assert!(t.h.iter().flatten().all(|v| v.is_finite()));
     }
 }
