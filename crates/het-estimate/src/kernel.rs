@@ -334,8 +334,10 @@ where
     // Uninitialised storage: zeroing 72 KiB per estimate would cost more than the estimate.
     let mut store = [const { MaybeUninit::<Sample>::uninit() }; KernelParams::MAX_SAMPLES as usize];
     let mut len = 0usize;
-    // The points a chunk at a time: read together in the plane, or projected together.
-    let mut ps = [DVec2::ZERO; CHUNK];
+    // The points a chunk at a time: read together in the plane, or projected together. Each
+    // step is a pass with no dependency from one point to the next (the processor overlaps
+    // the points' square roots): the points and their densities, the values, σa^p, then the
+    // stored samples.
     let mut origins = [DVec3::ZERO; CHUNK];
     let mut found = [None; CHUNK];
     let mut read = [Coefficients::default(); CHUNK];
@@ -343,8 +345,10 @@ where
     for first in (0..n).step_by(CHUNK) {
         let m = CHUNK.min(n - first);
         for j in 0..m {
-            ps[j] = proposal.sample(set.unit_square((first + j) as u32));
-            origins[j] = chord.mid + ps[j].x * chord.x_hat + ps[j].y * chord.minor_dir;
+            let p = proposal.sample(set.unit_square((first + j) as u32));
+            origins[j] = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
+            rho[j] = proposal.distances(p);
+            inv_q[j] = proposal.inv_pdf(rho[j]);
         }
         if in_plane && probe.lookup_at_points(&origins[..m], &mut read[..m]) {
             for (f, &c) in found[..m].iter_mut().zip(&read[..m]) {
@@ -352,12 +356,6 @@ where
             }
         } else {
             probe.project_values(&origins[..m], chord.normal, &mut found[..m]);
-        }
-        // In passes with no dependency from one point to the next (the processor overlaps
-        // the points' square roots): the proposal's density, σa^p, then the stored samples.
-        for (j, &p) in ps[..m].iter().enumerate() {
-            rho[j] = proposal.distances(p);
-            inv_q[j] = proposal.inv_pdf(rho[j]);
         }
         if miss_endpoints {
             for f in &mut found[..m] {
@@ -455,7 +453,8 @@ fn power(a: [f64; 3], p: f64) -> [f64; 3] {
 }
 
 /// The W₂/q-weighted means (σa as the power mean of exponent `exponent`, σs arithmetic) of
-/// the channels selected by `group` of `samples` (the other channels' entries are 0), with
+/// the channels selected by `group` of `samples` (the other channels' entries are 0, and
+/// `group`'s channels with equal sums share one root), with
 /// the kernel of a homogeneous medium (`sigma_a`, `sigma_s`, `g`) for a chord of length `d`;
 /// `None` when that medium has no diffusion length (σt' = 0) or every weight is 0.
 #[inline]
@@ -473,7 +472,6 @@ fn weighted_means(
     }
     let kappa = (3.0 * sigma_a / st).sqrt();
     let d_t = d * st;
-    let mask = group.map(|b| if b { 1.0 } else { 0.0 });
     let table = table.at_kappa(kappa);
     let (mut wa, mut ws, mut w) = ([0.0; 3], [0.0; 3], 0.0);
     // A batch at a time, in three passes (log-weights, weights, sums): the passes have no
@@ -501,9 +499,10 @@ fn weighted_means(
             } else {
                 weight
             };
+            // Every channel is summed (cheaper than masking); only `group`'s are returned.
             for k in 0..3 {
-                wa[k] += weight * mask[k] * s.a_p[k];
-                ws[k] += weight * mask[k] * s.s[k];
+                wa[k] += weight * s.a_p[k];
+                ws[k] += weight * s.s[k];
             }
             w += weight;
         }
