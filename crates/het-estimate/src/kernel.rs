@@ -268,7 +268,7 @@ impl Proposal {
     }
 }
 
-/// Fewest points an iteration other than the last reweights (see [`estimate`], steps 3–4):
+/// Fewest points an iteration other than the last reweights (module docs, steps 3–4):
 /// those iterations reweight the first max(`PILOT_POINTS`, N/4) of the N points.
 ///
 /// They only choose the kernel of the next iteration, whose coefficients enter the weight
