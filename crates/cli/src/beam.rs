@@ -14,7 +14,7 @@ use tracer::integrator::Method;
 use crate::common::{
     check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{Given, check_averaging_flag, check_method_flags};
+use crate::flags::{Given, check_averaging_flag, check_method_flags, check_semi_minor_flag};
 use crate::interrupt;
 
 /// Texture kinds.
@@ -173,6 +173,11 @@ pub struct Args {
     /// or `monte-carlo` (always sample and project).
     #[arg(long, value_parser = crate::choices::averaging())]
     averaging: Option<het_estimate::Averaging>,
+    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
+    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
+    /// presets and the checker half-space; docs/physics.md#path-width).
+    #[arg(long, value_parser = crate::choices::semi_minor())]
+    semi_minor: Option<het_estimate::SemiMinorAxis>,
     /// Photons for `pt` (rounded up to batches of 8192).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     photons: Option<u64>,
@@ -252,6 +257,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.estimator_samples.is_some(),
     )?;
     check_averaging_flag(&[args.method], args.averaging.is_some())?;
+    check_semi_minor_flag(&[args.method], args.semi_minor.is_some())?;
     let setup = args.setup.setup()?;
     // The beam's half-space is index-matched (η = 1).
     let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
@@ -284,7 +290,8 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
                 args.estimator_samples
                     .map(|n| n.min(u32::MAX as u64) as u32),
             )
-            .with_averaging(args.averaging),
+            .with_averaging(args.averaging)
+            .with_semi_minor(args.semi_minor),
         profile,
         photons,
         sub,
@@ -304,6 +311,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         serde_json::json!({
             "seed": args.seed,
             "averaging": args.method.with_averaging(args.averaging).averaging().map(|a| a.name()),
+            "semi_minor": args.method.with_semi_minor(args.semi_minor).semi_minor().map(het_estimate::Named::name),
             "interrupted": interrupted.is_some(),
             "max_collisions": tracer::integrator::walk::collision_cap(),
         }),

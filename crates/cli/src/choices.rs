@@ -63,6 +63,16 @@ pub fn averaging() -> Choice<het_estimate::Averaging> {
     )
 }
 
+/// Sone's semi-minor axis reading of Eq. (2) (`w/2`, `w`).
+pub fn semi_minor() -> Choice<het_estimate::SemiMinorAxis> {
+    by_name(
+        het_estimate::SemiMinorAxis::ALL
+            .iter()
+            .map(|b| b.name())
+            .collect(),
+    )
+}
+
 /// A profile model name.
 pub fn profile() -> Choice<ProfileModel> {
     by_name(ProfileModel::ALL.iter().map(|m| m.name()).collect())

@@ -20,7 +20,7 @@ use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
 use crate::common::parse_positive;
-use crate::flags::{Given, check_averaging_flag, check_method_flags};
+use crate::flags::{Given, check_averaging_flag, check_method_flags, check_semi_minor_flag};
 
 /// Flags that set up the beam experiment: they do not apply to a scene.
 const BEAM_ONLY: &[&str] = &[
@@ -70,6 +70,11 @@ pub struct Args {
     /// or `monte-carlo` (always sample and project).
     #[arg(long, value_parser = crate::choices::averaging())]
     averaging: Option<het_estimate::Averaging>,
+    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
+    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
+    /// presets and the checker half-space; docs/physics.md#path-width).
+    #[arg(long, value_parser = crate::choices::semi_minor())]
+    semi_minor: Option<het_estimate::SemiMinorAxis>,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
     /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
     /// (beam, in --out).
@@ -167,6 +172,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.estimator_samples.is_some(),
     )?;
     check_averaging_flag(&args.methods, args.averaging.is_some())?;
+    check_semi_minor_flag(&args.methods, args.semi_minor.is_some())?;
     if args.beam {
         given.refuse(SCENE_ONLY, "with --beam (it applies to a scene study)")?;
     } else {
@@ -272,6 +278,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
             m.with_profile(args.profile)
                 .with_estimator_samples(estimator_samples(args))
                 .with_averaging(args.averaging.or(scene.settings().averaging))
+                .with_semi_minor(args.semi_minor)
         })
         .collect();
     let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
@@ -411,6 +418,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         .map(|m| {
             m.with_estimator_samples(samples)
                 .with_averaging(args.averaging)
+                .with_semi_minor(args.semi_minor)
         })
         .collect();
     let runs = beam_study(

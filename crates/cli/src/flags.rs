@@ -90,3 +90,17 @@ pub fn check_averaging_flag(methods: &[Method], given: bool) -> anyhow::Result<(
     }
     Ok(())
 }
+
+/// Errors when `--semi-minor` was given but none of `methods` is the Sone estimator, the one
+/// whose ellipse it sizes.
+pub fn check_semi_minor_flag(methods: &[Method], given: bool) -> anyhow::Result<()> {
+    if given && !methods.iter().any(|m| m.semi_minor().is_some()) {
+        let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
+        bail!(
+            "--semi-minor does not apply to `{}`: only the sone estimator averages over an \
+             ellipse sized by Eq. (2)",
+            names.join(", ")
+        );
+    }
+    Ok(())
+}

@@ -1,5 +1,5 @@
-//! Method overrides (`--profile`, `--estimator-samples`, `--averaging`) reach the runs and their sidecars, for
-//! `converge` (on a tiny scene) and `beam`.
+//! Method overrides (`--profile`, `--estimator-samples`, `--averaging`, `--semi-minor`) reach
+//! the runs and their sidecars, for `converge` (on a tiny scene), `beam` and `render`.
 
 use std::process::Command;
 
@@ -127,4 +127,84 @@ fn beam_prefilters_by_default_and_records_it() {
     assert!(!refused.status.success());
     let err = String::from_utf8_lossy(&refused.stderr);
     assert!(err.contains("--averaging does not apply"), "{err}");
+}
+
+/// `--semi-minor w` sizes Sone's ellipse with b = w instead of w/2: the beam map changes (on
+/// the check preset the ellipse then covers other cells), the sidecar records the reading
+/// (`w/2` by default), the render sidecar's estimator parameters carry it, and the flag is
+/// refused for an estimator without Sone's ellipse.
+#[test]
+fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let run = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(["beam", "--preset", "check", "--resolution", "12"])
+            .args(["--subsamples", "1", "--out", out.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+                .unwrap();
+        (v, std::fs::read(&out).unwrap())
+    };
+    let (half, half_exr) = map("half.exr", &["--method", "sone"]);
+    let (full, full_exr) = map("full.exr", &["--method", "sone", "--semi-minor", "w"]);
+    assert_eq!(half["semi_minor"], "w/2");
+    assert_eq!(full["semi_minor"], "w");
+    assert_ne!(half_exr, full_exr, "b = w gave the same map as b = w/2");
+
+    let refused = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args([
+            "beam",
+            "--preset",
+            "check",
+            "--resolution",
+            "4",
+            "--method",
+            "kernel",
+        ])
+        .args(["--semi-minor", "w", "--out"])
+        .arg(dir.path().join("refused.exr"))
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(err.contains("--semi-minor does not apply"), "{err}");
+    assert!(!dir.path().join("refused.exr").exists());
+
+    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
+        .replace("width = 128", "width = 4")
+        .replace("height = 128", "height = 4");
+    let scene_path = dir.path().join("slab.toml");
+    std::fs::write(&scene_path, scene).unwrap();
+    let out = dir.path().join("slab.exr");
+    let run = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
+        .args([
+            "--spp",
+            "1",
+            "--semi-minor",
+            "w",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
+            .unwrap();
+    let params = v["estimator_parameters"].as_str().unwrap();
+    assert!(params.contains("semi_minor: Width"), "{params}");
 }

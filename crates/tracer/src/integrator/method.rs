@@ -74,6 +74,39 @@ impl Method {
         }
     }
 
+    /// The same method with Sone's semi-minor axis reading of Eq. (2) replaced by
+    /// `semi_minor` (b = w/2, the literal reading and default, or b = w); other methods and
+    /// `None` leave it unchanged.
+    pub fn with_semi_minor(self, semi_minor: Option<het_estimate::SemiMinorAxis>) -> Self {
+        match (self, semi_minor) {
+            (
+                Method::Bssrdf {
+                    estimator: Estimator::Sone(mut p),
+                    profile,
+                },
+                Some(b),
+            ) => {
+                p.semi_minor = b;
+                Method::Bssrdf {
+                    estimator: Estimator::Sone(p),
+                    profile,
+                }
+            }
+            (m, _) => m,
+        }
+    }
+
+    /// Sone's semi-minor axis reading (`None` for other methods).
+    pub fn semi_minor(&self) -> Option<het_estimate::SemiMinorAxis> {
+        match self {
+            Method::Bssrdf {
+                estimator: Estimator::Sone(p),
+                ..
+            } => Some(p.semi_minor),
+            _ => None,
+        }
+    }
+
     /// Sone's or the kernel's averaging (`None` for other methods).
     pub fn averaging(&self) -> Option<het_estimate::Averaging> {
         match self {
