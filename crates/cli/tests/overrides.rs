@@ -129,6 +129,17 @@ fn beam_prefilters_by_default_and_records_it() {
     assert!(err.contains("--averaging does not apply"), "{err}");
 }
 
+/// Runs `cmd`, asks for success, and reads the sidecar of its output `out`.
+fn sidecar_of_run(cmd: &mut Command, out: &std::path::Path) -> serde_json::Value {
+    let run = cmd.output().unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap()).unwrap()
+}
+
 /// `--semi-minor w` sizes Sone's ellipse with b = w instead of w/2: the beam map changes (on
 /// the check preset the ellipse then covers other cells), the sidecar records the reading
 /// (`w/2` by default), the render sidecar's estimator parameters carry it, and the flag is
@@ -138,20 +149,13 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
     let dir = tempfile::tempdir().unwrap();
     let map = |name: &str, extra: &[&str]| {
         let out = dir.path().join(name);
-        let run = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
-            .args(["beam", "--preset", "check", "--resolution", "12"])
-            .args(["--subsamples", "1", "--out", out.to_str().unwrap()])
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
+        let v = sidecar_of_run(
+            Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+                .args(["beam", "--preset", "check", "--resolution", "12"])
+                .args(["--subsamples", "1", "--out", out.to_str().unwrap()])
+                .args(extra),
+            &out,
         );
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
-                .unwrap();
         (v, std::fs::read(&out).unwrap())
     };
     let (half, half_exr) = map("half.exr", &["--method", "sone"]);
@@ -185,26 +189,19 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
     let scene_path = dir.path().join("slab.toml");
     std::fs::write(&scene_path, scene).unwrap();
     let out = dir.path().join("slab.exr");
-    let run = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
-        .args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
-        .args([
-            "--spp",
-            "1",
-            "--semi-minor",
-            "w",
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let v = sidecar_of_run(
+        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
+            .args([
+                "--spp",
+                "1",
+                "--semi-minor",
+                "w",
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+        &out,
     );
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
-            .unwrap();
     let params = v["estimator_parameters"].as_str().unwrap();
     assert!(params.contains("semi_minor: Width"), "{params}");
 }
