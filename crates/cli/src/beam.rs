@@ -14,7 +14,7 @@ use tracer::integrator::Method;
 use crate::common::{
     check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{Given, check_averaging_flag, check_method_flags, check_semi_minor_flag};
+use crate::flags::{Given, RegionFlags, check_method_flags};
 use crate::interrupt;
 
 /// Texture kinds.
@@ -167,17 +167,8 @@ pub struct Args {
     /// at most 1024).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// Sone's and the kernel's averaging: `prefiltered` (default: Sone's constant-time closed
-    /// forms, and the kernel's points read in the surface's plane without projection rays,
-    /// where the field allows it and the surface is flat; sampling and projecting elsewhere)
-    /// or `monte-carlo` (always sample and project).
-    #[arg(long, value_parser = crate::choices::averaging())]
-    averaging: Option<het_estimate::Averaging>,
-    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
-    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
-    /// presets and the checker half-space; docs/physics.md#path-width).
-    #[arg(long, value_parser = crate::choices::semi_minor())]
-    semi_minor: Option<het_estimate::SemiMinorAxis>,
+    #[command(flatten)]
+    region: RegionFlags,
     /// Photons for `pt` (rounded up to batches of 8192).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     photons: Option<u64>,
@@ -256,8 +247,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         given.has("profile"),
         args.estimator_samples.is_some(),
     )?;
-    check_averaging_flag(&[args.method], args.averaging.is_some())?;
-    check_semi_minor_flag(&[args.method], args.semi_minor.is_some())?;
+    args.region.check(&[args.method])?;
     let setup = args.setup.setup()?;
     // The beam's half-space is index-matched (η = 1).
     let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
@@ -283,21 +273,14 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     .context("--resolution")?;
     set_collision_cap(args.max_collisions);
     interrupt::install()?;
-    let map = run_method(
-        &setup,
-        args.method
-            .with_estimator_samples(
-                args.estimator_samples
-                    .map(|n| n.min(u32::MAX as u64) as u32),
-            )
-            .with_averaging(args.averaging)
-            .with_semi_minor(args.semi_minor),
-        profile,
-        photons,
-        sub,
-        args.seed,
-        true,
-    )?;
+    let method = args.region.apply(
+        args.method.with_estimator_samples(
+            args.estimator_samples
+                .map(|n| n.min(u32::MAX as u64) as u32),
+        ),
+        None,
+    );
+    let map = run_method(&setup, method, profile, photons, sub, args.seed, true)?;
     let interrupted = interrupt::received().map(interrupt::name);
     if let Some(signal) = interrupted
         && map.samples == 0
@@ -310,8 +293,8 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         &out,
         serde_json::json!({
             "seed": args.seed,
-            "averaging": args.method.with_averaging(args.averaging).averaging().map(|a| a.name()),
-            "semi_minor": args.method.with_semi_minor(args.semi_minor).semi_minor().map(het_estimate::Named::name),
+            "averaging": method.averaging().map(|a| a.name()),
+            "semi_minor": method.semi_minor().map(het_estimate::Named::name),
             "interrupted": interrupted.is_some(),
             "max_collisions": tracer::integrator::walk::collision_cap(),
         }),

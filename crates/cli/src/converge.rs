@@ -20,7 +20,7 @@ use tracer::scene::Scene;
 
 use crate::beam::{SetupArgs, run_method};
 use crate::common::parse_positive;
-use crate::flags::{Given, check_averaging_flag, check_method_flags, check_semi_minor_flag};
+use crate::flags::{Given, RegionFlags, check_method_flags};
 
 /// Flags that set up the beam experiment: they do not apply to a scene.
 const BEAM_ONLY: &[&str] = &[
@@ -64,17 +64,8 @@ pub struct Args {
     /// Averaging samples per region of the segment, Sone and kernel estimators.
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// Sone's and the kernel's averaging: `prefiltered` (default: Sone's constant-time closed
-    /// forms, and the kernel's points read in the surface's plane without projection rays,
-    /// where the field allows it and the surface is flat; sampling and projecting elsewhere)
-    /// or `monte-carlo` (always sample and project).
-    #[arg(long, value_parser = crate::choices::averaging())]
-    averaging: Option<het_estimate::Averaging>,
-    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
-    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
-    /// presets and the checker half-space; docs/physics.md#path-width).
-    #[arg(long, value_parser = crate::choices::semi_minor())]
-    semi_minor: Option<het_estimate::SemiMinorAxis>,
+    #[command(flatten)]
+    region: RegionFlags,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
     /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
     /// (beam, in --out).
@@ -171,8 +162,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
         args.profile.is_some(),
         args.estimator_samples.is_some(),
     )?;
-    check_averaging_flag(&args.methods, args.averaging.is_some())?;
-    check_semi_minor_flag(&args.methods, args.semi_minor.is_some())?;
+    args.region.check(&args.methods)?;
     if args.beam {
         given.refuse(SCENE_ONLY, "with --beam (it applies to a scene study)")?;
     } else {
@@ -275,10 +265,11 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .methods
         .iter()
         .map(|m| {
-            m.with_profile(args.profile)
-                .with_estimator_samples(estimator_samples(args))
-                .with_averaging(args.averaging.or(scene.settings().averaging))
-                .with_semi_minor(args.semi_minor)
+            args.region.apply(
+                m.with_profile(args.profile)
+                    .with_estimator_samples(estimator_samples(args)),
+                scene.settings().averaging,
+            )
         })
         .collect();
     let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
@@ -415,11 +406,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     let methods: Vec<Method> = args
         .methods
         .iter()
-        .map(|m| {
-            m.with_estimator_samples(samples)
-                .with_averaging(args.averaging)
-                .with_semi_minor(args.semi_minor)
-        })
+        .map(|m| args.region.apply(m.with_estimator_samples(samples), None))
         .collect();
     let runs = beam_study(
         &setup,

@@ -77,30 +77,58 @@ pub fn check_method_flags(methods: &[Method], profile: bool, samples: bool) -> a
     Ok(())
 }
 
-/// Errors when `--averaging` was given but none of `methods` is the Sone or kernel estimator,
-/// the two that read prefiltered or in-plane values where they can.
-pub fn check_averaging_flag(methods: &[Method], given: bool) -> anyhow::Result<()> {
-    if given && !methods.iter().any(|m| m.averaging().is_some()) {
-        let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
-        bail!(
-            "--averaging does not apply to `{}`: only the sone and kernel estimators have a \
-             prefiltered and a Monte Carlo averaging",
-            names.join(", ")
-        );
-    }
-    Ok(())
+/// The region estimators' flags, shared by `render`, `beam` and `converge` (flattened into
+/// each): how Sone and the kernel average, and how wide Sone's ellipse is.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct RegionFlags {
+    /// Sone's and the kernel's averaging: `prefiltered` (default: Sone's constant-time closed
+    /// forms, and the kernel's points read in the surface's plane without projection rays,
+    /// where the field allows it and the surface is flat; sampling and projecting elsewhere)
+    /// or `monte-carlo` (always sample and project).
+    #[arg(long, value_parser = crate::choices::averaging())]
+    pub averaging: Option<het_estimate::Averaging>,
+    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
+    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
+    /// presets and the checker half-space; docs/physics.md#path-width).
+    #[arg(long, value_parser = crate::choices::semi_minor())]
+    pub semi_minor: Option<het_estimate::SemiMinorAxis>,
 }
 
-/// Errors when `--semi-minor` was given but none of `methods` is the Sone estimator, the one
-/// whose ellipse it sizes.
-pub fn check_semi_minor_flag(methods: &[Method], given: bool) -> anyhow::Result<()> {
-    if given && !methods.iter().any(|m| m.semi_minor().is_some()) {
-        let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
-        bail!(
-            "--semi-minor does not apply to `{}`: only the sone estimator averages over an \
-             ellipse sized by Eq. (2)",
+impl RegionFlags {
+    /// Errors when a flag was given that none of `methods` uses: `--averaging` applies to the
+    /// Sone and kernel estimators (the two that read prefiltered or in-plane values where they
+    /// can), `--semi-minor` to Sone alone (the one whose ellipse it sizes).
+    pub fn check(&self, methods: &[Method]) -> anyhow::Result<()> {
+        let names = || {
+            let names: Vec<_> = methods.iter().map(|m| m.name()).collect();
             names.join(", ")
-        );
+        };
+        if self.averaging.is_some() && !methods.iter().any(|m| m.averaging().is_some()) {
+            bail!(
+                "--averaging does not apply to `{}`: only the sone and kernel estimators have a \
+                 prefiltered and a Monte Carlo averaging",
+                names()
+            );
+        }
+        if self.semi_minor.is_some() && !methods.iter().any(|m| m.semi_minor().is_some()) {
+            bail!(
+                "--semi-minor does not apply to `{}`: only the sone estimator averages over an \
+                 ellipse sized by Eq. (2)",
+                names()
+            );
+        }
+        Ok(())
     }
-    Ok(())
+
+    /// `method` with these flags applied; `scene_averaging` (a scene file's `averaging`)
+    /// stands where `--averaging` was not given.
+    pub fn apply(
+        &self,
+        method: Method,
+        scene_averaging: Option<het_estimate::Averaging>,
+    ) -> Method {
+        method
+            .with_averaging(self.averaging.or(scene_averaging))
+            .with_semi_minor(self.semi_minor)
+    }
 }

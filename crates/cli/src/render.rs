@@ -20,7 +20,7 @@ use crate::common::{
     check_image_memory, check_writable, note_triangles, parse_exr_out, parse_positive,
     parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{check_averaging_flag, check_method_flags, check_semi_minor_flag};
+use crate::flags::{RegionFlags, check_method_flags};
 use crate::interrupt;
 
 /// Which way paths are traced.
@@ -52,17 +52,8 @@ pub struct Args {
     /// at most 1024).
     #[arg(long, value_parser = parse_positive)]
     estimator_samples: Option<u64>,
-    /// Sone's and the kernel's averaging: `prefiltered` (default: Sone's constant-time closed
-    /// forms, and the kernel's points read in the surface's plane without projection rays,
-    /// where the field allows it and the surface is flat; sampling and projecting elsewhere)
-    /// or `monte-carlo` (always sample and project).
-    #[arg(long, value_parser = crate::choices::averaging())]
-    averaging: Option<het_estimate::Averaging>,
-    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
-    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
-    /// presets and the checker half-space; docs/physics.md#path-width).
-    #[arg(long, value_parser = crate::choices::semi_minor())]
-    semi_minor: Option<het_estimate::SemiMinorAxis>,
+    #[command(flatten)]
+    region: RegionFlags,
     /// Where the estimators invert artist materials' colours and radii: `before` averaging
     /// (per point) or `after` (default: each material's `invert`; see
     /// docs/artist-parameters.md).
@@ -132,16 +123,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         args.profile.is_some(),
         args.estimator_samples.is_some(),
     )?;
-    check_averaging_flag(&[method], args.averaging.is_some())?;
-    check_semi_minor_flag(&[method], args.semi_minor.is_some())?;
-    let method = method
-        .with_profile(args.profile)
-        .with_estimator_samples(
+    args.region.check(&[method])?;
+    let method = args.region.apply(
+        method.with_profile(args.profile).with_estimator_samples(
             args.estimator_samples
                 .map(|n| n.min(u32::MAX as u64) as u32),
-        )
-        .with_averaging(args.averaging.or(scene.settings().averaging))
-        .with_semi_minor(args.semi_minor);
+        ),
+        scene.settings().averaging,
+    );
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);

@@ -164,7 +164,8 @@ impl KernelTable {
         self.at_kappa(kappa).log_weight(rho_i, rho_o)
     }
 
-    /// The table at one κ (clamped to [0, √3]; NaN reads as 0): the two κ slices around it
+    /// The table at one κ (clamped to [0, √3]; NaN reads as √3, since `f64::min` returns the
+    /// number when one side is NaN): the two κ slices around it
     /// and the blend between them, found once for the many lookups of one weighted average.
     #[inline]
     pub fn at_kappa(&self, kappa: f64) -> KappaSlice<'_> {
@@ -363,5 +364,12 @@ mod tests {
             }
         }
         assert!(t.h.iter().flatten().all(|v| v.is_finite()));
+        // A NaN κ reads as the clamp's top, √3 (as documented on `at_kappa`).
+        for (ri, ro) in [(0.3, 7.0), (2.0, 2.0)] {
+            assert_eq!(
+                t.log_weight(ri, ro, f64::NAN),
+                t.log_weight(ri, ro, KAPPA_MAX)
+            );
+        }
     }
 }

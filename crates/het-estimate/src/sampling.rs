@@ -198,7 +198,8 @@ pub fn sin_cos_eighth(x: f64) -> (f64, f64) {
 #[inline]
 pub fn sin_cos_turn(u: f64) -> (f64, f64) {
     // Adding and subtracting 1.5·2^52 rounds to an integer in two additions (`round` is a
-    // library call on the baseline x86-64 target); past 2^51 every such 4u is already one.
+    // library call on the baseline x86-64 target). It needs |4u| < 2^51, so that the sum
+    // stays in [2^52, 2^53) where the spacing is 1; larger arguments take `round`.
     // (`pattern::fast_floor` with a correction to the nearest made the kernel's points 5 %
     // slower: a conversion to i64 and back, and a comparison, where this is two additions.)
     const ROUND: f64 = 6_755_399_441_055_744.0;
