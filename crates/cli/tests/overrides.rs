@@ -205,3 +205,31 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
     let params = v["estimator_parameters"].as_str().unwrap();
     assert!(params.contains("semi_minor: Width"), "{params}");
 }
+
+/// A scene file's `averaging` reaches the render when `--averaging` is absent, and the flag
+/// wins over it when given (both applied by the same `RegionFlags::apply`).
+#[test]
+fn scene_averaging_applies_unless_the_flag_is_given() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
+        .replace("width = 128", "width = 4")
+        .replace("height = 128", "height = 4")
+        .replace("[render]", "[render]\naveraging = \"monte-carlo\"");
+    let scene_path = dir.path().join("slab.toml");
+    std::fs::write(&scene_path, scene).unwrap();
+    let out = dir.path().join("slab.exr");
+    let render = |extra: &[&str]| {
+        sidecar_of_run(
+            Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+                .args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
+                .args(["--spp", "1", "--out", out.to_str().unwrap()])
+                .args(extra),
+            &out,
+        )
+    };
+    assert_eq!(render(&[])["averaging"], "monte-carlo");
+    assert_eq!(
+        render(&["--averaging", "prefiltered"])["averaging"],
+        "prefiltered"
+    );
+}
