@@ -140,22 +140,34 @@ pub struct ProbeSampler {
 /// Source of [`ProbeSampler`] ids.
 static NEXT_SAMPLER_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
-/// What a truncated mass ([`TableSampler::fraction_within`] at half the cap) was computed for:
-/// the sampler, the channel and the bits of σa, σs and the cap.
+/// What a channel's table searches were computed for: the sampler, the channel and the bits
+/// of σa, σs and the radius cap.
 #[derive(Clone, Copy, PartialEq, Eq)]
-struct FractionKey {
+struct ChannelKey {
     sampler: u64,
     channel: usize,
     bits: [u64; 3],
 }
 
+/// The table searches of one channel of [`ProbeSampler::channels`]: x_o's own probe radius
+/// ([`TableSampler::radius_for_fraction`], `None` where x_o's profile reaches nowhere) and,
+/// when the probe radius exceeds half the cap, the masses of the radial density's components
+/// below half the cap ([`TableSampler::fraction_within`]; the second is 0 for a single
+/// profile).
+#[derive(Clone, Copy)]
+struct ChannelSearches {
+    own_radius: Option<f64>,
+    masses: Option<[f64; 2]>,
+}
+
 thread_local! {
-    /// The last truncated mass computed on this thread. Piecewise-constant fields (constants,
-    /// stripes, checks) ask for the same one at nearly every probe set, and computing it is a
-    /// table search (6 % of a `jensen-out` render of the checker slab before this memo). A
-    /// pure function's cache: it never changes a result.
-    static LAST_FRACTION: std::cell::Cell<Option<(FractionKey, f64)>> =
-        const { std::cell::Cell::new(None) };
+    /// The last searches computed on this thread, per channel. Piecewise-constant fields
+    /// (constants, stripes, checks) ask for the same ones at nearly every probe set, and each
+    /// is a table search (the masses were 6 % of a `jensen-out` render of the checker slab
+    /// before they were kept; the radius and the masses the draws below the cap need, 4 % of
+    /// a `sone` render). A pure function's cache: it never changes a result.
+    static LAST_SEARCHES: [std::cell::Cell<Option<(ChannelKey, ChannelSearches)>>; 3] =
+        const { [const { std::cell::Cell::new(None) }; 3] };
 }
 
 impl ProbeSampler {
@@ -231,33 +243,40 @@ impl ProbeSampler {
         let mut radial: [Option<(Radial<'_>, f64)>; 3] = [None; 3];
         let mut norm = [1.0; 3];
         let mut below = [f64::INFINITY; 3];
+        let mut masses = [[1.0, 0.0]; 3];
         for (ch, &f) in first.iter().enumerate() {
             if f < ch {
                 radial[ch] = radial[f];
                 norm[ch] = norm[f];
                 below[ch] = below[f];
+                masses[ch] = masses[f];
                 continue;
             }
-            radial[ch] = self.channel(c, ch);
-            if let Some((prof, r_max)) = &radial[ch]
-                && *r_max > 0.5 * cap
+            let key = ChannelKey {
+                sampler: self.id,
+                channel: ch,
+                bits: [c.sigma_a[ch], c.sigma_s[ch], cap].map(f64::to_bits),
+            };
+            let searches = LAST_SEARCHES.with(|last| match last[ch].get() {
+                Some((k, found)) if k == key => found,
+                _ => {
+                    let found = self.searches(c, ch, cap);
+                    last[ch].set(Some((key, found)));
+                    found
+                }
+            });
+            radial[ch] = self.channel(c, ch, searches.own_radius);
+            if let Some(m) = searches.masses
+                && let Some((prof, _)) = radial[ch]
             {
-                let key = FractionKey {
-                    sampler: self.id,
-                    channel: ch,
-                    bits: [c.sigma_a[ch], c.sigma_s[ch], cap].map(f64::to_bits),
+                let f = match prof {
+                    Radial::One(_) => m[0],
+                    Radial::Mixture(..) => 0.5 * (m[0] + m[1]),
                 };
-                let f = LAST_FRACTION.with(|last| match last.get() {
-                    Some((k, f)) if k == key => f,
-                    _ => {
-                        let f = prof.fraction_within(0.5 * cap);
-                        last.set(Some((key, f)));
-                        f
-                    }
-                });
                 if f > 0.0 {
                     below[ch] = 0.5 * cap;
                     norm[ch] = f;
+                    masses[ch] = m;
                 }
             }
         }
@@ -266,19 +285,44 @@ impl ProbeSampler {
             count,
             norm,
             below,
+            masses,
         }
     }
 
-    /// Channel `ch`'s radial density and probe radius at coefficients `c`.
-    fn channel(&self, c: Coefficients, ch: usize) -> Option<(Radial<'_>, f64)> {
+    /// The table searches of channel `ch` at coefficients `c` with radius cap `cap` (see
+    /// [`ChannelSearches`]).
+    fn searches(&self, c: Coefficients, ch: usize, cap: f64) -> ChannelSearches {
+        let own_radius = self
+            .table
+            .sampler(c.sigma_a[ch], c.sigma_s[ch])
+            .ok()
+            .map(|s| s.radius_for_fraction(PROBE_ENERGY_FRACTION));
+        let masses = self
+            .channel(c, ch, own_radius)
+            .filter(|(_, r_max)| *r_max > 0.5 * cap)
+            .map(|(prof, _)| match prof {
+                Radial::One(s) => [s.fraction_within(0.5 * cap), 0.0],
+                Radial::Mixture(a, b) => {
+                    [a.fraction_within(0.5 * cap), b.fraction_within(0.5 * cap)]
+                }
+            });
+        ChannelSearches { own_radius, masses }
+    }
+
+    /// Channel `ch`'s radial density and probe radius at coefficients `c`, where x_o's own
+    /// profile (if it is valid) reaches `own_radius` ([`ProbeSampler::searches`]).
+    fn channel(
+        &self,
+        c: Coefficients,
+        ch: usize,
+        own_radius: Option<f64>,
+    ) -> Option<(Radial<'_>, f64)> {
         let own = self
             .table
             .sampler(c.sigma_a[ch], c.sigma_s[ch])
             .ok()
-            .map(|s| {
-                let r = s.radius_for_fraction(PROBE_ENERGY_FRACTION);
-                (s, if r.is_finite() { r } else { 0.0 })
-            })
+            .zip(own_radius)
+            .map(|(s, r)| (s, if r.is_finite() { r } else { 0.0 }))
             .filter(|(_, r)| *r > 0.0);
         let wide = self.widest[ch].filter(|((a, s), _)| {
             (*a, *s) != (c.sigma_a[ch], c.sigma_s[ch]) && !self.bounds.is_constant()
@@ -300,12 +344,14 @@ impl ProbeSampler {
 /// The three channels' radial densities and probe radii; `count[k]` is how many channels share
 /// channel `k`'s density (0 for a channel that repeats an earlier one); `norm[k]` is the mass
 /// of the density below `below[k]` when a share [`NARROW_SHARE`] of the radii are drawn below
-/// it (see [`probe_within`]), 1 and ∞ otherwise.
+/// it (see [`probe_within`]), 1 and ∞ otherwise; `masses[k]` are the masses of the density's
+/// components below `below[k]` (the second 0 for a single profile).
 struct Channels<'a> {
     radial: [Option<(Radial<'a>, f64)>; 3],
     count: [u8; 3],
     norm: [f64; 3],
     below: [f64; 3],
+    masses: [[f64; 2]; 3],
 }
 
 /// A channel's radial sampling density: x_o's profile, or an equal mixture of it and the
@@ -338,31 +384,26 @@ impl Radial<'_> {
         }
     }
     /// A radius from the density truncated to `[0, cap)` and renormalised: each component is
-    /// chosen with its weight times its mass below `cap`, then its CDF (`fraction_within`) is
-    /// inverted exactly (`radius_for_fraction`) within that mass. (`sample_r` splits `u`
-    /// between the table's two rows, so scaling its `u` would not truncate.)
-    fn sample_r_below(&self, u: f64, cap: f64) -> Option<f64> {
-        let below = |s: &TableSampler<'_>, v: f64| {
-            let r = s.radius_for_fraction(v * s.fraction_within(cap));
+    /// chosen with its weight times its mass below `cap` (`masses`, each component's
+    /// `fraction_within(cap)`, which the caller keeps), then its CDF is inverted exactly
+    /// (`radius_for_fraction`) within that mass. (`sample_r` splits `u` between the table's
+    /// two rows, so scaling its `u` would not truncate.)
+    fn sample_r_below(&self, u: f64, cap: f64, masses: [f64; 2]) -> Option<f64> {
+        let below = |s: &TableSampler<'_>, v: f64, mass: f64| {
+            let r = s.radius_for_fraction(v * mass);
             (r.is_finite() && r < cap).then_some(r)
         };
         match self {
-            Radial::One(s) => below(s, u),
+            Radial::One(s) => below(s, u, masses[0]),
             Radial::Mixture(a, b) => {
-                let (fa, fb) = (a.fraction_within(cap), b.fraction_within(cap));
+                let [fa, fb] = masses;
                 let wa = fa / (fa + fb);
                 if u < wa {
-                    below(a, u / wa)
+                    below(a, u / wa, fa)
                 } else {
-                    below(b, ((u - wa) / (1.0 - wa)).min(1.0))
+                    below(b, ((u - wa) / (1.0 - wa)).min(1.0), fb)
                 }
             }
-        }
-    }
-    fn fraction_within(&self, r: f64) -> f64 {
-        match self {
-            Radial::One(s) => s.fraction_within(r),
-            Radial::Mixture(a, b) => 0.5 * (a.fraction_within(r) + b.fraction_within(r)),
         }
     }
 }
@@ -467,6 +508,131 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     let channels = sampler.channels(coeffs, max_radius);
     let origin = x_o.position();
     let frame = Frame::new(x_o.normal());
+    trace_probes(chords, origin, &frame, &channels, rng, |h| {
+        let p = axis_densities_in(origin, &frame, h, &channels)
+            .iter()
+            .sum::<f64>();
+        let kept = p > 0.0 && p.is_finite();
+        if kept {
+            set.hits[set.len] = Some(ProbeHit {
+                hit: *h,
+                weight: 1.0 / p,
+            });
+            set.len += 1;
+        }
+        kept
+    });
+}
+
+/// The incident points found by the three probes of one shading point, without their weights
+/// (see [`probe_points_within_into`]; at most [`MAX_PROBE_HITS`] per probe, no allocation).
+#[derive(Debug, Clone)]
+pub struct ProbePoints<P> {
+    hits: [Option<P>; 3 * MAX_PROBE_HITS],
+    len: usize,
+}
+
+impl<P: Copy> ProbePoints<P> {
+    /// An empty set, to be filled by [`probe_points_within_into`].
+    pub fn new() -> Self {
+        Self {
+            hits: [None; 3 * MAX_PROBE_HITS],
+            len: 0,
+        }
+    }
+}
+
+impl<P: Copy> Default for ProbePoints<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<P> ProbePoints<P> {
+    /// The points, in the order the probes found them.
+    pub fn iter(&self) -> impl Iterator<Item = &P> {
+        self.hits[..self.len].iter().flatten()
+    }
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+    /// True when no probe found anything.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// The density `p(x)` of one probe set (the module docs' formula, for the x_o, coefficients
+/// and radius cap the set was traced with): what turns a [`ProbePoints`] entry into a
+/// [`ProbeHit`], when the caller needs it.
+pub struct ProbeDensity<'s> {
+    origin: DVec3,
+    frame: Frame,
+    channels: Channels<'s>,
+}
+
+impl ProbeDensity<'_> {
+    /// `1 / p(x_i)` (an area), or `None` where the density is 0 or not finite, which a
+    /// point the probes found has only by rounding at the edge of a probe sphere (such a
+    /// point contributes nothing: [`probe_within_into`] drops it from its set).
+    pub fn weight(&self, x_i: &impl SurfacePoint) -> Option<f64> {
+        let p = axis_densities_in(self.origin, &self.frame, x_i, &self.channels)
+            .iter()
+            .sum::<f64>();
+        (p > 0.0 && p.is_finite()).then(|| 1.0 / p)
+    }
+}
+
+/// [`probe_within_into`] without the weights: the same probes, draw for draw, and every
+/// point they find, with the density that gives each its weight on demand. A renderer that
+/// weights only some of the points (those that gather light, and the one that carries the
+/// path on) saves the rest's densities: on the checker slab about half the points face away
+/// from the light. The sum over the points of `f(x) · weight(x)` (0 where the weight is
+/// `None`) has the expectation of [`probe_within_into`]'s, and so does `len` times one point
+/// chosen uniformly. Each probe keeps at most [`MAX_PROBE_HITS`] points here, counting the
+/// rare ones whose weight is `None`, which [`probe_within_into`] does not count.
+pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
+    points: &mut ProbePoints<C::Point>,
+    chords: &C,
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &'s ProbeSampler,
+    max_radius: f64,
+    rng: &mut U,
+) -> ProbeDensity<'s> {
+    points.len = 0;
+    let density = ProbeDensity {
+        origin: x_o.position(),
+        frame: Frame::new(x_o.normal()),
+        channels: sampler.channels(coeffs, max_radius),
+    };
+    trace_probes(
+        chords,
+        density.origin,
+        &density.frame,
+        &density.channels,
+        rng,
+        |h| {
+            points.hits[points.len] = Some(*h);
+            points.len += 1;
+            true
+        },
+    );
+    density
+}
+
+/// The three probes of one shading point (one per axis of `frame`, about `origin`): calls
+/// `keep` on every point each probe's chord crosses, in order, until `keep` has returned true
+/// [`MAX_PROBE_HITS`] times for that probe. Draws 3 uniform numbers per axis from `rng`.
+fn trace_probes<C: ProbeChords, U: UniformSource>(
+    chords: &C,
+    origin: DVec3,
+    frame: &Frame,
+    channels: &Channels<'_>,
+    rng: &mut U,
+    mut keep: impl FnMut(&C::Point) -> bool,
+) {
     for axis in 0..3 {
         let ch = ((rng.next_f64() * 3.0) as usize).min(2);
         let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
@@ -476,7 +642,7 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
         let r = if !channels.below[ch].is_finite() {
             prof.sample_r(u_r)
         } else if u_r < NARROW_SHARE {
-            prof.sample_r_below(u_r / NARROW_SHARE, channels.below[ch])
+            prof.sample_r_below(u_r / NARROW_SHARE, channels.below[ch], channels.masses[ch])
         } else {
             prof.sample_r(((u_r - NARROW_SHARE) / (1.0 - NARROW_SHARE)).min(1.0))
         };
@@ -492,18 +658,8 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
         let base = origin + r * (cos * vx + sin * vy) - half * vz;
         let mut kept = 0;
         chords.for_each_hit(base, vz, 2.0 * half, |h| {
-            if kept < MAX_PROBE_HITS {
-                let p = axis_densities_in(origin, &frame, h, &channels)
-                    .iter()
-                    .sum::<f64>();
-                if p > 0.0 && p.is_finite() {
-                    set.hits[set.len] = Some(ProbeHit {
-                        hit: *h,
-                        weight: 1.0 / p,
-                    });
-                    set.len += 1;
-                    kept += 1;
-                }
+            if kept < MAX_PROBE_HITS && keep(h) {
+                kept += 1;
             }
         });
     }
@@ -587,7 +743,9 @@ fn axis_densities_in(
         let share = f64::from(count) / (3.0 * std::f64::consts::TAU);
         for axis in 0..3 {
             let r = r_proj[axis];
-            if r > 0.0 {
+            // A probe along an axis in x's tangent plane cannot find x (|n_g · axis| = 0):
+            // its term is 0, without the table's density (on a box, two of the three).
+            if r > 0.0 && nl[axis] != 0.0 {
                 // The radial density of the draws: x_o's alone, or the defensive mixture with
                 // the one truncated below `below` (see `probe_within`).
                 let mix = if below.is_finite() {
@@ -659,6 +817,109 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// [`probe_points_within_into`] finds the points [`probe_within_into`] finds, draw for draw,
+    /// and its density weights each exactly as the eager set does; alternating the
+    /// coefficients (three distinct channels, a mixture density, capped and uncapped radii)
+    /// exercises the per-channel memo of the table searches, which must never return another
+    /// call's values.
+    #[test]
+    fn points_weighted_on_demand_equal_the_weighted_set() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let bounds = FieldBounds {
+            min: Coefficients::grey(0.01, 1.0),
+            max: Coefficients::grey(0.2, 2.0),
+        };
+        let sampler = ProbeSampler::new(family, bounds);
+        let coeffs = [
+            Coefficients {
+                sigma_a: crate::Rgb::new(0.02, 0.05, 0.2),
+                sigma_s: crate::Rgb::new(1.0, 1.5, 2.0),
+            },
+            Coefficients::grey(0.01, 1.0),
+            Coefficients::grey(0.2, 2.0),
+        ];
+        // Tilted x_o, so that every axis's term is non-zero at most points.
+        let n = DVec3::new(0.3, -0.2, 1.0).normalize();
+        let x_o = P(DVec3::ZERO, n);
+        let (mut eager, mut lazy) = (ProbeSet::new(), ProbePoints::new());
+        let mut found = 0;
+        for k in 0..3000u64 {
+            // The same coefficients twice in a row, with the cap changed between them.
+            let c = coeffs[((k / 2) % 3) as usize];
+            let cap = if k % 2 == 0 { f64::INFINITY } else { 5.0 };
+            let slab = Slab(0.5 + (k % 7) as f64);
+            let (mut a, mut b) = (SplitMix64::new(k), SplitMix64::new(k));
+            probe_within_into(&mut eager, &slab, &x_o, c, &sampler, cap, &mut a);
+            let density =
+                probe_points_within_into(&mut lazy, &slab, &x_o, c, &sampler, cap, &mut b);
+            assert_eq!(a.next_u64(), b.next_u64(), "the same draws");
+            let weighted: Vec<(DVec3, f64)> = lazy
+                .iter()
+                .filter_map(|x| density.weight(x).map(|w| (x.position(), w)))
+                .collect();
+            let want: Vec<(DVec3, f64)> =
+                eager.iter().map(|h| (h.hit.position(), h.weight)).collect();
+            assert_eq!(weighted, want, "set {k}");
+            // Against the density computed with nothing remembered.
+            for &(x, w) in &weighted {
+                let normal = if x.z > -1e-9 { DVec3::Z } else { DVec3::NEG_Z };
+                LAST_SEARCHES.with(|last| last.iter().for_each(|slot| slot.set(None)));
+                let p = probe_density_within(&x_o, c, &sampler, cap, &P(x, normal));
+                assert!(
+                    (w * p - 1.0).abs() < 1e-12,
+                    "set {k}: weight {w}, 1/p {}",
+                    1.0 / p
+                );
+            }
+            found += want.len();
+        }
+        assert!(found > 3000, "too few points to compare: {found}");
+    }
+
+    /// The draws below a cap from a mixture of a narrow and a wide profile, with the
+    /// components' masses below the cap as [`ProbeSampler::channels`] keeps them (0.98 and
+    /// 0.07 here), follow the truncated, renormalised mixture: a χ² test over 20 bins of the
+    /// radius (swapping the two masses fails it).
+    #[test]
+    fn draws_below_the_cap_follow_the_truncated_mixture() {
+        use bssrdf_core::chi_square::ChiSquareTest;
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let table = ProfileTable::new(family);
+        let (a, b) = (
+            table.sampler(5.0, 1.0).unwrap(),
+            table.sampler(0.001, 1.0).unwrap(),
+        );
+        let cap = 0.5;
+        let masses = [a.fraction_within(cap), b.fraction_within(cap)];
+        assert!(masses[0] > 0.9 && masses[1] < 0.1, "{masses:?}");
+        let radial = Radial::Mixture(a, b);
+        let bins = 20;
+        let n = 100_000;
+        let mut observed = vec![0u64; bins];
+        let mut rng = SplitMix64::new(5);
+        for _ in 0..n {
+            let r = radial
+                .sample_r_below(rng.next_f64(), cap, masses)
+                .expect("a radius below the cap");
+            assert!((0.0..cap).contains(&r));
+            observed[((r / cap * bins as f64) as usize).min(bins - 1)] += 1;
+        }
+        let cdf = |r: f64| (a.fraction_within(r) + b.fraction_within(r)) / (masses[0] + masses[1]);
+        let expected: Vec<f64> = (0..bins)
+            .map(|k| {
+                let (r0, r1) = (
+                    k as f64 * cap / bins as f64,
+                    (k + 1) as f64 * cap / bins as f64,
+                );
+                n as f64 * (cdf(r1) - cdf(r0))
+            })
+            .collect();
+        let chi = ChiSquareTest::SINGLE.check(&observed, &expected).unwrap();
+        assert!(chi.passes(), "{chi}");
     }
 
     /// Mean and standard error of the mean of `n` draws of `draw`.

@@ -160,10 +160,27 @@ impl BssrdfObject {
             .probe_chords_into(set, chords, x_o, coeffs, self.extent, rng);
     }
 
+    /// [`BssrdfObject::probe_set_into`] without the weights: the points into `points`, and
+    /// the density that weights each when the caller needs it.
+    pub(crate) fn probe_points_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
+        &self,
+        points: &mut crate::integrator::probe::ProbePoints,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: het_estimate::Coefficients,
+        rng: &mut Rng,
+    ) -> het_estimate::probe::ProbeDensity<'_> {
+        self.sampler
+            .probe_points_into(points, chords, x_o, coeffs, self.extent, rng)
+    }
+
     /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
     /// (unitless; 1 for η = 1).
     #[inline]
     pub fn transmission(&self, cos: f64) -> f64 {
+        if self.eta == 1.0 {
+            return 1.0; // an index-matched boundary reflects nothing
+        }
         1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta)
     }
 

@@ -1001,18 +1001,19 @@ impl<'s> PathIntegrator<'s> {
             object,
         };
         let at_xo = material.medium.coefficients(hit);
-        let mut set = crate::integrator::probe::ProbeSet::new();
-        b.probe_set_into(&mut set, &surface, hit, at_xo, rng);
+        let mut set = crate::integrator::probe::ProbePoints::new();
+        let density = b.probe_points_into(&mut set, &surface, hit, at_xo, rng);
         counters.probe_sets += 1;
         if set.is_empty() {
             counters.probe_misses += 1;
             return Step::Stop;
         }
-        // Every hit gathers light; one, chosen uniformly, carries the path on (weight n).
+        // Every hit gathers light; one, chosen uniformly, carries the path on (weight n). A
+        // hit's weight 1/p(x) is computed only where it is used (it gathers light, or carries
+        // the path): about half the hits on a one-sided lit object need neither.
         let carrier = rng.below(set.len() as u32) as usize;
         let mut next = None;
-        for (k, ph) in set.iter().enumerate() {
-            let x_i = ph.hit;
+        for (k, &x_i) in set.iter().enumerate() {
             let ld = self.direct(
                 x_i.p,
                 |wi| x_i.spawn_origin(wi),
@@ -1041,15 +1042,19 @@ impl<'s> PathIntegrator<'s> {
                 ),
                 _ => (ld.l, 0.0),
             };
-            if ld.is_zero() && (k != carrier || self.defer_weights) {
-                // Nothing to gather: skip the (costly) estimate, or owe it (the carrier).
-                if k == carrier {
-                    next = Some((x_i, Err(ph.weight * set.len() as f64)));
-                }
+            if ld.is_zero() && k != carrier {
+                continue; // nothing to gather, nothing to carry
+            }
+            let Some(weight) = density.weight(&x_i) else {
+                continue; // p(x) = 0 by rounding at a probe sphere's edge: no contribution
+            };
+            if ld.is_zero() && self.defer_weights {
+                // Nothing to gather: the carrier owes its (costly) estimate.
+                next = Some((x_i, Err(weight * set.len() as f64)));
                 continue;
             }
             let pw = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
-            let w = pw.rd * ph.weight;
+            let w = pw.rd * weight;
             self.settle(st, rng, counters);
             if !ld.is_zero() {
                 st.l += st.beta * w * ld * b.coupling(&pw, cos_light, cos_o);

@@ -53,12 +53,28 @@ impl ProbeSampler {
     ) {
         lib::probe_within_into(set, chords, x_o, coeffs, &self.0, max_radius, rng);
     }
+
+    /// The same probes without the weights ([`lib::probe_points_within_into`]): the points
+    /// into `points`, and the density that weights each on demand.
+    pub(crate) fn probe_points_into<C: ProbeChords<Point = Hit>>(
+        &self,
+        points: &mut ProbePoints,
+        chords: &C,
+        x_o: &Hit,
+        coeffs: Coefficients,
+        max_radius: f64,
+        rng: &mut Rng,
+    ) -> lib::ProbeDensity<'_> {
+        lib::probe_points_within_into(points, chords, x_o, coeffs, &self.0, max_radius, rng)
+    }
 }
 
 /// A found incident point and its estimator weight `1/p(x)`.
 pub type ProbeHit = lib::ProbeHit<Hit>;
 /// The incident points found by the three probes of one camera sample.
 pub type ProbeSet = lib::ProbeSet<Hit>;
+/// The incident points found by the three probes of one camera sample, before their weights.
+pub type ProbePoints = lib::ProbePoints<Hit>;
 
 impl ProbeChords for ObjectSurface<'_> {
     type Point = Hit;
