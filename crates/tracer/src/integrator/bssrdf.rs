@@ -142,25 +142,11 @@ impl BssrdfObject {
         coeffs: het_estimate::Coefficients,
         rng: &mut Rng,
     ) -> crate::integrator::probe::ProbeSet {
-        let mut set = crate::integrator::probe::ProbeSet::new();
-        self.probe_set_into(&mut set, chords, x_o, coeffs, rng);
-        set
-    }
-
-    /// [`BssrdfObject::probe_set`] into `set`, which the caller keeps (no copy of the set).
-    pub(crate) fn probe_set_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
-        &self,
-        set: &mut crate::integrator::probe::ProbeSet,
-        chords: &C,
-        x_o: &Hit,
-        coeffs: het_estimate::Coefficients,
-        rng: &mut Rng,
-    ) {
         self.sampler
-            .probe_chords_into(set, chords, x_o, coeffs, self.extent, rng);
+            .probe_chords(chords, x_o, coeffs, self.extent, rng)
     }
 
-    /// [`BssrdfObject::probe_set_into`] without the weights: the points into `points`, and
+    /// [`BssrdfObject::probe_set`] without the weights: the points into `points`, and
     /// the density that weights each when the caller needs it.
     pub(crate) fn probe_points_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,

@@ -305,16 +305,15 @@ impl<'s> LightTracer<'s> {
             geometry,
             object: x_i.object,
         };
-        let mut set = crate::integrator::probe::ProbeSet::new();
-        b.probe_set_into(&mut set, &surface, &x_i, at_xi, rng);
+        let mut set = crate::integrator::probe::ProbePoints::new();
+        let density = b.probe_points_into(&mut set, &surface, &x_i, at_xi, rng);
         if set.is_empty() {
             counters.probe_misses += 1;
             return;
         }
         let camera = scene.camera();
         let width = camera.resolution().0;
-        for ph in set.iter() {
-            let x_o = ph.hit;
+        for &x_o in set.iter() {
             let Some(c) = camera.connect(x_o.p) else {
                 continue;
             };
@@ -323,6 +322,10 @@ impl<'s> LightTracer<'s> {
             if cos_o <= 0.0 || !self.sees(&x_o, w_o, c.dist) {
                 continue;
             }
+            // The point's weight 1/p(x), only for the points the camera sees.
+            let Some(weight) = density.weight(&x_o) else {
+                continue;
+            };
             let s = match self.roles {
                 Roles::Physical => b.eval(
                     &surface,
@@ -345,7 +348,7 @@ impl<'s> LightTracer<'s> {
                     counters,
                 ),
             };
-            let v = beta * s * (ph.weight * c.importance * cos_o);
+            let v = beta * s * (weight * c.importance * cos_o);
             if v.is_finite() && !v.is_zero() {
                 splats.push((c.pixel.1 * width + c.pixel.0, v));
             }

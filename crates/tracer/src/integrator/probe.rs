@@ -41,19 +41,6 @@ impl ProbeSampler {
         lib::probe_within(chords, x_o, coeffs, &self.0, max_radius, rng)
     }
 
-    /// [`ProbeSampler::probe_chords`] into `set` ([`lib::probe_within_into`]).
-    pub(crate) fn probe_chords_into<C: ProbeChords<Point = Hit>>(
-        &self,
-        set: &mut ProbeSet,
-        chords: &C,
-        x_o: &Hit,
-        coeffs: Coefficients,
-        max_radius: f64,
-        rng: &mut Rng,
-    ) {
-        lib::probe_within_into(set, chords, x_o, coeffs, &self.0, max_radius, rng);
-    }
-
     /// The same probes without the weights ([`lib::probe_points_within_into`]): the points
     /// into `points`, and the density that weights each on demand.
     pub(crate) fn probe_points_into<C: ProbeChords<Point = Hit>>(
