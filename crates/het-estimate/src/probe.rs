@@ -417,44 +417,9 @@ pub struct ProbeHit<P> {
     pub weight: f64,
 }
 
-/// The incident points found by the three probes of one shading point (no allocation: at
-/// most [`MAX_PROBE_HITS`] per probe).
-#[derive(Debug, Clone)]
-pub struct ProbeSet<P> {
-    hits: [Option<ProbeHit<P>>; 3 * MAX_PROBE_HITS],
-    len: usize,
-}
-
-impl<P: Copy> ProbeSet<P> {
-    /// An empty set, to be filled by [`probe_within_into`].
-    pub fn new() -> Self {
-        Self {
-            hits: [None; 3 * MAX_PROBE_HITS],
-            len: 0,
-        }
-    }
-}
-
-impl<P: Copy> Default for ProbeSet<P> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl<P> ProbeSet<P> {
-    /// The hits.
-    pub fn iter(&self) -> impl Iterator<Item = &ProbeHit<P>> {
-        self.hits[..self.len].iter().flatten()
-    }
-    /// Number of hits.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-    /// True when no probe found anything.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-}
+/// The incident points found by the three probes of one shading point, each with its weight
+/// (no allocation: at most [`MAX_PROBE_HITS`] per probe). Filled by [`probe_within_into`].
+pub type ProbeSet<P> = ProbePoints<ProbeHit<P>>;
 
 /// Traces one probe per axis around `x_o` (see the module docs); `coeffs` are the coefficients
 /// at x_o that shape the sampling density. Draws 3 uniform numbers per axis from `rng`.
@@ -524,8 +489,9 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     });
 }
 
-/// The incident points found by the three probes of one shading point, without their weights
-/// (see [`probe_points_within_into`]; at most [`MAX_PROBE_HITS`] per probe, no allocation).
+/// What the three probes of one shading point found, in the order they found it: points
+/// (`ProbePoints<P>`, filled by [`probe_points_within_into`], weighted on demand) or points
+/// with their weights ([`ProbeSet`]). No allocation: at most [`MAX_PROBE_HITS`] per probe.
 #[derive(Debug, Clone)]
 pub struct ProbePoints<P> {
     hits: [Option<P>; 3 * MAX_PROBE_HITS],
@@ -533,7 +499,7 @@ pub struct ProbePoints<P> {
 }
 
 impl<P: Copy> ProbePoints<P> {
-    /// An empty set, to be filled by [`probe_points_within_into`].
+    /// An empty set.
     pub fn new() -> Self {
         Self {
             hits: [None; 3 * MAX_PROBE_HITS],
@@ -549,7 +515,7 @@ impl<P: Copy> Default for ProbePoints<P> {
 }
 
 impl<P> ProbePoints<P> {
-    /// The points, in the order the probes found them.
+    /// The points (or hits), in the order the probes found them.
     pub fn iter(&self) -> impl Iterator<Item = &P> {
         self.hits[..self.len].iter().flatten()
     }
