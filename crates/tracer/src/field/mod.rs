@@ -395,6 +395,24 @@ impl Field {
     pub fn is_constant(&self) -> bool {
         self.min() == self.max()
     }
+
+    /// The axis a varying field defined in space is constant along (patterns and planar
+    /// images are projections along it): below a surface whose normal is that axis the field
+    /// does not change with depth, below any other it does. `None` for a field that does not
+    /// vary and for UV-mapped images (defined on the surface only).
+    pub fn projection_axis(&self) -> Option<Axis> {
+        if self.is_constant() {
+            return None;
+        }
+        match self {
+            Field::Pattern { projection, .. }
+            | Field::Image(ImageField {
+                mapping: ImageMapping::Planar { projection, .. },
+                ..
+            }) => Some(projection.axis),
+            _ => None,
+        }
+    }
 }
 
 /// The medium of a translucent material: σa and σs fields, or an artist's colour and mean

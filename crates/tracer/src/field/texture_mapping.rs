@@ -18,6 +18,24 @@ pub enum Axis {
 }
 
 impl Axis {
+    /// The unit vector along the axis.
+    pub const fn unit(self) -> DVec3 {
+        match self {
+            Axis::X => DVec3::X,
+            Axis::Y => DVec3::Y,
+            Axis::Z => DVec3::Z,
+        }
+    }
+
+    /// `"x"`, `"y"` or `"z"`, as scene files spell it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Axis::X => "x",
+            Axis::Y => "y",
+            Axis::Z => "z",
+        }
+    }
+
     /// `"x"`, `"y"` or `"z"`.
     pub fn parse(s: &str) -> Option<Axis> {
         match s {
