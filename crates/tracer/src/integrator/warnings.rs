@@ -195,7 +195,7 @@ fn small_objects(scene: &Scene) -> Vec<String> {
 }
 
 /// The share of an object's pixels beyond which [`depth_varying`] warns.
-pub const DEPTH_WARNING_SHARE: f64 = 0.05;
+const DEPTH_WARNING_SHARE: f64 = 0.05;
 /// A surface is oblique to a field's axis when its normal is more than 25° from the axis
 /// (|n · axis| below cos 25°).
 const OBLIQUE_COS: f64 = 0.906_307_787_036_649_9;
