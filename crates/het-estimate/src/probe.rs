@@ -133,7 +133,7 @@ pub struct ProbeSampler {
     /// and that radius; `None` where no corner scatters.
     widest: [Option<((f64, f64), f64)>; 3],
     /// A number no other sampler of this process has (clones share it, and their tables): the
-    /// key of [`LAST_FRACTION`], which an address would not be once a sampler is dropped.
+    /// key of [`LAST_SEARCHES`], which an address would not be once a sampler is dropped.
     id: u64,
 }
 
@@ -150,7 +150,8 @@ struct ChannelKey {
 }
 
 /// The table searches of one channel of [`ProbeSampler::channels`]: x_o's own probe radius
-/// ([`TableSampler::radius_for_fraction`], `None` where x_o's profile reaches nowhere) and,
+/// ([`TableSampler::radius_for_fraction`]; `None` where the table refuses x_o's coefficients,
+/// and 0 or not finite where its profile reaches nowhere) and,
 /// when the probe radius exceeds half the cap, the masses of the radial density's components
 /// below half the cap ([`TableSampler::fraction_within`]; the second is 0 for a single
 /// profile).
@@ -539,9 +540,10 @@ pub struct ProbeDensity<'s> {
 }
 
 impl ProbeDensity<'_> {
-    /// `1 / p(x_i)` (an area), or `None` where the density is 0 or not finite, which a
-    /// point the probes found has only by rounding at the edge of a probe sphere (such a
-    /// point contributes nothing: [`probe_within_into`] drops it from its set).
+    /// `1 / p(x_i)` (an area), or `None` where the density is 0 or not finite: a point the
+    /// probes found has such a density only at the edge of a probe sphere (by rounding) or at
+    /// x_o itself (every projected radius 0). Such a point contributes nothing:
+    /// [`probe_within_into`] drops it from its set.
     pub fn weight(&self, x_i: &impl SurfacePoint) -> Option<f64> {
         let p = axis_densities_in(self.origin, &self.frame, x_i, &self.channels)
             .iter()
@@ -556,8 +558,9 @@ impl ProbeDensity<'_> {
 /// path on) saves the rest's densities: on the checker slab about half the points face away
 /// from the light. The sum over the points of `f(x) · weight(x)` (0 where the weight is
 /// `None`) has the expectation of [`probe_within_into`]'s, and so does `len` times one point
-/// chosen uniformly. Each probe keeps at most [`MAX_PROBE_HITS`] points here, counting the
-/// rare ones whose weight is `None`, which [`probe_within_into`] does not count.
+/// chosen uniformly, but for one difference in the rare sets with such a point: each probe
+/// keeps at most [`MAX_PROBE_HITS`] points here counting it, where [`probe_within_into`]
+/// does not (a chord with more crossings than that loses one more of its farthest here).
 pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
     points: &mut ProbePoints<C::Point>,
     chords: &C,

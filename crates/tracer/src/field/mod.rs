@@ -396,21 +396,63 @@ impl Field {
         self.min() == self.max()
     }
 
-    /// The axis a varying field defined in space is constant along (patterns and planar
-    /// images are projections along it): below a surface whose normal is that axis the field
-    /// does not change with depth, below any other it does. `None` for a field that does not
-    /// vary and for UV-mapped images (defined on the surface only).
-    pub fn projection_axis(&self) -> Option<Axis> {
+    /// The directions a varying field defined in space changes along ([`Variation`]);
+    /// `None` for a field that does not vary and for UV-mapped images (defined on the
+    /// surface only).
+    pub fn variation(&self) -> Option<Variation> {
         if self.is_constant() {
             return None;
         }
         match self {
+            Field::Pattern {
+                pattern: Pattern::Stripe(stripe),
+                projection,
+                ..
+            } => {
+                let (cos, sin) = stripe.direction();
+                Some(Variation::Along(projection.plane_vector(cos, sin)))
+            }
             Field::Pattern { projection, .. }
             | Field::Image(ImageField {
                 mapping: ImageMapping::Planar { projection, .. },
                 ..
-            }) => Some(projection.axis),
+            }) => Some(Variation::AcrossAxis(projection.axis)),
             _ => None,
+        }
+    }
+}
+
+/// The directions along which a field defined in space changes: every direction across its
+/// projection axis (checks, planar images), or one direction of the pattern's plane (stripes).
+/// Below a surface the field changes with depth where the surface's normal has a component
+/// along them ([`Variation::depth_sine`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Variation {
+    /// Constant along the axis, changing across it.
+    AcrossAxis(Axis),
+    /// Changing along this unit vector only.
+    Along(DVec3),
+}
+
+impl Variation {
+    /// The sine of the angle between the unit normal `n` and the directions the field is
+    /// constant along: 0 where the field does not change with depth below a surface with
+    /// normal `n`, 1 where depth is a direction it changes along.
+    pub fn depth_sine(&self, n: DVec3) -> f64 {
+        match *self {
+            Variation::AcrossAxis(a) => (1.0 - n.dot(a.unit()).powi(2)).max(0.0).sqrt(),
+            Variation::Along(g) => n.dot(g).abs(),
+        }
+    }
+
+    /// For messages: `constant along x`, or `varying along (0.71, 0.71, 0.00) only` for a
+    /// stripe.
+    pub fn describe(&self) -> String {
+        match *self {
+            Variation::AcrossAxis(a) => format!("constant along {}", a.name()),
+            Variation::Along(g) => {
+                format!("varying along ({:.2}, {:.2}, {:.2}) only", g.x, g.y, g.z)
+            }
         }
     }
 }

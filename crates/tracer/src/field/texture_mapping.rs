@@ -83,6 +83,17 @@ impl PlanarProjection {
         }
     }
 
+    /// The vector of the pattern's plane with components `(s, t)`: the inverse of
+    /// [`PlanarProjection::st_vector`] on that plane.
+    #[inline]
+    pub fn plane_vector(&self, s: f64, t: f64) -> DVec3 {
+        match self.axis {
+            Axis::Z => DVec3::new(s, t, 0.0),
+            Axis::X => DVec3::new(0.0, s, t),
+            Axis::Y => DVec3::new(t, 0.0, s),
+        }
+    }
+
     /// The footprint of the ellipse `e` in the `(s, t)` plane (the field is constant along
     /// the axis, so the ellipse's points are read at their `(s, t)`): uniformly weighted.
     pub fn footprint(&self, e: &het_estimate::PlanarEllipse) -> PlaneFootprint {

@@ -1046,7 +1046,7 @@ impl<'s> PathIntegrator<'s> {
                 continue; // nothing to gather, nothing to carry
             }
             let Some(weight) = density.weight(&x_i) else {
-                continue; // p(x) = 0 by rounding at a probe sphere's edge: no contribution
+                continue; // p(x) = 0 (a sphere's edge, or x_o itself): no contribution
             };
             if ld.is_zero() && self.defer_weights {
                 // Nothing to gather: the carrier owes its (costly) estimate.

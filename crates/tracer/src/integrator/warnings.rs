@@ -5,7 +5,7 @@
 //! loader read but could not honour ([`Scene::load_notes`]). Printed by the CLI and recorded in
 //! the sidecar.
 
-use crate::field::Axis;
+use crate::field::Variation;
 use crate::geometry::Hit;
 use crate::integrator::Method;
 use crate::light::Light;
@@ -196,37 +196,37 @@ fn small_objects(scene: &Scene) -> Vec<String> {
 
 /// The share of an object's pixels beyond which [`depth_varying`] warns.
 const DEPTH_WARNING_SHARE: f64 = 0.05;
-/// A surface is oblique to a field's axis when its normal is more than 25° from the axis
-/// (|n · axis| below cos 25°).
-const OBLIQUE_COS: f64 = 0.906_307_787_036_649_9;
+/// A surface is oblique to a field when its normal is more than 25° from the directions the
+/// field is constant along ([`Variation::depth_sine`] above sin 25°).
+const OBLIQUE_SINE: f64 = 0.422_618_261_740_699_4;
 
 /// One warning per translucent object whose medium changes with depth below more than
 /// [`DEPTH_WARNING_SHARE`] of the object's pixels. Every estimator reads the coefficients on
 /// the surface and takes them to continue unchanged below it (the kernel's derivation states
 /// it, docs/kernel.md#assumptions); a field defined in space (a pattern or a planar image) is
-/// constant only along its projection axis, so below a surface oblique to that axis the
-/// medium the light crosses is not the one its surface shows. Measured with the kernel
-/// (docs/shapes.md, "What remains"): 0.85–0.94 of the path tracer on such faces of the
-/// heterogeneous bunny (`examples/scenes/bunny.toml`), 1.03–1.06 with a layer boundary
-/// 0.05–0.5 below a flat surface.
+/// constant only along its projection axis (a stripe also along its bands), so below a
+/// surface oblique to those directions the medium the light crosses is not the one its
+/// surface shows. Measured with the kernel (docs/shapes.md, "What remains"): 0.81–0.94 of the
+/// path tracer on such faces of the heterogeneous bunny (`examples/scenes/bunny.toml`, with
+/// its shape correction), 1.03–1.06 with a layer boundary 0.05–0.5 below a flat surface.
 fn depth_varying(scene: &Scene) -> Vec<String> {
     let mut warnings = Vec::new();
     for (i, t) in scene.translucent_objects() {
-        let axes: Vec<(&str, Axis)> = t
+        let fields: Vec<(&str, Variation)> = t
             .medium
             .named_fields()
             .into_iter()
-            .filter_map(|(name, f)| f.projection_axis().map(|a| (name, a)))
+            .filter_map(|(name, f)| f.variation().map(|v| (name, v)))
             .collect();
-        if axes.is_empty() {
+        if fields.is_empty() {
             continue;
         }
         let (mut seen, mut oblique) = (0u32, 0u32);
         for_object_pixels(scene, i, |hit| {
             seen += 1;
-            if axes
+            if fields
                 .iter()
-                .any(|(_, a)| hit.ns.dot(a.unit()).abs() < OBLIQUE_COS)
+                .any(|(_, v)| v.depth_sine(hit.ns) > OBLIQUE_SINE)
             {
                 oblique += 1;
             }
@@ -239,18 +239,18 @@ fn depth_varying(scene: &Scene) -> Vec<String> {
         if share <= DEPTH_WARNING_SHARE {
             continue;
         }
-        let fields = axes
+        let described = fields
             .iter()
-            .map(|(name, a)| format!("`{name}` constant along {}", a.name()))
+            .map(|(name, v)| format!("`{name}` {}", v.describe()))
             .collect::<Vec<_>>()
             .join(", ");
         warnings.push(format!(
-            "translucent object `{}`: its medium ({fields}) changes with depth below {:.1} % \
-             of its pixels (surfaces more than 25° from perpendicular to that axis); every \
-             BSSRDF estimator reads the coefficients on the surface and takes them to continue \
-             unchanged below it, which measured from 0.85 (curved faces of the heterogeneous \
-             bunny) to 1.06 (a layer below a flat surface) of the path tracer with `kernel` \
-             (docs/shapes.md); compare with `--method pt`",
+            "translucent object `{}`: its medium ({described}) changes with depth below \
+             {:.1} % of its pixels (surfaces tilted more than 25° from the directions the \
+             medium is constant along); every BSSRDF estimator reads the coefficients on the \
+             surface and takes them to continue unchanged below it, which measured from 0.81 \
+             (curved faces of the heterogeneous bunny) to 1.06 (a layer below a flat surface) \
+             of the path tracer with `kernel` (docs/shapes.md); compare with `--method pt`",
             scene.objects()[i as usize].name,
             100.0 * share
         ));
@@ -292,7 +292,7 @@ fn image_share(scene: &Scene, object: u32) -> f64 {
 mod tests {
     use super::*;
     use crate::camera::Camera;
-    use crate::field::MediumField;
+    use crate::field::{Axis, MediumField};
     use crate::geometry::primitives;
     use crate::scene::{Material, RenderSettings, SceneBuilder, Translucent};
     use bssrdf_core::Rgb;
@@ -324,9 +324,14 @@ mod tests {
             .unwrap()
     }
 
-    /// [`sphere_scene`]'s camera over `mesh`, whose σa is a check (σa 0.01 and 0.1, σs 1)
-    /// projected along `axis`.
-    fn checked_scene(mesh: crate::geometry::TriangleMesh, axis: Axis) -> Scene {
+    /// A check (σa 0.01 and 0.1, cells of 0.5) projected along `axis`.
+    fn check_along(axis: Axis) -> crate::field::Field {
+        let projection = crate::field::PlanarProjection::new(axis, DVec3::ZERO);
+        crate::field::Field::check(0.5, [Rgb::splat(0.01), Rgb::splat(0.1)], projection).unwrap()
+    }
+
+    /// [`sphere_scene`]'s camera over `mesh`, whose σa is `sigma_a` (σs 1).
+    fn textured_scene(mesh: crate::geometry::TriangleMesh, sigma_a: crate::field::Field) -> Scene {
         let camera = Camera::orthographic(
             DVec3::new(0.0, 0.0, 5.0),
             DVec3::NEG_Z,
@@ -337,10 +342,6 @@ mod tests {
             64,
         )
         .unwrap();
-        let projection = crate::field::PlanarProjection::new(axis, DVec3::ZERO);
-        let sigma_a =
-            crate::field::Field::check(0.5, [Rgb::splat(0.01), Rgb::splat(0.1)], projection)
-                .unwrap();
         let sigma_s = crate::field::Field::constant(Rgb::ONE).unwrap();
         let medium = MediumField::new(sigma_a, sigma_s);
         SceneBuilder::new(RenderSettings::new(64, 64, 1), camera)
@@ -365,7 +366,7 @@ mod tests {
     }
 
     /// A box seen from above with its check along z (the view axis) shows the medium below its
-    /// top face: no warning. The same box with the check along x: every pixel's medium changes
+    /// top face: no warning (nor with a stripe varying along x). The same box with the check along x: every pixel's medium changes
     /// with depth. A sphere of radius R seen along z with the check along z: the normal at
     /// distance ρ from the axis has n_z = √(1 − ρ²/R²), below cos 25° where ρ/R > sin 25°,
     /// which is 1 − sin² 25° = cos² 25° = 82.1 % of the projected disk. A constant medium and
@@ -373,19 +374,53 @@ mod tests {
     #[test]
     fn depth_warning_names_the_share_of_oblique_pixels() {
         let block = || primitives::cuboid(DVec3::new(-1.0, -1.0, -2.0), DVec3::new(1.0, 1.0, 0.0));
-        assert_eq!(depth_share(&checked_scene(block(), Axis::Z)), None);
-        let along_x = depth_share(&checked_scene(block(), Axis::X)).expect("a warning");
+        assert_eq!(
+            depth_share(&textured_scene(block(), check_along(Axis::Z))),
+            None
+        );
+        let along_x =
+            depth_share(&textured_scene(block(), check_along(Axis::X))).expect("a warning");
         assert!((along_x - 100.0).abs() < 1e-9, "{along_x} %");
-        let ball = depth_share(&checked_scene(
+        let ball = depth_share(&textured_scene(
             primitives::icosphere(DVec3::ZERO, 1.5, 4),
-            Axis::Z,
+            check_along(Axis::Z),
         ))
         .expect("a warning");
         let want = 100.0 * (25f64.to_radians().cos()).powi(2);
         // The rim's pixel row is 3 % of the disk's pixels; facets move the normals a little.
         assert!((ball - want).abs() < 3.0, "{ball} %, want {want} %");
         assert_eq!(depth_share(&sphere_scene(0.0)), None);
-        let pt = scene_warnings(&checked_scene(block(), Axis::X), Method::PathTraced);
+        // A stripe along z varying along x only, on the box seen from above: the top face's
+        // normal is across x, so nothing changes with depth there.
+        let projection = crate::field::PlanarProjection::new(Axis::Z, DVec3::ZERO);
+        let stripe =
+            crate::field::Field::stripe(0.5, 0.0, [Rgb::splat(0.01), Rgb::splat(0.1)], projection)
+                .unwrap();
+        assert_eq!(
+            stripe.variation(),
+            Some(crate::field::Variation::Along(DVec3::X))
+        );
+        let v = stripe.variation().unwrap();
+        assert_eq!(v.depth_sine(DVec3::Z), 0.0);
+        assert_eq!(v.depth_sine(DVec3::Y), 0.0);
+        assert_eq!(v.depth_sine(DVec3::NEG_X), 1.0);
+        assert_eq!(depth_share(&textured_scene(block(), stripe.clone())), None);
+        // The sphere with that stripe: oblique where |n_x| > sin 25°, outside the band
+        // |x| < R sin 25° of the projected disk, 1 − 2(s√(1 − s²) + asin s)/π = 47.8 % of it
+        // (s = sin 25°).
+        let ball = depth_share(&textured_scene(
+            primitives::icosphere(DVec3::ZERO, 1.5, 4),
+            stripe,
+        ))
+        .expect("a warning");
+        let s = 25f64.to_radians().sin();
+        let want =
+            100.0 * (1.0 - 2.0 * (s * (1.0 - s * s).sqrt() + s.asin()) / std::f64::consts::PI);
+        assert!((ball - want).abs() < 3.0, "{ball} %, want {want} %");
+        let pt = scene_warnings(
+            &textured_scene(block(), check_along(Axis::X)),
+            Method::PathTraced,
+        );
         assert!(!pt.iter().any(|w| w.contains("changes with depth")));
     }
 
