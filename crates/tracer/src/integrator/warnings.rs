@@ -210,27 +210,44 @@ const OBLIQUE_SINE: f64 = 0.422_618_261_740_699_4;
 /// path tracer on such faces of the heterogeneous bunny (`examples/scenes/bunny.toml`, with
 /// its shape correction), 1.03–1.06 with a layer boundary 0.05–0.5 below a flat surface.
 fn depth_varying(scene: &Scene) -> Vec<String> {
-    let mut warnings = Vec::new();
-    for (i, t) in scene.translucent_objects() {
-        let fields: Vec<(&str, Variation)> = t
-            .medium
-            .named_fields()
-            .into_iter()
-            .filter_map(|(name, f)| f.variation().map(|v| (name, v)))
-            .collect();
-        if fields.is_empty() {
-            continue;
-        }
-        let (mut seen, mut oblique) = (0u32, 0u32);
-        for_object_pixels(scene, i, |hit| {
-            seen += 1;
-            if fields
+    let mut tallies: Vec<DepthTally<'_>> = scene
+        .translucent_objects()
+        .map(|(object, t)| DepthTally {
+            object,
+            fields: t
+                .medium
+                .named_fields()
+                .into_iter()
+                .filter_map(|(name, f)| f.variation().map(|v| (name, v)))
+                .collect(),
+            seen: 0,
+            oblique: 0,
+        })
+        .filter(|t| !t.fields.is_empty())
+        .collect();
+    if tallies.is_empty() {
+        return Vec::new();
+    }
+    // One sweep of the pixel grid for every object at once.
+    for_pixel_hits(scene, |hit| {
+        if let Some(t) = tallies.iter_mut().find(|t| t.object == hit.object) {
+            t.seen += 1;
+            if t.fields
                 .iter()
                 .any(|(_, v)| v.depth_sine(hit.ns) > OBLIQUE_SINE)
             {
-                oblique += 1;
+                t.oblique += 1;
             }
-        });
+        }
+    });
+    let mut warnings = Vec::new();
+    for DepthTally {
+        object: i,
+        fields,
+        seen,
+        oblique,
+    } in tallies
+    {
         let share = if seen > 0 {
             f64::from(oblique) / f64::from(seen)
         } else {
@@ -258,10 +275,18 @@ fn depth_varying(scene: &Scene) -> Vec<String> {
     warnings
 }
 
-/// Calls `f` with the first hit of every camera ray, on a grid of at most [`SHARE_GRID`]²
-/// pixel centres spread evenly over the image, that hits `object` first; returns the number
-/// of grid pixels.
-fn for_object_pixels(scene: &Scene, object: u32, mut f: impl FnMut(&Hit)) -> u32 {
+/// One object's fields that vary in space, and how many of its grid pixels [`depth_varying`]
+/// saw, and saw over oblique surfaces.
+struct DepthTally<'a> {
+    object: u32,
+    fields: Vec<(&'a str, Variation)>,
+    seen: u32,
+    oblique: u32,
+}
+
+/// Calls `f` with the first hit of every camera ray on a grid of at most [`SHARE_GRID`]²
+/// pixel centres spread evenly over the image; returns the number of grid pixels.
+fn for_pixel_hits(scene: &Scene, mut f: impl FnMut(&Hit)) -> u32 {
     let camera = scene.camera();
     let (w, h) = camera.resolution();
     let (nx, ny) = (w.min(SHARE_GRID), h.min(SHARE_GRID));
@@ -269,10 +294,7 @@ fn for_object_pixels(scene: &Scene, object: u32, mut f: impl FnMut(&Hit)) -> u32
         for i in 0..nx {
             let px = ((i as f64 + 0.5) * w as f64 / nx as f64).floor() + 0.5;
             let py = ((j as f64 + 0.5) * h as f64 / ny as f64).floor() + 0.5;
-            let ray = camera.ray(px, py);
-            if let Some(hit) = scene.geometry().intersect(&ray)
-                && hit.object == object
-            {
+            if let Some(hit) = scene.geometry().intersect(&camera.ray(px, py)) {
                 f(&hit);
             }
         }
@@ -284,7 +306,7 @@ fn for_object_pixels(scene: &Scene, object: u32, mut f: impl FnMut(&Hit)) -> u32
 /// most [`SHARE_GRID`]² pixel centres spread evenly over the image.
 fn image_share(scene: &Scene, object: u32) -> f64 {
     let mut seen = 0u32;
-    let total = for_object_pixels(scene, object, |_| seen += 1);
+    let total = for_pixel_hits(scene, |hit| seen += u32::from(hit.object == object));
     f64::from(seen) / f64::from(total)
 }
 
