@@ -2,8 +2,13 @@
 
 /// Unpolarised Fresnel reflectance for light arriving at the boundary with cosine `cos_i`
 /// (measured from the normal on the incident side, `cos_i ∈ [0, 1]`) and relative index
-/// `eta = n_transmitted / n_incident`. Returns 1 under total internal reflection.
+/// `eta = n_transmitted / n_incident`. Returns 1 under total internal reflection, and exactly
+/// 0 at `eta = 1` (an index-matched boundary is no boundary: the formula would round to
+/// about 1e-32, and to 1 at grazing incidence, where `sin²θ_t` reaches 1).
 pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
+    if eta == 1.0 {
+        return 0.0;
+    }
     let cos_i = cos_i.clamp(0.0, 1.0);
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -147,6 +152,18 @@ impl DiffuseFresnel {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An index-matched boundary reflects nothing at any angle, grazing included; just off
+    /// η = 1 the reflectance is small but not zero.
+    #[test]
+    fn index_matched_boundary_reflects_nothing() {
+        for k in 0..=100 {
+            let cos = k as f64 / 100.0;
+            assert_eq!(dielectric(cos, 1.0), 0.0, "cos {cos}");
+        }
+        let near = dielectric(0.5, 1.01);
+        assert!(near > 0.0 && near < 1e-3, "{near}");
+    }
 
     #[test]
     fn moments_match_independent_table() {

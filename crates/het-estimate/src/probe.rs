@@ -140,12 +140,11 @@ pub struct ProbeSampler {
 /// Source of [`ProbeSampler`] ids.
 static NEXT_SAMPLER_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
-/// What a channel's table searches were computed for: the sampler, the channel and the bits
-/// of σa, σs and the radius cap.
+/// What a channel's table searches were computed for (each channel has its own memo slot):
+/// the sampler and the bits of σa, σs and the radius cap.
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct ChannelKey {
     sampler: u64,
-    channel: usize,
     bits: [u64; 3],
 }
 
@@ -207,10 +206,10 @@ impl ProbeSampler {
     /// scatters).
     pub fn probe_radius(&self, c: Coefficients) -> f64 {
         self.channels(c, f64::INFINITY)
-            .radial
+            .channel
             .iter()
             .flatten()
-            .map(|(_, r)| *r)
+            .map(|d| d.r_max)
             .fold(0.0, f64::max)
     }
 
@@ -241,21 +240,14 @@ impl ProbeSampler {
         for f in first {
             count[f] += 1;
         }
-        let mut radial: [Option<(Radial<'_>, f64)>; 3] = [None; 3];
-        let mut norm = [1.0; 3];
-        let mut below = [f64::INFINITY; 3];
-        let mut masses = [[1.0, 0.0]; 3];
+        let mut channel: [Option<ChannelDensity<'_>>; 3] = [None; 3];
         for (ch, &f) in first.iter().enumerate() {
             if f < ch {
-                radial[ch] = radial[f];
-                norm[ch] = norm[f];
-                below[ch] = below[f];
-                masses[ch] = masses[f];
+                channel[ch] = channel[f];
                 continue;
             }
             let key = ChannelKey {
                 sampler: self.id,
-                channel: ch,
                 bits: [c.sigma_a[ch], c.sigma_s[ch], cap].map(f64::to_bits),
             };
             let searches = LAST_SEARCHES.with(|last| match last[ch].get() {
@@ -266,28 +258,20 @@ impl ProbeSampler {
                     found
                 }
             });
-            radial[ch] = self.channel(c, ch, searches.own_radius);
-            if let Some(m) = searches.masses
-                && let Some((prof, _)) = radial[ch]
-            {
-                let f = match prof {
-                    Radial::One(_) => m[0],
-                    Radial::Mixture(..) => 0.5 * (m[0] + m[1]),
-                };
-                if f > 0.0 {
-                    below[ch] = 0.5 * cap;
-                    norm[ch] = f;
-                    masses[ch] = m;
-                }
-            }
+            channel[ch] =
+                self.channel(c, ch, searches.own_radius)
+                    .map(|(radial, r_max)| ChannelDensity {
+                        radial,
+                        r_max,
+                        truncated: searches.masses.filter(|&m| radial.mass(m) > 0.0).map(
+                            |masses| Truncation {
+                                below: 0.5 * cap,
+                                masses,
+                            },
+                        ),
+                    });
         }
-        Channels {
-            radial,
-            count,
-            norm,
-            below,
-            masses,
-        }
+        Channels { channel, count }
     }
 
     /// The table searches of channel `ch` at coefficients `c` with radius cap `cap` (see
@@ -342,17 +326,30 @@ impl ProbeSampler {
     }
 }
 
-/// The three channels' radial densities and probe radii; `count[k]` is how many channels share
-/// channel `k`'s density (0 for a channel that repeats an earlier one); `norm[k]` is the mass
-/// of the density below `below[k]` when a share [`NARROW_SHARE`] of the radii are drawn below
-/// it (see [`probe_within`]), 1 and ∞ otherwise; `masses[k]` are the masses of the density's
-/// components below `below[k]` (the second 0 for a single profile).
+/// The three channels' sampling densities (`None` where a channel does not scatter);
+/// `count[k]` is how many channels share channel `k`'s density (0 for a channel that repeats
+/// an earlier one).
 struct Channels<'a> {
-    radial: [Option<(Radial<'a>, f64)>; 3],
+    channel: [Option<ChannelDensity<'a>>; 3],
     count: [u8; 3],
-    norm: [f64; 3],
-    below: [f64; 3],
-    masses: [[f64; 2]; 3],
+}
+
+/// One channel's sampling density: its radial density, its probe radius, and, on an object
+/// small enough, the truncation the draws below half its extent use (see [`probe_within`]).
+#[derive(Clone, Copy)]
+struct ChannelDensity<'a> {
+    radial: Radial<'a>,
+    r_max: f64,
+    truncated: Option<Truncation>,
+}
+
+/// A share [`NARROW_SHARE`] of the radii are drawn below `below`, from the radial density
+/// truncated there; `masses` are its components' masses below `below` (the second 0 for a
+/// single profile; [`Radial::mass`] combines them).
+#[derive(Clone, Copy)]
+struct Truncation {
+    below: f64,
+    masses: [f64; 2],
 }
 
 /// A channel's radial sampling density: x_o's profile, or an equal mixture of it and the
@@ -364,6 +361,14 @@ enum Radial<'a> {
 }
 
 impl Radial<'_> {
+    /// The density's mass below a radius, from its components' masses there.
+    #[inline]
+    fn mass(&self, masses: [f64; 2]) -> f64 {
+        match self {
+            Radial::One(_) => masses[0],
+            Radial::Mixture(..) => 0.5 * (masses[0] + masses[1]),
+        }
+    }
     #[inline]
     fn sample_r(&self, u: f64) -> Option<f64> {
         match self {
@@ -471,22 +476,14 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     rng: &mut U,
 ) {
     set.len = 0;
-    let channels = sampler.channels(coeffs, max_radius);
-    let origin = x_o.position();
-    let frame = Frame::new(x_o.normal());
-    trace_probes(chords, origin, &frame, &channels, rng, |h| {
-        let p = axis_densities_in(origin, &frame, h, &channels)
-            .iter()
-            .sum::<f64>();
-        let kept = p > 0.0 && p.is_finite();
-        if kept {
-            set.hits[set.len] = Some(ProbeHit {
-                hit: *h,
-                weight: 1.0 / p,
-            });
+    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
+    density.trace(chords, rng, |h| match density.weight(h) {
+        Some(weight) => {
+            set.hits[set.len] = Some(ProbeHit { hit: *h, weight });
             set.len += 1;
+            true
         }
-        kept
+        None => false,
     });
 }
 
@@ -539,16 +536,126 @@ pub struct ProbeDensity<'s> {
     channels: Channels<'s>,
 }
 
-impl ProbeDensity<'_> {
+impl<'s> ProbeDensity<'s> {
+    /// The density of the probes around `x_o` with coefficients `coeffs` there, radii capped
+    /// at `max_radius` ([`probe_within`]).
+    fn new(
+        x_o: &impl SurfacePoint,
+        coeffs: Coefficients,
+        sampler: &'s ProbeSampler,
+        max_radius: f64,
+    ) -> Self {
+        Self {
+            origin: x_o.position(),
+            frame: Frame::new(x_o.normal()),
+            channels: sampler.channels(coeffs, max_radius),
+        }
+    }
+
+    /// `p(x_i)` (1/length²).
+    pub fn density(&self, x_i: &impl SurfacePoint) -> f64 {
+        self.axis_densities(x_i).iter().sum()
+    }
+
     /// `1 / p(x_i)` (an area), or `None` where the density is 0 or not finite: a point the
     /// probes found has such a density only at the edge of a probe sphere (by rounding) or at
     /// x_o itself (every projected radius 0). Such a point contributes nothing:
     /// [`probe_within_into`] drops it from its set.
     pub fn weight(&self, x_i: &impl SurfacePoint) -> Option<f64> {
-        let p = axis_densities_in(self.origin, &self.frame, x_i, &self.channels)
-            .iter()
-            .sum::<f64>();
+        let p = self.density(x_i);
         (p > 0.0 && p.is_finite()).then(|| 1.0 / p)
+    }
+
+    /// The three axes' terms of `p(x_i)` (tangent s, tangent t, normal), each already divided
+    /// by 3 (the axes' share).
+    pub fn axis_densities(&self, x_i: &impl SurfacePoint) -> [f64; 3] {
+        let frame = &self.frame;
+        let d = x_i.position() - self.origin;
+        let dist = d.length();
+        let ng = x_i.geometric_normal();
+        let dl = DVec3::new(d.dot(frame.s), d.dot(frame.t), d.dot(frame.n));
+        let nl = DVec3::new(ng.dot(frame.s), ng.dot(frame.t), ng.dot(frame.n));
+        let r_proj = [
+            (dl.y * dl.y + dl.z * dl.z).sqrt(),
+            (dl.z * dl.z + dl.x * dl.x).sqrt(),
+            (dl.x * dl.x + dl.y * dl.y).sqrt(),
+        ];
+        let mut pdf = [0.0; 3];
+        for (channel, &count) in self.channels.channel.iter().zip(&self.channels.count) {
+            let Some(c) = channel else {
+                continue;
+            };
+            if count == 0 || dist >= c.r_max {
+                continue;
+            }
+            let share = f64::from(count) / (3.0 * std::f64::consts::TAU);
+            for axis in 0..3 {
+                let r = r_proj[axis];
+                // A probe along an axis in x's tangent plane cannot find x (|n_g · axis| = 0):
+                // its term is 0, without the table's density (on a box, two of the three).
+                if r > 0.0 && nl[axis] != 0.0 {
+                    // The radial density of the draws: x_o's alone, or the defensive mixture
+                    // with the one truncated below `below` (see `probe_within`).
+                    let mix = match c.truncated {
+                        Some(t) => {
+                            let narrow = if r < t.below {
+                                NARROW_SHARE / c.radial.mass(t.masses)
+                            } else {
+                                0.0
+                            };
+                            narrow + (1.0 - NARROW_SHARE)
+                        }
+                        None => 1.0,
+                    };
+                    pdf[axis] += share * mix * c.radial.pdf_r(r) / r * nl[axis].abs();
+                }
+            }
+        }
+        pdf
+    }
+
+    /// The three probes (one per axis of x_o's frame): calls `keep` on every point each
+    /// probe's chord crosses, in order, until `keep` has returned true [`MAX_PROBE_HITS`]
+    /// times for that probe. Draws 3 uniform numbers per axis from `rng`.
+    fn trace<C: ProbeChords, U: UniformSource>(
+        &self,
+        chords: &C,
+        rng: &mut U,
+        mut keep: impl FnMut(&C::Point) -> bool,
+    ) {
+        for axis in 0..3 {
+            let ch = ((rng.next_f64() * 3.0) as usize).min(2);
+            let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
+            let Some(c) = self.channels.channel[ch] else {
+                continue;
+            };
+            let r = match c.truncated {
+                None => c.radial.sample_r(u_r),
+                Some(t) if u_r < NARROW_SHARE => {
+                    c.radial
+                        .sample_r_below(u_r / NARROW_SHARE, t.below, t.masses)
+                }
+                Some(_) => c
+                    .radial
+                    .sample_r(((u_r - NARROW_SHARE) / (1.0 - NARROW_SHARE)).min(1.0)),
+            };
+            let Some(r) = r else {
+                continue;
+            };
+            if r.is_nan() || r >= c.r_max {
+                continue;
+            }
+            let (sin, cos) = crate::sampling::sin_cos_turn(u_phi);
+            let (vx, vy, vz) = self.frame.axes(axis);
+            let half = (c.r_max * c.r_max - r * r).sqrt();
+            let base = self.origin + r * (cos * vx + sin * vy) - half * vz;
+            let mut kept = 0;
+            chords.for_each_hit(base, vz, 2.0 * half, |h| {
+                if kept < MAX_PROBE_HITS && keep(h) {
+                    kept += 1;
+                }
+            });
+        }
     }
 }
 
@@ -571,67 +678,13 @@ pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
     rng: &mut U,
 ) -> ProbeDensity<'s> {
     points.len = 0;
-    let density = ProbeDensity {
-        origin: x_o.position(),
-        frame: Frame::new(x_o.normal()),
-        channels: sampler.channels(coeffs, max_radius),
-    };
-    trace_probes(
-        chords,
-        density.origin,
-        &density.frame,
-        &density.channels,
-        rng,
-        |h| {
-            points.hits[points.len] = Some(*h);
-            points.len += 1;
-            true
-        },
-    );
+    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
+    density.trace(chords, rng, |h| {
+        points.hits[points.len] = Some(*h);
+        points.len += 1;
+        true
+    });
     density
-}
-
-/// The three probes of one shading point (one per axis of `frame`, about `origin`): calls
-/// `keep` on every point each probe's chord crosses, in order, until `keep` has returned true
-/// [`MAX_PROBE_HITS`] times for that probe. Draws 3 uniform numbers per axis from `rng`.
-fn trace_probes<C: ProbeChords, U: UniformSource>(
-    chords: &C,
-    origin: DVec3,
-    frame: &Frame,
-    channels: &Channels<'_>,
-    rng: &mut U,
-    mut keep: impl FnMut(&C::Point) -> bool,
-) {
-    for axis in 0..3 {
-        let ch = ((rng.next_f64() * 3.0) as usize).min(2);
-        let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
-        let Some((prof, r_max)) = channels.radial[ch].as_ref() else {
-            continue;
-        };
-        let r = if !channels.below[ch].is_finite() {
-            prof.sample_r(u_r)
-        } else if u_r < NARROW_SHARE {
-            prof.sample_r_below(u_r / NARROW_SHARE, channels.below[ch], channels.masses[ch])
-        } else {
-            prof.sample_r(((u_r - NARROW_SHARE) / (1.0 - NARROW_SHARE)).min(1.0))
-        };
-        let Some(r) = r else {
-            continue;
-        };
-        if r.is_nan() || r >= *r_max {
-            continue;
-        }
-        let (sin, cos) = crate::sampling::sin_cos_turn(u_phi);
-        let (vx, vy, vz) = frame.axes(axis);
-        let half = (r_max * r_max - r * r).sqrt();
-        let base = origin + r * (cos * vx + sin * vy) - half * vz;
-        let mut kept = 0;
-        chords.for_each_hit(base, vz, 2.0 * half, |h| {
-            if kept < MAX_PROBE_HITS && keep(h) {
-                kept += 1;
-            }
-        });
-    }
 }
 
 /// `p(x)` of the module docs (1/length²): the density with which [`probe`] around `x_o`, with
@@ -653,14 +706,7 @@ pub fn probe_density_within(
     max_radius: f64,
     x_i: &impl SurfacePoint,
 ) -> f64 {
-    axis_densities_in(
-        x_o.position(),
-        &Frame::new(x_o.normal()),
-        x_i,
-        &sampler.channels(coeffs, max_radius),
-    )
-    .iter()
-    .sum()
+    ProbeDensity::new(x_o, coeffs, sampler, max_radius).density(x_i)
 }
 
 /// The three axes' terms of [`probe_density`] (tangent s, tangent t, normal), each already
@@ -671,63 +717,7 @@ pub fn axis_densities(
     sampler: &ProbeSampler,
     x_i: &impl SurfacePoint,
 ) -> [f64; 3] {
-    axis_densities_in(
-        x_o.position(),
-        &Frame::new(x_o.normal()),
-        x_i,
-        &sampler.channels(coeffs, f64::INFINITY),
-    )
-}
-
-fn axis_densities_in(
-    x_o: DVec3,
-    frame: &Frame,
-    x_i: &impl SurfacePoint,
-    channels: &Channels<'_>,
-) -> [f64; 3] {
-    let d = x_i.position() - x_o;
-    let dist = d.length();
-    let ng = x_i.geometric_normal();
-    let dl = DVec3::new(d.dot(frame.s), d.dot(frame.t), d.dot(frame.n));
-    let nl = DVec3::new(ng.dot(frame.s), ng.dot(frame.t), ng.dot(frame.n));
-    let r_proj = [
-        (dl.y * dl.y + dl.z * dl.z).sqrt(),
-        (dl.z * dl.z + dl.x * dl.x).sqrt(),
-        (dl.x * dl.x + dl.y * dl.y).sqrt(),
-    ];
-    let mut pdf = [0.0; 3];
-    for (((channel, &count), &norm), &below) in channels
-        .radial
-        .iter()
-        .zip(&channels.count)
-        .zip(&channels.norm)
-        .zip(&channels.below)
-    {
-        let Some((prof, r_max)) = channel else {
-            continue;
-        };
-        if count == 0 || dist >= *r_max {
-            continue;
-        }
-        let share = f64::from(count) / (3.0 * std::f64::consts::TAU);
-        for axis in 0..3 {
-            let r = r_proj[axis];
-            // A probe along an axis in x's tangent plane cannot find x (|n_g · axis| = 0):
-            // its term is 0, without the table's density (on a box, two of the three).
-            if r > 0.0 && nl[axis] != 0.0 {
-                // The radial density of the draws: x_o's alone, or the defensive mixture with
-                // the one truncated below `below` (see `probe_within`).
-                let mix = if below.is_finite() {
-                    let narrow = if r < below { NARROW_SHARE / norm } else { 0.0 };
-                    narrow + (1.0 - NARROW_SHARE)
-                } else {
-                    1.0
-                };
-                pdf[axis] += share * mix * prof.pdf_r(r) / r * nl[axis].abs();
-            }
-        }
-    }
-    pdf
+    ProbeDensity::new(x_o, coeffs, sampler, f64::INFINITY).axis_densities(x_i)
 }
 
 /// The shading frame at x_o.

@@ -164,9 +164,6 @@ impl BssrdfObject {
     /// (unitless; 1 for η = 1).
     #[inline]
     pub fn transmission(&self, cos: f64) -> f64 {
-        if self.eta == 1.0 {
-            return 1.0; // an index-matched boundary reflects nothing
-        }
         1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta)
     }
 
