@@ -5,23 +5,12 @@
 //!     cargo run --release --example kernel_variants -- <stripe|check> <seed> <out-dir>
 //!
 //! then compare each map with a light-traced reference of the same preset, e.g.
-//! `het-bssrdf compare <out>/stripe-it2-n32.exr stripe-pt.exr --min-radius 1 --min-counts 100`.
+//! `het-bssrdf compare <out>/stripe-it2-n64-p0.875.exr stripe-pt.exr --min-radius 1 --min-counts 100`.
 
-use bssrdf_core::ProfileModel;
-use experiments::beam::{BeamSetup, BeamTexture, bssrdf_map, write_beam_map};
+use het_bssrdf::experiments::beam::{Variant, write_variant_maps};
 use het_bssrdf::het_estimate::{Estimator, KernelParams, SampleBudget};
-use het_bssrdf::{bssrdf_core, experiments};
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [preset, seed, out] = &args[..] else {
-        eprintln!("usage: kernel_variants <stripe|check> <seed> <out-dir>");
-        std::process::exit(2);
-    };
-    let texture = BeamTexture::preset(preset).expect("preset: stripe or check");
-    let seed: u64 = seed.parse().expect("seed: an integer");
-    let setup = BeamSetup::paper(texture);
-    std::fs::create_dir_all(out).expect("output directory");
     // (iterations, points, power-mean exponent p)
     let variants = [
         (1, 32, 1.0),
@@ -45,30 +34,23 @@ fn main() {
         (2, 64, 0.9),
         (2, 128, 0.9),
     ];
-    for (iterations, samples, exponent) in variants {
-        let params = KernelParams::new()
-            .with_iterations(iterations)
-            .with_samples(SampleBudget::fixed(samples))
-            .with_exponent(exponent);
-        let map = bssrdf_map(
-            &setup,
-            Estimator::Kernel(params),
-            ProfileModel::Tabulated,
-            4,
-            seed,
-            &|_| {},
-        )
-        .expect("beam map");
-        let path = std::path::Path::new(out).join(format!(
-            "{preset}-it{iterations}-n{samples}-p{exponent}.exr"
-        ));
-        write_beam_map(
-            &map,
-            &setup,
-            &path,
-            serde_json::json!({"iterations": iterations, "samples": samples, "exponent": exponent}),
-        )
-        .expect("write");
-        println!("{} ({:.1} s)", path.display(), map.seconds);
-    }
+    write_variant_maps(
+        "kernel_variants",
+        variants
+            .into_iter()
+            .map(|(iterations, samples, exponent)| Variant {
+                name: format!("it{iterations}-n{samples}-p{exponent}"),
+                estimator: Estimator::Kernel(
+                    KernelParams::new()
+                        .with_iterations(iterations)
+                        .with_samples(SampleBudget::fixed(samples))
+                        .with_exponent(exponent),
+                ),
+                sidecar: serde_json::json!({
+                    "iterations": iterations,
+                    "samples": samples,
+                    "exponent": exponent,
+                }),
+            }),
+    );
 }

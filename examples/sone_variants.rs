@@ -8,8 +8,7 @@
 //! a flag of the CLI (`--semi-minor` on `render`, `beam` and `converge`), which is how a
 //! scene is rendered with it.
 
-use het_bssrdf::bssrdf_core::ProfileModel;
-use het_bssrdf::experiments::beam::{BeamSetup, BeamTexture, bssrdf_map, write_beam_map};
+use het_bssrdf::experiments::beam::{Variant, write_variant_maps};
 use het_bssrdf::het_estimate::path_integral::{MeanSquareAngle, SemiMinorAxis};
 use het_bssrdf::het_estimate::{Estimator, SoneParams};
 
@@ -28,35 +27,18 @@ const VARIANTS: [(&str, SemiMinorAxis, MeanSquareAngle); 3] = [
     ),
 ];
 
-fn params(b: SemiMinorAxis, t: MeanSquareAngle) -> SoneParams {
-    let mut p = SoneParams::paper();
-    p.semi_minor = b;
-    p.mean_square_angle = t;
-    p
-}
-
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [preset, seed, out] = &args[..] else {
-        eprintln!("usage: sone_variants <stripe|check> <seed> <out-dir>");
-        std::process::exit(2);
-    };
-    let texture = BeamTexture::preset(preset).expect("preset: stripe or check");
-    let seed: u64 = seed.parse().expect("seed: an integer");
-    let setup = BeamSetup::paper(texture);
-    std::fs::create_dir_all(out).expect("output directory");
-    for (name, b, t) in VARIANTS {
-        let map = bssrdf_map(
-            &setup,
-            Estimator::Sone(params(b, t)),
-            ProfileModel::Tabulated,
-            4,
-            seed,
-            &|_| {},
-        )
-        .expect("beam map");
-        let path = std::path::Path::new(out).join(format!("{preset}-sone-{name}.exr"));
-        write_beam_map(&map, &setup, &path, serde_json::json!({"variant": name})).expect("write");
-        println!("{} ({:.1} s)", path.display(), map.seconds);
-    }
+    write_variant_maps(
+        "sone_variants",
+        VARIANTS.into_iter().map(|(name, b, t)| {
+            let mut p = SoneParams::paper();
+            p.semi_minor = b;
+            p.mean_square_angle = t;
+            Variant {
+                name: format!("sone-{name}"),
+                estimator: Estimator::Sone(p),
+                sidecar: serde_json::json!({"variant": name}),
+            }
+        }),
+    );
 }

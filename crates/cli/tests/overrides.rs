@@ -1,16 +1,25 @@
 //! Method overrides (`--profile`, `--estimator-samples`, `--averaging`, `--semi-minor`) reach
 //! the runs and their sidecars, for `converge` (on a tiny scene), `beam` and `render`.
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// The built-in checker slab at `size` × `size` pixels, with `render_extra` added to its
+/// `[render]` table, written as `slab.toml` in `dir`.
+fn tiny_slab(dir: &Path, size: u32, render_extra: &str) -> PathBuf {
+    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
+        .replace("width = 128", &format!("width = {size}"))
+        .replace("height = 128", &format!("height = {size}"))
+        .replace("[render]", &format!("[render]\n{render_extra}"));
+    let path = dir.join("slab.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
 
 #[test]
 fn converge_writes_each_methods_largest_render_with_its_real_parameters() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
-        .replace("width = 128", "width = 8")
-        .replace("height = 128", "height = 8");
-    let scene_path = dir.path().join("slab.toml");
-    std::fs::write(&scene_path, scene).unwrap();
+    let scene_path = tiny_slab(dir.path(), 8, "");
     let out = dir.path().join("study");
     let status = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
         .env("HET_BSSRDF_CACHE_DIR", dir.path().join("cache"))
@@ -130,7 +139,7 @@ fn beam_prefilters_by_default_and_records_it() {
 }
 
 /// Runs `cmd`, asks for success, and reads the sidecar of its output `out`.
-fn sidecar_of_run(cmd: &mut Command, out: &std::path::Path) -> serde_json::Value {
+fn sidecar_of_run(cmd: &mut Command, out: &Path) -> serde_json::Value {
     let run = cmd.output().unwrap();
     assert!(
         run.status.success(),
@@ -183,11 +192,7 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
     assert!(err.contains("--semi-minor does not apply"), "{err}");
     assert!(!dir.path().join("refused.exr").exists());
 
-    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
-        .replace("width = 128", "width = 4")
-        .replace("height = 128", "height = 4");
-    let scene_path = dir.path().join("slab.toml");
-    std::fs::write(&scene_path, scene).unwrap();
+    let scene_path = tiny_slab(dir.path(), 4, "");
     let out = dir.path().join("slab.exr");
     let v = sidecar_of_run(
         Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
@@ -211,12 +216,7 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
 #[test]
 fn scene_averaging_applies_unless_the_flag_is_given() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = include_str!("../../../examples/scenes/checker-slab.toml")
-        .replace("width = 128", "width = 4")
-        .replace("height = 128", "height = 4")
-        .replace("[render]", "[render]\naveraging = \"monte-carlo\"");
-    let scene_path = dir.path().join("slab.toml");
-    std::fs::write(&scene_path, scene).unwrap();
+    let scene_path = tiny_slab(dir.path(), 4, "averaging = \"monte-carlo\"");
     let out = dir.path().join("slab.exr");
     let render = |extra: &[&str]| {
         sidecar_of_run(

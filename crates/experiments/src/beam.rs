@@ -495,6 +495,49 @@ pub fn bssrdf_map(
     })
 }
 
+/// One estimator variant of [`write_variant_maps`]: its file-name suffix, the estimator, and
+/// what its sidecar records about it.
+pub struct Variant {
+    /// File-name suffix: the map is `<preset>-<name>.exr`.
+    pub name: String,
+    /// The estimator, with the variant's parameters.
+    pub estimator: Estimator,
+    /// Merged into the map's sidecar.
+    pub sidecar: serde_json::Value,
+}
+
+/// The examples' variant studies (`examples/sone_variants.rs`, `examples/kernel_variants.rs`):
+/// for the preset, seed and output directory on the command line (`<stripe|check> <seed>
+/// <out-dir>`; `example` names the program in the usage line, which exits with status 2 on
+/// other arguments), writes each variant's beam map with the tabulated profile and 4 × 4
+/// subsamples per pixel as `<out-dir>/<preset>-<name>.exr` with its sidecar, for `het-bssrdf
+/// compare` against a light-traced reference, and prints each path with its time.
+pub fn write_variant_maps(example: &str, variants: impl IntoIterator<Item = Variant>) {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [preset, seed, out] = &args[..] else {
+        eprintln!("usage: {example} <stripe|check> <seed> <out-dir>");
+        std::process::exit(2);
+    };
+    let texture = BeamTexture::preset(preset).expect("preset: stripe or check");
+    let seed: u64 = seed.parse().expect("seed: an integer");
+    let setup = BeamSetup::paper(texture);
+    std::fs::create_dir_all(out).expect("output directory");
+    for v in variants {
+        let map = bssrdf_map(
+            &setup,
+            v.estimator,
+            ProfileModel::Tabulated,
+            4,
+            seed,
+            &|_| {},
+        )
+        .expect("beam map");
+        let path = std::path::Path::new(out).join(format!("{preset}-{}.exr", v.name));
+        write_beam_map(&map, &setup, &path, v.sidecar).expect("write");
+        println!("{} ({:.1} s)", path.display(), map.seconds);
+    }
+}
+
 /// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar
 /// beside it (feature `plot`), and a JSON sidecar with the set-up, the method, timings and
 /// counters (`extra` is merged in).

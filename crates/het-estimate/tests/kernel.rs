@@ -74,18 +74,34 @@ fn constant_field_without_bounds_returns_the_constant() {
     }
 }
 
-/// Two regions: σa = 0.01 for y < 1.5 (where both endpoints lie) and 0.2 above, σs = 1,
-/// g = 0, η = 1. With one iteration the weight is the kernel of the endpoint value
-/// (σa = 0.01), so the estimate tends to the power mean ((1 − F)·0.01^p + F·0.2^p)^{1/p}, F
-/// the share of ∫W₂ dA over y > 1.5 (checked for p = 1, the arithmetic mean, and the default
-/// p). F comes from an independent quadrature of the tabulated weight over the plane
-/// (midpoint rule in x = s·tan u, y = s·tan v); the estimate's mean over 48 seeds must agree
-/// within 4 standard errors (plus 0.5 % for the self-normalised ratio's O(1/N) bias).
-/// The share F of ∫W₂ dA over y > `y0` for the kernel of the homogeneous medium (σa = `a`,
-/// σs = 1, g = 0, η = 1) and the chord from `x_i` to `x_o` on the x axis: an independent
-/// quadrature of the tabulated weight over the plane (midpoint rule in x = s·tan u,
-/// y = s·tan v).
-fn share_above(a: f64, y0: f64, x_i: f64, x_o: f64) -> f64 {
+// The two regions of the tests below: σa = A0 for y < Y0 (where both endpoints, X_I and X_O
+// on the x axis, lie) and A1 above, σs = 1, g = 0, η = 1.
+const A0: f64 = 0.01;
+const A1: f64 = 0.2;
+const Y0: f64 = 1.5;
+const X_I: f64 = -2.0;
+const X_O: f64 = 3.0;
+
+/// The averaged σa of estimator `e` on [`A0`]'s two regions, over seeds 0..48: its mean,
+/// standard error and standard deviation.
+fn two_region_estimates(e: Estimator) -> (f64, f64, f64) {
+    let f = FnField(|p: &PlanePoint| Coefficients::grey(if p.y > Y0 { A1 } else { A0 }, 1.0));
+    let (pi, po) = (PlanePoint::new(X_I, 0.0), PlanePoint::new(X_O, 0.0));
+    let vals: Vec<f64> = (0..48)
+        .map(|seed| {
+            run(e, 0.0, 1.0, &Plane, &f, &pi, &po, seed)
+                .coefficients
+                .sigma_a[0]
+        })
+        .collect();
+    mean_se_sd(&vals)
+}
+
+/// The share F of ∫W₂ dA over y > [`Y0`] for the kernel of the homogeneous medium (σa = `a`,
+/// σs = 1, g = 0, η = 1) and the chord from [`X_I`] to [`X_O`]: an independent quadrature of
+/// the tabulated weight over the plane (midpoint rule in x = s·tan u, y = s·tan v).
+fn share_above(a: f64) -> f64 {
+    let (y0, x_i, x_o) = (Y0, X_I, X_O);
     let table = KernelTable::shared(boundary_coefficient(1.0).unwrap());
     let st = a + 1.0;
     let kappa = (3.0 * a / st).sqrt();
@@ -139,33 +155,21 @@ fn mean_se_sd(vals: &[f64]) -> (f64, f64, f64) {
 /// errors (plus 0.5 % for the self-normalised ratio's O(1/N) bias).
 #[test]
 fn two_region_average_matches_quadrature_of_the_weight() {
-    let (a0, a1, y0): (f64, f64, f64) = (0.01, 0.2, 1.5);
-    let (x_i, x_o) = ((-2.0, 0.0), (3.0, 0.0));
-    let share = share_above(a0, y0, x_i.0, x_o.0);
-    let f = FnField(|p: &PlanePoint| Coefficients::grey(if p.y > y0 { a1 } else { a0 }, 1.0));
-    let (pi, po) = (PlanePoint::new(x_i.0, x_i.1), PlanePoint::new(x_o.0, x_o.1));
+    let share = share_above(A0);
     for p in [1.0, KernelParams::new().exponent] {
-        let want = power_mean(a0, a1, share, p);
-        let e = Estimator::Kernel(
+        let want = power_mean(A0, A1, share, p);
+        let (mean, se, _) = two_region_estimates(Estimator::Kernel(
             KernelParams::new()
                 .with_samples(SampleBudget::Fixed(NonZeroU32::new(1024).unwrap()))
                 .with_iterations(1)
                 .with_exponent(p),
-        );
-        let vals: Vec<f64> = (0..48)
-            .map(|seed| {
-                run(e, 0.0, 1.0, &Plane, &f, &pi, &po, seed)
-                    .coefficients
-                    .sigma_a[0]
-            })
-            .collect();
-        let (mean, se, _) = mean_se_sd(&vals);
+        ));
         assert!(
             (mean - want).abs() < 4.0 * se + 5e-3 * want,
             "p = {p}: mean {mean} ± {se}, quadrature {want} (F = {share})"
         );
         // The endpoint value (0.01) is far from it: the kernel reaches over the boundary.
-        assert!(mean > a0 + 5.0 * se);
+        assert!(mean > A0 + 5.0 * se);
     }
 }
 
@@ -174,41 +178,17 @@ fn two_region_average_matches_quadrature_of_the_weight() {
 /// kernel); the second reweights all of them with the kernel of the first one's estimate.
 /// So the mean over 48 seeds must match the power mean at the share F₂ of the kernel of
 /// a₁ = the first iteration's expected value (two quadratures; the pilot's noise enters at
-/// second order, inside the 0.5 % allowance), and the spread must be well below that of 256
-/// points: an estimate whose last iteration saw only the pilot subset (a quarter of the
-/// points) would spread as much, and one whose pilot were a handful of points would carry
-/// its noise into the kernel (and miss the mean).
+/// second order, inside the 0.5 % allowance), and the spread must be well below that of one
+/// iteration at 64 points: an estimate whose last iteration saw only the pilot subset (a
+/// quarter of the points) would spread more, and one whose pilot were a handful of points
+/// would carry its noise into the kernel (and miss the mean).
 #[test]
 fn second_iteration_reweights_every_point_with_the_first_ones_kernel() {
-    let (a0, a1, y0): (f64, f64, f64) = (0.01, 0.2, 1.5);
-    let (x_i, x_o) = ((-2.0, 0.0), (3.0, 0.0));
     let p = KernelParams::new().exponent;
-    let first = power_mean(a0, a1, share_above(a0, y0, x_i.0, x_o.0), p);
-    let share = share_above(first, y0, x_i.0, x_o.0);
-    let want = power_mean(a0, a1, share, p);
-
-    let f = FnField(|p: &PlanePoint| Coefficients::grey(if p.y > y0 { a1 } else { a0 }, 1.0));
-    let (pi, po) = (PlanePoint::new(x_i.0, x_i.1), PlanePoint::new(x_o.0, x_o.1));
-    let spread = |samples: u32, iterations: u32| {
-        let vals: Vec<f64> = (0..48)
-            .map(|seed| {
-                run(
-                    kernel(samples, iterations),
-                    0.0,
-                    1.0,
-                    &Plane,
-                    &f,
-                    &pi,
-                    &po,
-                    seed,
-                )
-                .coefficients
-                .sigma_a[0]
-            })
-            .collect();
-        mean_se_sd(&vals)
-    };
-    let (mean, se, sd) = spread(1024, 2);
+    let first = power_mean(A0, A1, share_above(A0), p);
+    let share = share_above(first);
+    let want = power_mean(A0, A1, share, p);
+    let (mean, se, sd) = two_region_estimates(kernel(1024, 2));
     assert!(
         (mean - want).abs() < 4.0 * se + 5e-3 * want,
         "mean {mean} ± {se}, quadrature {want} (first iteration {first}, F₂ = {share})"
@@ -218,7 +198,7 @@ fn second_iteration_reweights_every_point_with_the_first_ones_kernel() {
     // Sixteen times the points of one iteration over 64 (which no pilot shortens) cut its
     // spread by more than Monte Carlo's 4 (the points are a shifted R2 sequence; measured:
     // 0.11 of it, and 0.35 when the last iteration sees only a quarter of the points).
-    let (_, _, sd_64) = spread(64, 1);
+    let (_, _, sd_64) = two_region_estimates(kernel(64, 1));
     assert!(
         sd <= 0.2 * sd_64,
         "sd {sd} at 1024 points and two iterations, {sd_64} at 64 points and one"

@@ -314,16 +314,16 @@ fn image_share(scene: &Scene, object: u32) -> f64 {
 mod tests {
     use super::*;
     use crate::camera::Camera;
-    use crate::field::{Axis, MediumField};
-    use crate::geometry::primitives;
+    use crate::field::{Axis, Field, MediumField, PlanarProjection, Variation};
+    use crate::geometry::{TriangleMesh, primitives};
     use crate::scene::{Material, RenderSettings, SceneBuilder, Translucent};
     use bssrdf_core::Rgb;
     use glam::DVec3;
     use het_estimate::Coefficients;
 
-    /// A sphere of radius 1.5 (σa = σs = 1) seen whole by a 64 × 64 orthographic view 4.4
-    /// wide: it covers π·1.5²/4.4² = 36.5 % of the image.
-    fn sphere_scene(g: f64) -> Scene {
+    /// One translucent object `name` (η 1, anisotropy `g`) under a uniform sky, seen along −z
+    /// by a 64 × 64 orthographic view 4.4 wide.
+    fn viewed_scene(name: &str, mesh: TriangleMesh, medium: MediumField, g: f64) -> Scene {
         let camera = Camera::orthographic(
             DVec3::new(0.0, 0.0, 5.0),
             DVec3::NEG_Z,
@@ -334,47 +334,39 @@ mod tests {
             64,
         )
         .unwrap();
-        let medium = MediumField::homogeneous(Coefficients::grey(1.0, 1.0)).unwrap();
         SceneBuilder::new(RenderSettings::new(64, 64, 1), camera)
             .light(Light::environment(Rgb::ONE).unwrap())
             .object(
-                "ball",
-                primitives::icosphere(DVec3::ZERO, 1.5, 3),
+                name,
+                mesh,
                 Material::Translucent(Translucent::new("m", medium, g, 1.0)),
             )
             .build()
             .unwrap()
     }
 
-    /// A check (σa 0.01 and 0.1, cells of 0.5) projected along `axis`.
-    fn check_along(axis: Axis) -> crate::field::Field {
-        let projection = crate::field::PlanarProjection::new(axis, DVec3::ZERO);
-        crate::field::Field::check(0.5, [Rgb::splat(0.01), Rgb::splat(0.1)], projection).unwrap()
+    /// A sphere of radius 1.5 (σa = σs = 1) seen whole by [`viewed_scene`]'s view: it covers
+    /// π·1.5²/4.4² = 36.5 % of the image.
+    fn sphere_scene(g: f64) -> Scene {
+        let medium = MediumField::homogeneous(Coefficients::grey(1.0, 1.0)).unwrap();
+        viewed_scene(
+            "ball",
+            primitives::icosphere(DVec3::ZERO, 1.5, 3),
+            medium,
+            g,
+        )
     }
 
-    /// [`sphere_scene`]'s camera over `mesh`, whose σa is `sigma_a` (σs 1).
-    fn textured_scene(mesh: crate::geometry::TriangleMesh, sigma_a: crate::field::Field) -> Scene {
-        let camera = Camera::orthographic(
-            DVec3::new(0.0, 0.0, 5.0),
-            DVec3::NEG_Z,
-            DVec3::Y,
-            4.4,
-            4.4,
-            64,
-            64,
-        )
-        .unwrap();
-        let sigma_s = crate::field::Field::constant(Rgb::ONE).unwrap();
-        let medium = MediumField::new(sigma_a, sigma_s);
-        SceneBuilder::new(RenderSettings::new(64, 64, 1), camera)
-            .light(Light::environment(Rgb::ONE).unwrap())
-            .object(
-                "body",
-                mesh,
-                Material::Translucent(Translucent::new("m", medium, 0.0, 1.0)),
-            )
-            .build()
-            .unwrap()
+    /// A check (σa 0.01 and 0.1, cells of 0.5) projected along `axis`.
+    fn check_along(axis: Axis) -> Field {
+        let projection = PlanarProjection::new(axis, DVec3::ZERO);
+        Field::check(0.5, [Rgb::splat(0.01), Rgb::splat(0.1)], projection).unwrap()
+    }
+
+    /// `mesh` in [`viewed_scene`], its σa `sigma_a` (σs 1, g 0).
+    fn textured_scene(mesh: TriangleMesh, sigma_a: Field) -> Scene {
+        let medium = MediumField::new(sigma_a, Field::constant(Rgb::ONE).unwrap());
+        viewed_scene("body", mesh, medium, 0.0)
     }
 
     /// The share of the depth warning, or `None` without one.
@@ -388,8 +380,8 @@ mod tests {
     }
 
     /// A box seen from above with its check along z (the view axis) shows the medium below its
-    /// top face: no warning (nor with a stripe varying along x). The same box with the check along x: every pixel's medium changes
-    /// with depth. A sphere of radius R seen along z with the check along z: the normal at
+    /// top face: no warning (nor with a stripe varying along x). The same box with the check
+    /// along x: every pixel's medium changes with depth. A sphere of radius R seen along z with the check along z: the normal at
     /// distance ρ from the axis has n_z = √(1 − ρ²/R²), below cos 25° where ρ/R > sin 25°,
     /// which is 1 − sin² 25° = cos² 25° = 82.1 % of the projected disk. A constant medium and
     /// the path tracer get no warning.
@@ -414,14 +406,10 @@ mod tests {
         assert_eq!(depth_share(&sphere_scene(0.0)), None);
         // A stripe along z varying along x only, on the box seen from above: the top face's
         // normal is across x, so nothing changes with depth there.
-        let projection = crate::field::PlanarProjection::new(Axis::Z, DVec3::ZERO);
+        let projection = PlanarProjection::new(Axis::Z, DVec3::ZERO);
         let stripe =
-            crate::field::Field::stripe(0.5, 0.0, [Rgb::splat(0.01), Rgb::splat(0.1)], projection)
-                .unwrap();
-        assert_eq!(
-            stripe.variation(),
-            Some(crate::field::Variation::Along(DVec3::X))
-        );
+            Field::stripe(0.5, 0.0, [Rgb::splat(0.01), Rgb::splat(0.1)], projection).unwrap();
+        assert_eq!(stripe.variation(), Some(Variation::Along(DVec3::X)));
         let v = stripe.variation().unwrap();
         assert_eq!(v.depth_sine(DVec3::Z), 0.0);
         assert_eq!(v.depth_sine(DVec3::Y), 0.0);
