@@ -396,6 +396,23 @@ impl Field {
         self.min() == self.max()
     }
 
+    /// The width of a varying pattern's bands or cells (scene units): the scale the medium
+    /// changes on; `None` for constants and images.
+    pub fn pattern_width(&self) -> Option<f64> {
+        match self {
+            _ if self.is_constant() => None,
+            Field::Pattern {
+                pattern: Pattern::Stripe(stripe),
+                ..
+            } => Some(stripe.width()),
+            Field::Pattern {
+                pattern: Pattern::Check(check),
+                ..
+            } => Some(check.width),
+            _ => None,
+        }
+    }
+
     /// The directions a varying field defined in space changes along ([`Variation`]);
     /// `None` for a field that does not vary and for UV-mapped images (defined on the
     /// surface only).
@@ -645,6 +662,14 @@ impl MediumField {
     /// True when neither field varies.
     pub fn is_constant(&self) -> bool {
         self.bounds.is_constant()
+    }
+
+    /// The narrowest pattern width of σa and σs ([`Field::pattern_width`]).
+    pub fn pattern_width(&self) -> Option<f64> {
+        match (self.sigma_a.pattern_width(), self.sigma_s.pattern_width()) {
+            (Some(a), Some(s)) => Some(a.min(s)),
+            (a, s) => a.or(s),
+        }
     }
 
     /// Per-channel majorant of σt = σa + σs over the whole medium (for an artist medium,

@@ -206,9 +206,10 @@ const OBLIQUE_SINE: f64 = 0.422_618_261_740_699_4;
 /// it, docs/kernel.md#assumptions); a field defined in space (a pattern or a planar image) is
 /// constant only along its projection axis (a stripe also along its bands), so below a
 /// surface oblique to those directions the medium the light crosses is not the one its
-/// surface shows. Measured with the kernel (docs/shapes.md, "What remains"): 0.81–0.94 of the
-/// path tracer on such faces of the heterogeneous bunny (`examples/scenes/bunny.toml`, with
-/// its shape correction), 1.03–1.06 with a layer boundary 0.05–0.5 below a flat surface.
+/// surface shows. Measured with the kernel (docs/shapes.md, "What remains"): 0.81 of the path
+/// tracer over the heterogeneous bunny (`examples/scenes/bunny.toml`), 0.95 with the shape
+/// correction, whose walks go through the medium (0.89 when they went through the coefficients
+/// at the surface); 1.03–1.06 with a layer boundary 0.05–0.5 below a flat surface.
 fn depth_varying(scene: &Scene) -> Vec<String> {
     let mut tallies: Vec<DepthTally<'_>> = scene
         .translucent_objects()
@@ -266,8 +267,9 @@ fn depth_varying(scene: &Scene) -> Vec<String> {
              {:.1} % of its pixels (surfaces tilted more than 25° from the directions the \
              medium is constant along); every BSSRDF estimator reads the coefficients on the \
              surface and takes them to continue unchanged below it, which measured from 0.81 \
-             (curved faces of the heterogeneous bunny) to 1.06 (a layer below a flat surface) \
-             of the path tracer with `kernel` (docs/shapes.md); compare with `--method pt`",
+             (the heterogeneous bunny; 0.95 with the material's `shape_correction`, whose \
+             walks go through the medium) to 1.06 (a layer below a flat surface) of the path \
+             tracer with `kernel` (docs/shapes.md); compare with `--method pt`",
             scene.objects()[i as usize].name,
             100.0 * share
         ));
