@@ -518,9 +518,13 @@ fn contains_half_ball(surface: &ObjectSurface<'_>, x_o: &Hit, reach: f64) -> boo
 }
 
 /// The field the walks scatter in: the medium itself where it has values inside the body
-/// (defined in space) and varies; `None` (x_o's coefficients) otherwise.
+/// (defined in space) and varies, and its σt stays within [`MAX_TRACKING_CONTRAST`] of its
+/// majorant; `None` (x_o's coefficients) otherwise.
 fn walk_medium(medium: &MediumField) -> Option<&MediumField> {
-    (medium.is_volumetric() && !medium.is_constant()).then_some(medium)
+    let b = medium.field_bounds();
+    let floor = b.min.sigma_a + b.min.sigma_s;
+    let trackable = (0..3).all(|c| medium.majorant()[c] <= MAX_TRACKING_CONTRAST * floor[c]);
+    (medium.is_volumetric() && !medium.is_constant() && trackable).then_some(medium)
 }
 
 /// The spacing h of the sample points: half the diffusion length 1/σtr (or transport mean
@@ -926,6 +930,10 @@ enum WalkMedium<'m> {
     },
 }
 
+/// Largest majorant / smallest σt for which the walks track the field: tracking takes about
+/// that many tentative collisions per real one in the thinnest part, so a medium of a
+/// sharper contrast (σt from 1e-6 to 1e6 is valid input) is walked in x_o's coefficients.
+const MAX_TRACKING_CONTRAST: f64 = 100.0;
 /// Most tentative collisions one delta- or ratio-tracked flight takes (a guard: a flight
 /// that long in a medium whose σt is far below its majorant ends as absorbed).
 const MAX_TRACKING: u32 = 1_000_000;
@@ -1343,9 +1351,9 @@ mod tests {
         assert!(mean > 0.95, "{mean} ± {se}");
     }
 
-    /// The walks scatter in a varying field defined in space, and the points are a quarter of
-    /// its cells' width apart; a uniform medium keeps half its diffusion length (here
-    /// 1/√(3 · 0.01 · 6.01) / 2 = 1.18).
+    /// The walks scatter in a varying field defined in space, unless its σt spans more than
+    /// [`MAX_TRACKING_CONTRAST`], and the points are a quarter of its cells' width apart; a
+    /// uniform medium keeps half its diffusion length (here 1/√(3 · 0.01 · 6.01) / 2 = 1.18).
     #[test]
     fn patterned_media_are_walked_in_and_sampled_by_their_cells() {
         let patterned = checks(2.0, [0.01, 0.6], 6.0);
@@ -1353,6 +1361,9 @@ mod tests {
         assert_eq!(sample_spacing(&patterned, true, 0.0, 8.0), 0.5);
         let uniform = checks(2.0, [0.01, 0.01], 6.0);
         assert!(walk_medium(&uniform).is_none());
+        // σt from 1e-6 to 1e6: tracking would take 1e12 tentative collisions per real one.
+        assert!(walk_medium(&checks(2.0, [0.0, 1e6], 1e-6)).is_none());
+        assert!(walk_medium(&checks(2.0, [0.0, 99.0], 1.0)).is_some());
         let h = sample_spacing(&uniform, false, 0.0, 8.0);
         assert!((h - 1.1777).abs() < 1e-3, "{h}");
     }
