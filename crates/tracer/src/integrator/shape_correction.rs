@@ -16,11 +16,12 @@
 //! c(x_o, ω) = [P_body(x_o, ω) / P_half(x_o, ω)] / [B_body(x_o) / B_half(x_o)],
 //!
 //! "half" meaning the half-space bounded by the tangent plane at x_o. The walks scatter in the
-//! medium itself wherever it is defined in space (a constant, a pattern or a planar image:
-//! the half-space below the tangent plane then holds the same field), so that a heterogeneous
-//! body's light is measured as it travels through the cells its surface does not show; with a
-//! UV-mapped medium, which has no values inside the body, in the coefficients at x_o. B is the
-//! profile at x_o's coefficients. On a half-space c = 1 whatever the profile's own error; on a
+//! medium itself wherever it varies and is defined in space (a pattern or a planar image: the
+//! half-space below the tangent plane then holds the same field), so that a heterogeneous
+//! body's light is measured as it travels through the cells its surface does not show; in the
+//! coefficients at x_o for a uniform medium, a UV-mapped one (which has no values inside the
+//! body) and one whose σt spans more than [`MAX_TRACKING_CONTRAST`] ([`walk_medium`]). B is
+//! the profile at x_o's coefficients. On a half-space c = 1 whatever the profile's own error; on a
 //! body, the corrected BSSRDF responds to uniform light in the same ratio to the path tracer as
 //! it does on a half-space.
 //!
