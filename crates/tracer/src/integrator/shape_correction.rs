@@ -293,7 +293,7 @@ impl ShapeCorrection {
         let (lo, hi) = geometry.object_bounds(object);
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
         let walk_medium = walk_medium(medium);
-        let h = sample_spacing(medium, walk_medium.is_some(), bssrdf.family.g(), extent);
+        let h = sample_spacing(medium, bssrdf.family.g(), extent);
         let area = mesh.surface_area();
         let n_points = ((area / (h * h)).ceil() as usize).clamp(MIN_POINTS, MAX_POINTS);
         // Triangle CDF by area.
@@ -533,10 +533,10 @@ fn walk_medium(medium: &MediumField) -> Option<&MediumField> {
 /// which the profile, and so the correction, varies); when the walks scatter in a patterned
 /// field, at most a quarter of its bands' or cells' width, since c then changes from cell to
 /// cell (docs/shapes.md, "Heterogeneous bodies"); bounded to [extent/40, extent/4].
-fn sample_spacing(medium: &MediumField, walks_in_field: bool, g: f64, extent: f64) -> f64 {
+fn sample_spacing(medium: &MediumField, g: f64, extent: f64) -> f64 {
     let reach = 0.5 * light_reach(medium.field_bounds().min, g).0;
     let cells = match medium.pattern_width() {
-        Some(w) if walks_in_field => 0.25 * w,
+        Some(w) if walk_medium(medium).is_some() => 0.25 * w,
         _ => f64::INFINITY,
     };
     reach.min(cells).clamp(extent / 40.0, extent / 4.0)
@@ -597,11 +597,7 @@ fn point_sums(
                 if !(majorant > 0.0 && majorant.is_finite()) {
                     continue;
                 }
-                WalkMedium::Field {
-                    field,
-                    channel: ch,
-                    majorant,
-                }
+                WalkMedium::Field { field, channel: ch }
             }
             None => {
                 let sigma_t = coeffs.sigma_a[ch] + coeffs.sigma_s[ch];
@@ -849,17 +845,25 @@ impl ProbeChords for TangentPlane {
         }
         let t = (self.p0 - origin).dot(self.n) / dn;
         if (0.0..=t_max).contains(&t) {
-            f(&Hit {
-                t,
-                p: origin + t * dir,
-                ng: self.n,
-                ns: self.n,
-                uv: DVec2::ZERO,
-                object: self.object,
-                prim: u32::MAX,
-                bary: DVec2::ZERO,
-                p_error: 0.0,
-            });
+            f(&self.hit(t, origin + t * dir));
+        }
+    }
+}
+
+impl TangentPlane {
+    /// The plane's point `p`, met at ray distance `t`, as a hit (no triangle, no texture
+    /// coordinates).
+    fn hit(&self, t: f64, p: DVec3) -> Hit {
+        Hit {
+            t,
+            p,
+            ng: self.n,
+            ns: self.n,
+            uv: DVec2::ZERO,
+            object: self.object,
+            prim: u32::MAX,
+            bary: DVec2::ZERO,
+            p_error: 0.0,
         }
     }
 }
@@ -873,8 +877,9 @@ enum Boundary<'a> {
 enum Crossing {
     /// Nothing ahead: the tangent plane is behind the flight, which ends in a collision.
     Open,
-    /// A face met from outside (numerically behind it): the walk steps over it.
-    Behind { p: DVec3, hit: Option<Hit> },
+    /// A face met from outside (numerically behind it): the walk steps over it and resumes
+    /// at `resume`, just past it, on `hit`.
+    Behind { resume: DVec3, hit: Option<Hit> },
     /// The boundary at distance `s`, point `p`, normal `ng` facing the flight (`cos` = d·ng
     /// > 0), and the body's hit there (none on the plane).
     At {
@@ -910,7 +915,11 @@ impl Boundary<'_> {
         };
         let cos = d.dot(ng);
         Some(if cos <= 0.0 {
-            Crossing::Behind { p, hit }
+            let step = 1e-9_f64.max(hit.map_or(0.0, |h| h.p_error));
+            Crossing::Behind {
+                resume: p + d * step,
+                hit,
+            }
         } else {
             Crossing::At { s, p, ng, cos, hit }
         })
@@ -922,12 +931,11 @@ impl Boundary<'_> {
 enum WalkMedium<'m> {
     /// One σt (1/length) and single-scattering albedo everywhere: x_o's coefficients.
     Homogeneous { sigma_t: f64, albedo: f64 },
-    /// The medium's own field, in one channel, with its majorant σ̄ ≥ σt everywhere
-    /// (1/length, > 0).
+    /// The medium's own field, in one channel (its majorant σ̄ ≥ σt everywhere must be
+    /// positive and finite: [`walk_medium`] and [`point_sums`] see to it).
     Field {
         field: &'m MediumField,
         channel: usize,
-        majorant: f64,
     },
 }
 
@@ -976,11 +984,8 @@ impl Walk<'_> {
             WalkMedium::Homogeneous { sigma_t, albedo } => {
                 self.escape_homogeneous(sigma_t, albedo, boundary, x_o, d, w, rng)
             }
-            WalkMedium::Field {
-                field,
-                channel,
-                majorant,
-            } => {
+            WalkMedium::Field { field, channel } => {
+                let majorant = field.majorant()[channel];
                 let sigma = |p: DVec3| {
                     let c = field.at_point(p);
                     (c.sigma_a[channel] + c.sigma_s[channel], c.sigma_s[channel])
@@ -1014,8 +1019,8 @@ impl Walk<'_> {
             };
             let t = match crossing {
                 Crossing::Open => -(1.0 - u[0]).ln() / sigma_t,
-                Crossing::Behind { p, hit } => {
-                    pos = p + d * 1e-9_f64.max(hit.map_or(0.0, |h| h.p_error));
+                Crossing::Behind { resume, hit } => {
+                    pos = resume;
                     on = hit;
                     continue;
                 }
@@ -1089,8 +1094,8 @@ impl Walk<'_> {
             let mut rng = Rng::from_keys(key, &[step, 0]);
             let (s_max, at) = match crossing {
                 Crossing::Open => (f64::INFINITY, None),
-                Crossing::Behind { p, hit } => {
-                    pos = p + d * 1e-9_f64.max(hit.map_or(0.0, |h| h.p_error));
+                Crossing::Behind { resume, hit } => {
+                    pos = resume;
                     on = hit;
                     continue;
                 }
@@ -1267,17 +1272,7 @@ mod tests {
             n: DVec3::Z,
             object: 0,
         };
-        let x_o = Hit {
-            t: 0.0,
-            p: DVec3::ZERO,
-            ng: DVec3::Z,
-            ns: DVec3::Z,
-            uv: DVec2::ZERO,
-            object: 0,
-            prim: u32::MAX,
-            bary: DVec2::ZERO,
-            p_error: 0.0,
-        };
+        let x_o = plane.hit(0.0, DVec3::ZERO);
         let walk = Walk {
             medium,
             g: 0.0,
@@ -1312,7 +1307,6 @@ mod tests {
                 WalkMedium::Field {
                     field: &field,
                     channel: 0,
-                    majorant: 4.0,
                 },
                 WalkMedium::Homogeneous {
                     sigma_t: 1.0,
@@ -1340,7 +1334,6 @@ mod tests {
         let field_walks = WalkMedium::Field {
             field: &field,
             channel: 0,
-            majorant: 1001.0,
         };
         let (mean, se) = escapes(field_walks, DVec3::Z, 4000);
         assert!(mean < 0.049 + 4.0 * se, "{mean} ± {se}");
@@ -1359,13 +1352,13 @@ mod tests {
     fn patterned_media_are_walked_in_and_sampled_by_their_cells() {
         let patterned = checks(2.0, [0.01, 0.6], 6.0);
         assert!(walk_medium(&patterned).is_some());
-        assert_eq!(sample_spacing(&patterned, true, 0.0, 8.0), 0.5);
+        assert_eq!(sample_spacing(&patterned, 0.0, 8.0), 0.5);
         let uniform = checks(2.0, [0.01, 0.01], 6.0);
         assert!(walk_medium(&uniform).is_none());
         // σt from 1e-6 to 1e6: tracking would take 1e12 tentative collisions per real one.
         assert!(walk_medium(&checks(2.0, [0.0, 1e6], 1e-6)).is_none());
         assert!(walk_medium(&checks(2.0, [0.0, 99.0], 1.0)).is_some());
-        let h = sample_spacing(&uniform, false, 0.0, 8.0);
+        let h = sample_spacing(&uniform, 0.0, 8.0);
         assert!((h - 1.1777).abs() < 1e-3, "{h}");
     }
 
@@ -1398,7 +1391,6 @@ mod tests {
             medium: WalkMedium::Field {
                 field: &field,
                 channel: 0,
-                majorant: 1.49,
             },
             g: 0.0,
             eta: 1.3,
