@@ -300,7 +300,16 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         &title,
         &runs,
         &summary,
-        serde_json::json!({ "scene": file.display().to_string(), "reference_spp": args.reference_spp }),
+        serde_json::json!({
+            "scene": file.display().to_string(),
+            "reference_spp": args.reference_spp,
+            // Seconds each method took to prepare (profile tables, shape corrections), once
+            // per method and not in its runs' times.
+            "prepare_seconds": finals
+                .iter()
+                .map(|(name, o)| (name.clone(), serde_json::Value::from(o.prepare_seconds)))
+                .collect::<serde_json::Map<_, _>>(),
+        }),
     )?;
     for (name, outcome) in &finals {
         let method = *methods
@@ -315,6 +324,14 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
     }
     print_summary(&summary);
+    for (name, outcome) in &finals {
+        if outcome.prepare_seconds >= 0.5 {
+            eprintln!(
+                "note: preparing `{name}` took {:.1} s, once, not counted in its times above",
+                outcome.prepare_seconds
+            );
+        }
+    }
     eprintln!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()

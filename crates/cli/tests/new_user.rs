@@ -543,6 +543,16 @@ fn small_translucent_objects_warn_with_bssrdf_methods() {
         "{}",
         r.stderr
     );
+    // The sidecar keeps the note and the preparation's time, apart from the sampling time.
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(s.join("c.json")).unwrap()).unwrap();
+    assert!(
+        json["notes"][0]
+            .as_str()
+            .is_some_and(|n| n.starts_with("shape correction of `"))
+            && json["prepare_seconds"].as_f64().is_some_and(|t| t > 0.0),
+        "{json}"
+    );
 }
 
 /// Every example scene the README points at loads and renders with the path tracer and with

@@ -3,6 +3,7 @@
 
 pub use indicatif::ProgressBar;
 use indicatif::ProgressStyle;
+use tracer::integrator::PrepareObserver;
 use tracer::render::RenderObserver;
 
 /// A progress bar over `len` units named `unit`, labelled `prefix`.
@@ -79,5 +80,55 @@ impl<C> RenderObserver<C> for RenderBar {
     }
     fn advance(&self, pixel_samples: u64) {
         self.bar.inc(pixel_samples);
+    }
+}
+
+/// A render's preparation as a bar over each long stage's steps (the shape correction's
+/// points); stopped by the tracer's interrupt flag (the default of
+/// [`PrepareObserver::stop_requested`]). Hidden until a stage starts, and when `show` is false.
+#[derive(Debug)]
+pub struct PrepareBar {
+    bar: Option<ProgressBar>,
+}
+
+impl PrepareBar {
+    /// A bar that shows when a stage starts, if `show`.
+    pub fn new(show: bool) -> Self {
+        Self {
+            bar: show.then(|| {
+                let b = ProgressBar::hidden();
+                b.set_style(
+                    ProgressStyle::with_template(
+                        "{prefix:>16} [{bar:40}] {human_pos}/{human_len} steps  {elapsed}<{eta}",
+                    )
+                    .expect("static template")
+                    .progress_chars("=> "),
+                );
+                b
+            }),
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+impl PrepareObserver for PrepareBar {
+    fn stage(&self, label: &str, units: u64) {
+        if let Some(b) = &self.bar {
+            b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            b.set_prefix(label.to_string());
+            b.set_length(units);
+            b.reset();
+        }
+    }
+    fn advance(&self, units: u64) {
+        if let Some(b) = &self.bar {
+            b.inc(units);
+        }
     }
 }

@@ -73,6 +73,9 @@ pub struct RenderOutcome {
     pub spp: u32,
     /// Wall-clock seconds of sampling.
     pub seconds: f64,
+    /// Wall-clock seconds of preparing the method (profile tables, shape corrections), not
+    /// in `seconds`; 0 for a checkpoint.
+    pub prepare_seconds: f64,
     /// Rays traced (all kinds).
     pub rays: u64,
     /// Integrator counters.
@@ -104,6 +107,7 @@ impl RenderOutcome {
             film,
             spp,
             seconds,
+            prepare_seconds: 0.0,
             rays,
             counters,
             method,
@@ -130,14 +134,55 @@ pub fn render_scene_observed(
     job: &RenderJob,
     observer: &dyn RenderObserver<PathCounters>,
 ) -> Result<RenderOutcome, RenderError> {
-    let integrator = PathIntegrator::new(
+    let prepared = prepare(scene, job)?;
+    Ok(render_prepared(scene, &prepared, job, observer))
+}
+
+/// A method prepared for a scene, to render at any budget and seed: what
+/// [`render_prepared`] needs besides the job.
+pub struct Prepared<'s> {
+    integrator: PathIntegrator<'s>,
+    seconds: f64,
+}
+
+impl Prepared<'_> {
+    /// Wall-clock seconds the preparation took.
+    pub fn seconds(&self) -> f64 {
+        self.seconds
+    }
+}
+
+/// Prepares `job.method` for `scene` (profile tables, estimators, shape corrections), with a
+/// progress bar for the long parts when `job.progress` is set. An interrupt during a shape
+/// correction stops it ([`RenderError::Interrupted`]).
+pub fn prepare<'s>(scene: &'s Scene, job: &RenderJob) -> Result<Prepared<'s>, RenderError> {
+    let t0 = std::time::Instant::now();
+    let bar = crate::progress::PrepareBar::new(job.progress);
+    let integrator = PathIntegrator::new_observed(
         scene,
         job.method,
         PathOptions {
             scattering: job.scattering,
             max_depth: job.max_depth,
         },
-    )?;
+        &bar,
+    );
+    bar.finish();
+    Ok(Prepared {
+        integrator: integrator?,
+        seconds: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Renders `scene` with a method `prepared` for it, at `job`'s budget and seed (its method,
+/// scattering and depth are the preparation's), reporting to `observer`.
+pub fn render_prepared(
+    scene: &Scene,
+    prepared: &Prepared<'_>,
+    job: &RenderJob,
+    observer: &dyn RenderObserver<PathCounters>,
+) -> RenderOutcome {
+    let integrator = &prepared.integrator;
     let (w, h) = scene.camera().resolution();
     let rays_before = scene.geometry().rays_traced();
     let Rendered {
@@ -147,21 +192,22 @@ pub fn render_scene_observed(
         counters,
         interrupted,
         ..
-    } = render_observed(w, h, &integrator, &job.options(), observer);
+    } = render_observed(w, h, integrator, &job.options(), observer);
     let mut film = Film::new(w, h);
     film.pixels = pixels;
-    Ok(RenderOutcome {
+    RenderOutcome {
         film,
         spp,
         seconds,
+        prepare_seconds: prepared.seconds,
         rays: scene.geometry().rays_traced() - rays_before,
         counters,
-        method: job.method.name().to_string(),
+        method: integrator.method().name().to_string(),
         warnings: integrator.warnings().to_vec(),
         notes: integrator.notes(),
         interrupted,
         checkpoint: false,
-    })
+    }
 }
 
 /// The PNG and JSON paths written beside an EXR path.
@@ -297,6 +343,8 @@ pub fn write_render(
         "width": film.width,
         "height": film.height,
         "wall_seconds": outcome.seconds,
+        "prepare_seconds": outcome.prepare_seconds,
+        "notes": outcome.notes,
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,
@@ -333,4 +381,34 @@ pub fn write_image_set(
     set.add(&png, png_bytes(film, &png, exposure)?);
     set.add(exr, exr_bytes(film, exr, attributes)?);
     set.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A method prepared once (as `converge` prepares each method) renders every budget and
+    /// seed exactly as a fresh preparation does: the integrator keeps no state between renders.
+    #[test]
+    fn a_method_prepared_once_renders_as_a_fresh_one() {
+        let scene = Scene::from_toml_str(crate::scenes::CHECKER_SLAB, Path::new("."), "slab")
+            .unwrap()
+            .with_resolution(12, 12)
+            .unwrap();
+        let method: Method = "sone".parse().unwrap();
+        let mut job = RenderJob::from_scene(&scene, method);
+        let prepared = prepare(&scene, &job).unwrap();
+        for (spp, seed) in [(2, 3), (1, 5), (2, 3)] {
+            job.budget = Budget::Samples(spp);
+            job.seed = seed;
+            let reused = render_prepared(&scene, &prepared, &job, &tracer::render::NoObserver);
+            let fresh = render_scene(&scene, &job).unwrap();
+            assert_eq!(
+                reused.film.pixels, fresh.film.pixels,
+                "spp {spp}, seed {seed}"
+            );
+            assert_eq!(reused.prepare_seconds, prepared.seconds());
+            assert!(fresh.prepare_seconds > 0.0);
+        }
+    }
 }

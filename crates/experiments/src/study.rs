@@ -9,7 +9,7 @@ use bssrdf_core::ProfileModel;
 use crate::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
 use crate::converge::Run;
 use crate::metrics::{MetricsError, compare, compare_films};
-use crate::run::{RenderJob, RenderOutcome, render_scene};
+use crate::run::{RenderJob, RenderOutcome, prepare, render_prepared, render_scene};
 use tracer::error::SceneError;
 use tracer::film::Film;
 use tracer::integrator::{Method, RenderError};
@@ -132,11 +132,17 @@ pub fn scene_study(
 ) -> Result<Vec<Run>, StudyError> {
     let mut runs = Vec::new();
     for &method in methods {
+        // Prepared once per method (a shape correction is measured once, not per budget);
+        // each run's `seconds` is its sampling time.
+        let mut job = base.clone();
+        job.method = method;
+        let prepared = prepare(scene, &job)?;
         for &s in spp {
-            let mut job = base.clone();
-            job.method = method;
             job.budget = Budget::Samples(s);
-            let outcome = render_scene(scene, &job)?;
+            let (w, h) = scene.camera().resolution();
+            let bar = crate::progress::RenderBar::new(method.name(), w, h, job.progress);
+            let outcome = render_prepared(scene, &prepared, &job, &bar);
+            bar.finish();
             let run = Run {
                 method: method.name().to_string(),
                 budget: s as u64,

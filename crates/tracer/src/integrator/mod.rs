@@ -9,6 +9,7 @@ pub mod light_trace;
 pub mod lighting;
 mod method;
 pub mod path;
+pub mod preparation;
 pub mod probe;
 mod shape_correction;
 pub mod walk;
@@ -17,6 +18,7 @@ pub mod warnings;
 pub use counters::PathCounters;
 pub use light_trace::{LightTraceError, LightTraceOptions, LightTraced, LightTracer, Roles};
 pub use path::{LightStrategy, Method, PathIntegrator, PathOptions};
+pub use preparation::PrepareObserver;
 
 /// Why a render could not start.
 #[derive(Debug, thiserror::Error)]
@@ -34,6 +36,13 @@ pub enum RenderError {
         what: &'static str,
         /// The parameter error.
         source: bssrdf_core::ParamError,
+    },
+    /// Preparation was stopped ([`PrepareObserver::stop_requested`], an interrupt) while the
+    /// object's shape correction was being measured; nothing was rendered.
+    #[error("object `{object}`: stopped while its shape correction was being measured")]
+    Interrupted {
+        /// The object.
+        object: String,
     },
 }
 

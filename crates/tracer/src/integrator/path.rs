@@ -36,6 +36,7 @@ use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, power_heuristic};
+use crate::integrator::preparation::PrepareObserver;
 use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
@@ -371,6 +372,17 @@ impl<'s> PathIntegrator<'s> {
         method: Method,
         options: PathOptions,
     ) -> Result<Self, RenderError> {
+        Self::new_observed(scene, method, options, &crate::render::NoObserver)
+    }
+
+    /// [`PathIntegrator::new`] reporting the long parts of preparation (shape corrections)
+    /// to `observer`, which may stop it ([`RenderError::Interrupted`]).
+    pub fn new_observed(
+        scene: &'s Scene,
+        method: Method,
+        options: PathOptions,
+        observer: &dyn PrepareObserver,
+    ) -> Result<Self, RenderError> {
         if method == Method::PathTraced {
             scene.require_path_traceable()?;
         }
@@ -391,12 +403,20 @@ impl<'s> PathIntegrator<'s> {
                             )
                             .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
                             if t.shape_correction {
-                                b.correction = Some(ShapeCorrection::build(
-                                    &b,
-                                    scene.geometry(),
-                                    index as u32,
-                                    &t.medium,
-                                ));
+                                b.correction = Some(
+                                    ShapeCorrection::build(
+                                        &b,
+                                        scene.geometry(),
+                                        index as u32,
+                                        &t.medium,
+                                        observer,
+                                    )
+                                    .ok_or_else(|| {
+                                        RenderError::Interrupted {
+                                            object: object.name.clone(),
+                                        }
+                                    })?,
+                                );
                             }
                             Some(Box::new(b))
                         }

@@ -70,6 +70,7 @@ use crate::field::MediumField;
 use crate::geometry::{Geometry, Hit, ObjectSurface, Ray};
 use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
+use crate::integrator::preparation::PrepareObserver;
 use crate::integrator::walk::{reflect, refract};
 use crate::integrator::warnings::light_reach;
 use crate::rng::Rng;
@@ -98,6 +99,17 @@ const MAX_STEPS: u32 = 20_000;
 const RR_WEIGHT: f64 = 0.05;
 /// Bounds on c: a point where the estimates are degenerate keeps c within them.
 const C_RANGE: (f64, f64) = (0.05, 20.0);
+
+/// One step of the preparation's current stage: `None` (skipped) once `observer` asks to
+/// stop, else `work()`, reported as done.
+fn step<T>(observer: &dyn PrepareObserver, work: impl FnOnce() -> T) -> Option<T> {
+    if observer.stop_requested() {
+        return None;
+    }
+    let done = work();
+    observer.advance(1);
+    Some(done)
+}
 
 /// One sample point of the correction.
 #[derive(Debug, Clone, Copy)]
@@ -287,7 +299,8 @@ impl ShapeCorrection {
         geometry: &Geometry,
         object: u32,
         medium: &MediumField,
-    ) -> Self {
+        observer: &dyn PrepareObserver,
+    ) -> Option<Self> {
         let t0 = std::time::Instant::now();
         let mesh = geometry.mesh(object);
         let (lo, hi) = geometry.object_bounds(object);
@@ -306,29 +319,37 @@ impl ShapeCorrection {
         }
         let surface = ObjectSurface { geometry, object };
         let grey = medium.is_grey();
+        // Progress: the walks at each point, then each fixed-point step's responses.
+        observer.stage("shape correction", (n_points * (1 + ITERATIONS)) as u64);
         // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
         // c = 1 (the walks and probes in the body and under the plane agree but for what
         // leaves that ball): no walks there (`None`).
         let raw: Vec<(Hit, Coefficients, Option<Sums>)> = (0..n_points)
             .into_par_iter()
             .filter_map(|i| {
-                let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
-                let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
-                let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                // In a heterogeneous medium the light x_o sees may come from its most
-                // translucent parts.
-                let reach_of = if walk_medium.is_some() {
-                    medium.field_bounds().min
-                } else {
-                    coeffs
-                };
-                let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
-                let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
-                    point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, i as u64)
-                });
-                Some((x_o, coeffs, sums))
+                step(observer, || {
+                    let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
+                    let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
+                    let coeffs = medium.at_surface(x_o.p, x_o.uv);
+                    // In a heterogeneous medium the light x_o sees may come from its most
+                    // translucent parts.
+                    let reach_of = if walk_medium.is_some() {
+                        medium.field_bounds().min
+                    } else {
+                        coeffs
+                    };
+                    let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
+                    let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
+                        point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, i as u64)
+                    });
+                    Some((x_o, coeffs, sums))
+                })
+                .flatten()
             })
             .collect();
+        if observer.stop_requested() {
+            return None;
+        }
         let hits: Vec<Hit> = raw.iter().map(|(x, _, _)| *x).collect();
         let points: Vec<DVec3> = hits.iter().map(|x| x.p).collect();
         let grid = Grid::new(&points, h, lo, hi);
@@ -371,17 +392,23 @@ impl ShapeCorrection {
                 .par_iter()
                 .enumerate()
                 .map(|(i, (x, coeffs, sums))| {
-                    sums.as_ref()?;
-                    Some(body_response(
-                        bssrdf,
-                        &surface,
-                        x,
-                        *coeffs,
-                        i as u64,
-                        |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
-                    ))
+                    step(observer, || {
+                        sums.as_ref()?;
+                        Some(body_response(
+                            bssrdf,
+                            &surface,
+                            x,
+                            *coeffs,
+                            i as u64,
+                            |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
+                        ))
+                    })
+                    .flatten()
                 })
                 .collect();
+            if observer.stop_requested() {
+                return None;
+            }
             let updated: Vec<Directional> = (0..raw.len())
                 .into_par_iter()
                 .map(|i| {
@@ -403,7 +430,7 @@ impl ShapeCorrection {
         }
         corr.vertices = corr.vertex_factors(mesh);
         corr.seconds = t0.elapsed().as_secs_f64();
-        corr
+        Some(corr)
     }
 
     /// f at every vertex of `mesh` (the neighbourhood query at the vertex, about its
@@ -1192,6 +1219,7 @@ fn roulette(w: f64, u: f64) -> Option<f64> {
 mod tests {
     use super::*;
     use crate::geometry::{TriangleMesh, primitives};
+    use crate::render::NoObserver;
     use crate::scene::Translucent;
     use bssrdf_core::ProfileModel;
 
@@ -1212,8 +1240,81 @@ mod tests {
             (hi - lo).max_element(),
         )
         .unwrap();
-        b.correction = Some(ShapeCorrection::build(&b, &geometry, 0, &field));
+        b.correction = Some(
+            ShapeCorrection::build(&b, &geometry, 0, &field, &NoObserver).expect("not stopped"),
+        );
         (geometry, b)
+    }
+
+    /// Counts a preparation's steps, and asks it to stop once `stop_after` are done.
+    struct Steps {
+        units: std::sync::atomic::AtomicU64,
+        done: std::sync::atomic::AtomicU64,
+        stop_after: u64,
+    }
+
+    impl Steps {
+        fn stopping_after(stop_after: u64) -> Self {
+            Self {
+                units: 0.into(),
+                done: 0.into(),
+                stop_after,
+            }
+        }
+        fn counts(&self) -> (u64, u64) {
+            use std::sync::atomic::Ordering::SeqCst;
+            (self.units.load(SeqCst), self.done.load(SeqCst))
+        }
+    }
+
+    impl PrepareObserver for Steps {
+        fn stage(&self, _: &str, units: u64) {
+            self.units
+                .fetch_add(units, std::sync::atomic::Ordering::SeqCst);
+        }
+        fn advance(&self, units: u64) {
+            self.done
+                .fetch_add(units, std::sync::atomic::Ordering::SeqCst);
+        }
+        fn stop_requested(&self) -> bool {
+            self.counts().1 >= self.stop_after
+        }
+    }
+
+    /// The build reports every step it announces and gives the same correction whoever
+    /// watches; asked to stop, it returns none, long before its walks are done (at most one
+    /// step in flight per thread after the request).
+    #[test]
+    fn the_build_reports_its_steps_and_stops_when_asked() {
+        let field = MediumField::homogeneous(Coefficients::grey(0.1, 0.9)).unwrap();
+        let (geometry, b) = corrected_in(
+            primitives::icosphere(DVec3::ZERO, 1.0, 2),
+            field.clone(),
+            1.3,
+        );
+        let plain = b.correction.as_ref().unwrap();
+        let steps = Steps::stopping_after(u64::MAX);
+        let watched = ShapeCorrection::build(&b, &geometry, 0, &field, &steps).unwrap();
+        let (units, done) = steps.counts();
+        assert_eq!(units, (plain.samples.len() * (1 + ITERATIONS)) as u64);
+        assert_eq!(done, units);
+        assert!(
+            plain
+                .samples
+                .iter()
+                .zip(&watched.samples)
+                .all(|(a, b)| a.f == b.f)
+        );
+        assert_eq!(plain.samples.len(), watched.samples.len());
+
+        let stopping = Steps::stopping_after(5);
+        assert!(ShapeCorrection::build(&b, &geometry, 0, &field, &stopping).is_none());
+        let (units, done) = stopping.counts();
+        let threads = rayon::current_num_threads() as u64;
+        assert!(
+            done >= 5 && done <= 5 + threads,
+            "{done} steps done of {units}"
+        );
     }
 
     fn hit_from_above(geometry: &Geometry, p: DVec3, n: DVec3) -> Hit {
@@ -1479,7 +1580,8 @@ mod tests {
                 (hi - lo).max_element(),
             )
             .unwrap();
-            let corr = ShapeCorrection::build(&b, &geometry, 0, &field);
+            let corr =
+                ShapeCorrection::build(&b, &geometry, 0, &field, &NoObserver).expect("not stopped");
             let x = hit_from_above(
                 &geometry,
                 DVec3::ZERO,
