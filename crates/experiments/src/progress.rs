@@ -27,13 +27,16 @@ pub fn bar(len: u64, prefix: &str, unit: &str) -> ProgressBar {
 pub struct RenderBar {
     bar: ProgressBar,
     pixels: u64,
+    show: bool,
 }
 
 impl RenderBar {
     /// A bar labelled `label` for a `width × height` render; hidden when `show` is false.
     pub fn new(label: &str, width: u32, height: u32, show: bool) -> Self {
+        // Drawn from the first pass on: not while the render is being prepared, whose own bar
+        // ([`PrepareBar`]) shows then.
         let bar = if show {
-            let b = ProgressBar::new(0);
+            let b = ProgressBar::hidden();
             b.set_style(
                 ProgressStyle::with_template(
                     "{prefix:>12} [{bar:40}] {percent:>3}%  {elapsed}<{eta}",
@@ -49,6 +52,7 @@ impl RenderBar {
         Self {
             bar,
             pixels: u64::from(width) * u64::from(height),
+            show,
         }
     }
 
@@ -65,6 +69,10 @@ impl RenderBar {
 
 impl<C> RenderObserver<C> for RenderBar {
     fn pass_started(&self, first: u32, end: u32, total: Option<u32>) {
+        if self.show && first == 0 {
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
         match total {
             Some(n) => {
                 if first == 0 {

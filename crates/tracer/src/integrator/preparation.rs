@@ -11,7 +11,7 @@
 /// What preparation reports while it runs, and how it is stopped early. Called from worker
 /// threads, hence `Sync`.
 pub trait PrepareObserver: Sync {
-    /// A stage of `units` steps starts; `label` names it ("shape correction").
+    /// A stage of `units` steps starts; `label` names it ("correction walks").
     fn stage(&self, label: &str, units: u64) {
         let _ = (label, units);
     }

@@ -319,8 +319,9 @@ impl ShapeCorrection {
         }
         let surface = ObjectSurface { geometry, object };
         let grey = medium.is_grey();
-        // Progress: the walks at each point, then each fixed-point step's responses.
-        observer.stage("shape correction", (n_points * (1 + ITERATIONS)) as u64);
+        // Progress: the walks at each point, then (a faster stage) each fixed-point step's
+        // responses.
+        observer.stage("correction walks", n_points as u64);
         // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
         // c = 1 (the walks and probes in the body and under the plane agree but for what
         // leaves that ball): no walks there (`None`).
@@ -387,6 +388,7 @@ impl ShapeCorrection {
         // Where c varies on the scale of the profile (corners, edges), the incident side's
         // factor differs from x_o's: iterate f ← √(f · T / B'), B' the body's response with
         // the current factors at the incident points, T what it should be (module docs).
+        observer.stage("correction steps", (raw.len() * ITERATIONS) as u64);
         for _ in 0..ITERATIONS {
             let response: Vec<Option<Rgb>> = raw
                 .par_iter()
@@ -1296,6 +1298,7 @@ mod tests {
         let steps = Steps::stopping_after(u64::MAX);
         let watched = ShapeCorrection::build(&b, &geometry, 0, &field, &steps).unwrap();
         let (units, done) = steps.counts();
+        // Every point's walks, then every point found at each fixed-point step.
         assert_eq!(units, (plain.samples.len() * (1 + ITERATIONS)) as u64);
         assert_eq!(done, units);
         assert!(
