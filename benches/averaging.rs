@@ -25,6 +25,9 @@
 //!   texels in [0.005, 0.1], nearest filtering, 30 × 30 scene units: about 8.5 texels per
 //!   unit), σs 1; `sone prefiltered` reads the texture's summed-area table (built before the
 //!   timings);
+//! * `plane-one-band`: the stripe preset's values in bands 10⁵ wide, so that every footprint
+//!   lies in one band and the closed form does no band work: `sone prefiltered` there is the
+//!   estimate's fixed cost (chord, widths, footprints), beside `jensen-out` only;
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
 //!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
 //!   pairs of surface points at most 8 apart: every projection is two BVH rays.
@@ -160,22 +163,37 @@ fn bench_scene<S, F>(
         })
     });
     for (label, estimator) in estimators() {
-        let prepared = estimator
-            .prepare(G, ETA)
-            .expect("valid benchmark parameters");
-        let mut rng = SplitMix64::new(7);
-        let mut i = 0usize;
-        group.bench_function(&label, |b| {
-            b.iter(|| {
-                let (x_i, x_o) = &pairs[i % pairs.len()];
-                i = i.wrapping_add(1);
-                let est =
-                    prepared.estimate(surface, field, black_box(x_i), black_box(x_o), &mut rng);
-                black_box(est.coefficients)
-            })
-        });
+        bench_estimator(&mut group, &label, estimator, surface, field, pairs);
     }
     group.finish();
+}
+
+/// Benchmarks `estimator` over `pairs` in `group` as `label`: one pair per iteration, keeping
+/// only the coefficients.
+fn bench_estimator<S, F>(
+    group: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    label: &str,
+    estimator: Estimator,
+    surface: &S,
+    field: &F,
+    pairs: &[(S::Point, S::Point)],
+) where
+    S: SurfaceQuery,
+    F: CoefficientField<S::Point>,
+{
+    let prepared = estimator
+        .prepare(G, ETA)
+        .expect("valid benchmark parameters");
+    let mut rng = SplitMix64::new(7);
+    let mut i = 0usize;
+    group.bench_function(label, |b| {
+        b.iter(|| {
+            let (x_i, x_o) = &pairs[i % pairs.len()];
+            i = i.wrapping_add(1);
+            let est = prepared.estimate(surface, field, black_box(x_i), black_box(x_o), &mut rng);
+            black_box(est.coefficients)
+        })
+    });
 }
 
 /// Prints, for each region estimator and N, the standard deviation of the averaged σa (red
@@ -343,6 +361,26 @@ fn bench_projection(c: &mut Criterion, surface: &ObjectSurface<'_>, pairs: &[(Hi
     group.finish();
 }
 
+/// `averaging/plane-one-band` (see the module docs): the prefiltered estimate's fixed cost.
+fn bench_one_band(c: &mut Criterion, pairs: &[(PlanePoint, PlanePoint)]) {
+    let field = StripeField {
+        pattern: Stripe::new(1e5, std::f64::consts::FRAC_PI_4),
+        ..stripe_preset()
+    };
+    let mut group = c.benchmark_group("averaging/plane-one-band");
+    group
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(30);
+    for (label, estimator) in [
+        ("jensen-out", Estimator::JensenOut),
+        ("sone prefiltered", Estimator::Sone(SoneParams::paper())),
+    ] {
+        bench_estimator(&mut group, label, estimator, &Plane, &field, pairs);
+    }
+    group.finish();
+}
+
 fn averaging(c: &mut Criterion) {
     let pairs = beam_pairs(1024, 1);
     let stripe = stripe_preset();
@@ -353,6 +391,7 @@ fn averaging(c: &mut Criterion) {
         values: [Coefficients::grey(0.005, 1.0), Coefficients::grey(0.1, 1.0)],
     };
     bench_scene(c, "plane-check", &Plane, &check, &pairs);
+    bench_one_band(c, &pairs);
     let constant = ConstantField(Coefficients::grey(0.05, 1.0));
     bench_scene(c, "plane-constant", &Plane, &constant, &pairs);
     let image = image_preset();
