@@ -100,15 +100,38 @@ const RR_WEIGHT: f64 = 0.05;
 /// Bounds on c: a point where the estimates are degenerate keeps c within them.
 const C_RANGE: (f64, f64) = (0.05, 20.0);
 
-/// One step of the preparation's current stage: `None` (skipped) once `observer` asks to
-/// stop, else `work()`, reported as done.
-fn step<T>(observer: &dyn PrepareObserver, work: impl FnOnce() -> T) -> Option<T> {
-    if observer.stop_requested() {
-        return None;
+/// The steps of a preparation that `observer` watches, and whether any was skipped because
+/// it asked to stop (then the build returns nothing, even if the observer changed its mind).
+struct Steps<'a> {
+    observer: &'a dyn PrepareObserver,
+    skipped: std::sync::atomic::AtomicBool,
+}
+
+impl<'a> Steps<'a> {
+    fn new(observer: &'a dyn PrepareObserver) -> Self {
+        Self {
+            observer,
+            skipped: false.into(),
+        }
     }
-    let done = work();
-    observer.advance(1);
-    Some(done)
+
+    /// One step of the current stage: `None` (skipped) once the observer asks to stop, else
+    /// `work()`, reported as done.
+    fn step<T>(&self, work: impl FnOnce() -> T) -> Option<T> {
+        if self.observer.stop_requested() {
+            self.skipped
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+            return None;
+        }
+        let done = work();
+        self.observer.advance(1);
+        Some(done)
+    }
+
+    /// True when a step was skipped.
+    fn stopped(&self) -> bool {
+        self.skipped.load(std::sync::atomic::Ordering::Relaxed)
+    }
 }
 
 /// One sample point of the correction.
@@ -321,6 +344,7 @@ impl ShapeCorrection {
         let grey = medium.is_grey();
         // Progress: the walks at each point, then (a faster stage) each fixed-point step's
         // responses.
+        let steps = Steps::new(observer);
         observer.stage("correction walks", n_points as u64);
         // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
         // c = 1 (the walks and probes in the body and under the plane agree but for what
@@ -328,27 +352,28 @@ impl ShapeCorrection {
         let raw: Vec<(Hit, Coefficients, Option<Sums>)> = (0..n_points)
             .into_par_iter()
             .filter_map(|i| {
-                step(observer, || {
-                    let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
-                    let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
-                    let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                    // In a heterogeneous medium the light x_o sees may come from its most
-                    // translucent parts.
-                    let reach_of = if walk_medium.is_some() {
-                        medium.field_bounds().min
-                    } else {
-                        coeffs
-                    };
-                    let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
-                    let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
-                        point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, i as u64)
-                    });
-                    Some((x_o, coeffs, sums))
-                })
-                .flatten()
+                steps
+                    .step(|| {
+                        let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
+                        let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
+                        let coeffs = medium.at_surface(x_o.p, x_o.uv);
+                        // In a heterogeneous medium the light x_o sees may come from its most
+                        // translucent parts.
+                        let reach_of = if walk_medium.is_some() {
+                            medium.field_bounds().min
+                        } else {
+                            coeffs
+                        };
+                        let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
+                        let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
+                            point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, i as u64)
+                        });
+                        Some((x_o, coeffs, sums))
+                    })
+                    .flatten()
             })
             .collect();
-        if observer.stop_requested() {
+        if steps.stopped() {
             return None;
         }
         let hits: Vec<Hit> = raw.iter().map(|(x, _, _)| *x).collect();
@@ -394,21 +419,22 @@ impl ShapeCorrection {
                 .par_iter()
                 .enumerate()
                 .map(|(i, (x, coeffs, sums))| {
-                    step(observer, || {
-                        sums.as_ref()?;
-                        Some(body_response(
-                            bssrdf,
-                            &surface,
-                            x,
-                            *coeffs,
-                            i as u64,
-                            |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
-                        ))
-                    })
-                    .flatten()
+                    steps
+                        .step(|| {
+                            sums.as_ref()?;
+                            Some(body_response(
+                                bssrdf,
+                                &surface,
+                                x,
+                                *coeffs,
+                                i as u64,
+                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
+                            ))
+                        })
+                        .flatten()
                 })
                 .collect();
-            if observer.stop_requested() {
+            if steps.stopped() {
                 return None;
             }
             let updated: Vec<Directional> = (0..raw.len())
@@ -1224,6 +1250,7 @@ mod tests {
     use crate::render::NoObserver;
     use crate::scene::Translucent;
     use bssrdf_core::ProfileModel;
+    use std::sync::atomic::{AtomicU64, Ordering::SeqCst};
 
     fn corrected(mesh: TriangleMesh, albedo: f64, eta: f64) -> (Geometry, BssrdfObject) {
         let field = MediumField::homogeneous(Coefficients::grey(1.0 - albedo, albedo)).unwrap();
@@ -1248,44 +1275,53 @@ mod tests {
         (geometry, b)
     }
 
-    /// Counts a preparation's steps, and asks it to stop once `stop_after` are done.
-    struct Steps {
-        units: std::sync::atomic::AtomicU64,
-        done: std::sync::atomic::AtomicU64,
+    /// Counts a preparation's steps, and asks it to stop once `stop_after` are done, or only
+    /// at its `blink`-th poll (an observer that changes its mind).
+    struct Watcher {
+        units: AtomicU64,
+        done: AtomicU64,
+        polls: AtomicU64,
         stop_after: u64,
+        blink: u64,
     }
 
-    impl Steps {
+    impl Watcher {
         fn stopping_after(stop_after: u64) -> Self {
             Self {
                 units: 0.into(),
                 done: 0.into(),
+                polls: 0.into(),
                 stop_after,
+                blink: u64::MAX,
+            }
+        }
+        fn blinking_at(blink: u64) -> Self {
+            Self {
+                blink,
+                ..Self::stopping_after(u64::MAX)
             }
         }
         fn counts(&self) -> (u64, u64) {
-            use std::sync::atomic::Ordering::SeqCst;
             (self.units.load(SeqCst), self.done.load(SeqCst))
         }
     }
 
-    impl PrepareObserver for Steps {
+    impl PrepareObserver for Watcher {
         fn stage(&self, _: &str, units: u64) {
-            self.units
-                .fetch_add(units, std::sync::atomic::Ordering::SeqCst);
+            self.units.fetch_add(units, SeqCst);
         }
         fn advance(&self, units: u64) {
-            self.done
-                .fetch_add(units, std::sync::atomic::Ordering::SeqCst);
+            self.done.fetch_add(units, SeqCst);
         }
         fn stop_requested(&self) -> bool {
-            self.counts().1 >= self.stop_after
+            self.polls.fetch_add(1, SeqCst) == self.blink || self.counts().1 >= self.stop_after
         }
     }
 
     /// The build reports every step it announces and gives the same correction whoever
     /// watches; asked to stop, it returns none, long before its walks are done (at most one
-    /// step in flight per thread after the request).
+    /// step in flight per thread after the request), and so it does when the observer asks
+    /// once and then no more: a correction from some of its points is never returned.
     #[test]
     fn the_build_reports_its_steps_and_stops_when_asked() {
         let field = MediumField::homogeneous(Coefficients::grey(0.1, 0.9)).unwrap();
@@ -1295,9 +1331,9 @@ mod tests {
             1.3,
         );
         let plain = b.correction.as_ref().unwrap();
-        let steps = Steps::stopping_after(u64::MAX);
-        let watched = ShapeCorrection::build(&b, &geometry, 0, &field, &steps).unwrap();
-        let (units, done) = steps.counts();
+        let watcher = Watcher::stopping_after(u64::MAX);
+        let watched = ShapeCorrection::build(&b, &geometry, 0, &field, &watcher).unwrap();
+        let (units, done) = watcher.counts();
         // Every point's walks, then every point found at each fixed-point step.
         assert_eq!(units, (plain.samples.len() * (1 + ITERATIONS)) as u64);
         assert_eq!(done, units);
@@ -1310,7 +1346,7 @@ mod tests {
         );
         assert_eq!(plain.samples.len(), watched.samples.len());
 
-        let stopping = Steps::stopping_after(5);
+        let stopping = Watcher::stopping_after(5);
         assert!(ShapeCorrection::build(&b, &geometry, 0, &field, &stopping).is_none());
         let (units, done) = stopping.counts();
         let threads = rayon::current_num_threads() as u64;
@@ -1318,6 +1354,14 @@ mod tests {
             done >= 5 && done <= 5 + threads,
             "{done} steps done of {units}"
         );
+        // Once in the walks, once in the fixed-point steps (each step polls once).
+        for blink in [10, plain.samples.len() as u64 + 5] {
+            let blinking = Watcher::blinking_at(blink);
+            assert!(
+                ShapeCorrection::build(&b, &geometry, 0, &field, &blinking).is_none(),
+                "poll {blink}"
+            );
+        }
     }
 
     fn hit_from_above(geometry: &Geometry, p: DVec3, n: DVec3) -> Hit {
