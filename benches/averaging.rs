@@ -138,6 +138,19 @@ fn beam_pairs(n: usize, seed: u64) -> Vec<(PlanePoint, PlanePoint)> {
         .collect()
 }
 
+/// The group `averaging/<scene>`, with the timings every averaging group uses.
+fn averaging_group<'c>(
+    c: &'c mut Criterion,
+    scene: &str,
+) -> criterion::BenchmarkGroup<'c, criterion::measurement::WallTime> {
+    let mut group = c.benchmark_group(format!("averaging/{scene}"));
+    group
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .sample_size(30);
+    group
+}
+
 /// Times one estimate per iteration, cycling through `pairs`, for every estimator.
 fn bench_scene<S, F>(
     c: &mut Criterion,
@@ -149,11 +162,7 @@ fn bench_scene<S, F>(
     S: SurfaceQuery,
     F: CoefficientField<S::Point>,
 {
-    let mut group = c.benchmark_group(format!("averaging/{scene}"));
-    group
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(30);
+    let mut group = averaging_group(c, scene);
     let mut i = 0usize;
     group.bench_function("field-lookup", |b| {
         b.iter(|| {
@@ -334,11 +343,7 @@ fn mesh_scene() -> (Geometry, MediumField, Vec<(Hit, Hit)>) {
 /// after a round trip through f32 as a renderer with f32 geometry would make (convert its
 /// points to `DVec3` for the trait, and back to f32 for its BVH).
 fn bench_projection(c: &mut Criterion, surface: &ObjectSurface<'_>, pairs: &[(Hit, Hit)]) {
-    let mut group = c.benchmark_group("averaging/mesh-stripe");
-    group
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(30);
+    let mut group = averaging_group(c, "mesh-stripe");
     let mut i = 0usize;
     group.bench_function("project f64", |b| {
         b.iter(|| {
@@ -367,11 +372,7 @@ fn bench_one_band(c: &mut Criterion, pairs: &[(PlanePoint, PlanePoint)]) {
         pattern: Stripe::new(1e5, std::f64::consts::FRAC_PI_4),
         ..stripe_preset()
     };
-    let mut group = c.benchmark_group("averaging/plane-one-band");
-    group
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-        .sample_size(30);
+    let mut group = averaging_group(c, "plane-one-band");
     for (label, estimator) in [
         ("jensen-out", Estimator::JensenOut),
         ("sone prefiltered", Estimator::Sone(SoneParams::paper())),

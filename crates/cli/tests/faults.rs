@@ -69,6 +69,19 @@ fn wait_for(what: &str, cond: impl Fn() -> bool) {
     }
 }
 
+/// Runs `het-bssrdf args…` in `dir`, sends it `sig` 1.5 s after it started, and returns its
+/// exit code and stderr.
+fn interrupted_after_a_while(dir: &Path, args: &[&str], sig: &str) -> (Option<i32>, String) {
+    let child = spawn(dir, args);
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, sig);
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// The JSON sidecar at `path`.
 fn sidecar(path: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(path).expect("read sidecar")).expect("sidecar JSON")
@@ -105,12 +118,8 @@ fn an_interrupt_writes_the_completed_passes() {
     for (sig, code) in [("INT", 130), ("TERM", 143)] {
         let s = Scratch::new();
         s.write("ok.toml", MINIMAL);
-        let child = spawn(s.path(), ENDLESS);
-        std::thread::sleep(Duration::from_millis(1500));
-        signal(&child, sig);
-        let out = child.wait_with_output().unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(code), "SIG{sig}: {stderr}");
+        let (status, stderr) = interrupted_after_a_while(s.path(), ENDLESS, sig);
+        assert_eq!(status, Some(code), "SIG{sig}: {stderr}");
         assert!(stderr.contains(&format!("SIG{sig}")), "{stderr}");
         let json = sidecar(&s.join("out.json"));
         assert_eq!(json["interrupted"], true, "{json}");
@@ -145,7 +154,7 @@ fn an_interrupt_stops_the_preparation() {
         "max = [20.0, 20.0, 0.0]",
     );
     s.write("slow.toml", scene);
-    let child = spawn(
+    let (status, stderr) = interrupted_after_a_while(
         s.path(),
         &[
             "render",
@@ -155,12 +164,9 @@ fn an_interrupt_stops_the_preparation() {
             "--out",
             "out.exr",
         ],
+        "INT",
     );
-    std::thread::sleep(Duration::from_millis(1500));
-    signal(&child, "INT");
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert_eq!(status, Some(130), "{stderr}");
     assert!(
         stderr.contains("stopped while its shape correction was being measured"),
         "{stderr}"
@@ -208,7 +214,7 @@ fn checkpoints_are_written_and_change_no_pixel() {
 #[test]
 fn an_interrupted_beam_writes_its_photons() {
     let s = Scratch::new();
-    let child = spawn(
+    let (status, stderr) = interrupted_after_a_while(
         s.path(),
         &[
             "beam",
@@ -221,12 +227,9 @@ fn an_interrupted_beam_writes_its_photons() {
             "--out",
             "beam.exr",
         ],
+        "INT",
     );
-    std::thread::sleep(Duration::from_millis(1500));
-    signal(&child, "INT");
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert_eq!(status, Some(130), "{stderr}");
     let json = sidecar(&s.join("beam.json"));
     assert_eq!(json["interrupted"], true, "{json}");
     let photons = json["map"]["samples"].as_u64().unwrap();

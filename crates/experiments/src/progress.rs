@@ -8,16 +8,18 @@ use tracer::render::RenderObserver;
 
 /// A progress bar over `len` units named `unit`, labelled `prefix`.
 pub fn bar(len: u64, prefix: &str, unit: &str) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{prefix:>14}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}  {{elapsed}}<{{eta}}"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
+    let bar = ProgressBar::new(len).with_style(counting_style(unit));
     bar.set_prefix(prefix.to_string());
     bar
+}
+
+/// The style of [`bar`]: prefix, bar, count of `unit`, elapsed and remaining time.
+fn counting_style(unit: &str) -> ProgressStyle {
+    ProgressStyle::with_template(&format!(
+        "{{prefix:>14}} [{{bar:40}}] {{human_pos}}/{{human_len}} {unit}  {{elapsed}}<{{eta}}"
+    ))
+    .expect("static template")
+    .progress_chars("=> ")
 }
 
 /// A render's progress as a bar over every pixel sample of the budget (of the current pass for
@@ -103,17 +105,7 @@ impl PrepareBar {
     /// A bar that shows when a stage starts, if `show`.
     pub fn new(show: bool) -> Self {
         Self {
-            bar: show.then(|| {
-                let b = ProgressBar::hidden();
-                b.set_style(
-                    ProgressStyle::with_template(
-                        "{prefix:>16} [{bar:40}] {human_pos}/{human_len} steps  {elapsed}<{eta}",
-                    )
-                    .expect("static template")
-                    .progress_chars("=> "),
-                );
-                b
-            }),
+            bar: show.then(|| ProgressBar::hidden().with_style(counting_style("steps"))),
         }
     }
 
@@ -128,10 +120,10 @@ impl PrepareBar {
 impl PrepareObserver for PrepareBar {
     fn stage(&self, label: &str, units: u64) {
         if let Some(b) = &self.bar {
-            b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
             b.set_prefix(label.to_string());
             b.set_length(units);
             b.reset();
+            b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
         }
     }
     fn advance(&self, units: u64) {

@@ -121,9 +121,18 @@ impl RenderOutcome {
 
 /// Renders `scene` with `job`.
 pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
+    Ok(render_prepared_with_bar(scene, &prepare(scene, job)?, job))
+}
+
+/// [`render_prepared`] behind a progress bar when `job.progress` is set.
+pub fn render_prepared_with_bar(
+    scene: &Scene,
+    prepared: &Prepared<'_>,
+    job: &RenderJob,
+) -> RenderOutcome {
     let (w, h) = scene.camera().resolution();
     let observer = crate::progress::RenderBar::new(job.method.name(), w, h, job.progress);
-    let outcome = render_scene_observed(scene, job, &observer);
+    let outcome = render_prepared(scene, prepared, job, &observer);
     observer.finish();
     outcome
 }

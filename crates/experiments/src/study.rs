@@ -9,7 +9,7 @@ use bssrdf_core::ProfileModel;
 use crate::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
 use crate::converge::Run;
 use crate::metrics::{MetricsError, compare, compare_films};
-use crate::run::{RenderJob, RenderOutcome, prepare, render_prepared, render_scene};
+use crate::run::{RenderJob, RenderOutcome, prepare, render_prepared_with_bar, render_scene};
 use tracer::error::SceneError;
 use tracer::film::Film;
 use tracer::integrator::{Method, RenderError};
@@ -139,10 +139,7 @@ pub fn scene_study(
         let prepared = prepare(scene, &job)?;
         for &s in spp {
             job.budget = Budget::Samples(s);
-            let (w, h) = scene.camera().resolution();
-            let bar = crate::progress::RenderBar::new(method.name(), w, h, job.progress);
-            let outcome = render_prepared(scene, &prepared, &job, &bar);
-            bar.finish();
+            let outcome = render_prepared_with_bar(scene, &prepared, &job);
             let run = Run {
                 method: method.name().to_string(),
                 budget: s as u64,
