@@ -31,6 +31,11 @@
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
 //!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
 //!   pairs of surface points at most 8 apart: every projection is two BVH rays.
+//! * `mesh-uv-image`: the `plane-image` texture UV-mapped on a flat box (a 60 × 60 top of
+//!   64 × 64 quads, texture coordinates the plane-image's projection), pairs of top-face
+//!   points at most 8 apart in x and y (x_i uniform in [−15, 15]²): `sone prefiltered` reads
+//!   the summed-area table through the texture coordinates' chart, against 16 + 32 samples of
+//!   two BVH rays each; `kernel prefiltered` reads its points through the chart.
 //!
 //! To add a scene, build its surface, field and pairs and call [`bench_scene`] and
 //! [`print_std_table`] with them; nothing else changes.
@@ -277,8 +282,9 @@ impl CoefficientField<PlanePoint> for PlaneMedium {
     }
 }
 
-/// The `plane-image` field (see the module docs), its summed-area table already built.
-fn image_preset() -> PlaneMedium {
+/// The medium of the image scenes: σa a 256 × 256 random RGB texture read through `mapping`
+/// (its summed-area table already built), σs 1.
+fn image_medium(mapping: ImageMapping) -> MediumField {
     let n = 256u32;
     let mut rng = SplitMix64::new(11);
     let texels = (0..n * n)
@@ -286,21 +292,88 @@ fn image_preset() -> PlaneMedium {
         .collect();
     let tex = std::sync::Arc::new(Texture::from_texels("random", n, n, texels).expect("valid"));
     tex.area_table();
-    let sigma_a = Field::image(
-        tex,
-        ImageMapping::Planar {
-            projection: PlanarProjection::new(Axis::Z, DVec3::ZERO),
-            size: [30.0, 30.0],
-        },
-        Wrap::Repeat,
-        Filter::Nearest,
-        Rgb::ONE,
-    )
-    .expect("valid image field");
-    PlaneMedium(MediumField::new(
-        sigma_a,
-        Field::constant(Rgb::ONE).expect("valid constant"),
-    ))
+    let sigma_a = Field::image(tex, mapping, Wrap::Repeat, Filter::Nearest, Rgb::ONE)
+        .expect("valid image field");
+    MediumField::new(sigma_a, Field::constant(Rgb::ONE).expect("valid constant"))
+}
+
+/// The `plane-image` field (see the module docs).
+fn image_preset() -> PlaneMedium {
+    PlaneMedium(image_medium(ImageMapping::Planar {
+        projection: PlanarProjection::new(Axis::Z, DVec3::ZERO),
+        size: [IMAGE_SIZE, IMAGE_SIZE],
+    }))
+}
+
+/// The side of the image scenes' texture in scene units.
+const IMAGE_SIZE: f64 = 30.0;
+
+/// The `mesh-uv-image` scene (see the module docs): a flat box whose top is 64 × 64 quads, its
+/// texture coordinates the plane-image's projection, the same texture UV-mapped, and pairs of
+/// top-face points at most 8 apart in x and y.
+fn uv_mesh_scene() -> (Geometry, MediumField, Vec<(Hit, Hit)>) {
+    let mut mesh = primitives::subdivided_cuboid(
+        DVec3::new(-30.0, -30.0, -20.0),
+        DVec3::new(30.0, 30.0, 0.0),
+        [64, 64, 4],
+    );
+    mesh.uvs = Some(
+        mesh.positions
+            .iter()
+            .map(|p| {
+                let uv = p.truncate() / IMAGE_SIZE + 0.5;
+                uv.as_vec2()
+            })
+            .collect(),
+    );
+    let geometry = Geometry::build(vec![mesh]);
+    let field = image_medium(ImageMapping::Uv);
+    let mut rng = SplitMix64::new(5);
+    let top = |x: f64, y: f64| {
+        geometry
+            .intersect(&Ray::new(DVec3::new(x, y, 1.0), DVec3::NEG_Z))
+            .expect("the top face is below")
+    };
+    let pairs = (0..1024)
+        .map(|_| {
+            let (x, y) = (30.0 * rng.next_f64() - 15.0, 30.0 * rng.next_f64() - 15.0);
+            let (dx, dy) = (16.0 * rng.next_f64() - 8.0, 16.0 * rng.next_f64() - 8.0);
+            (top(x, y), top(x + dx, y + dy))
+        })
+        .collect();
+    (geometry, field, pairs)
+}
+
+/// `averaging/mesh-uv-image` (see the module docs): what prefiltering through the UV chart
+/// saves against sampling, where every sample costs two BVH rays.
+fn bench_uv_mesh(c: &mut Criterion) {
+    let (geometry, field, pairs) = uv_mesh_scene();
+    let surface = ObjectSurface::new(&geometry, 0);
+    let mut group = averaging_group(c, "mesh-uv-image");
+    let sampled = |n| {
+        SoneParams::paper()
+            .with_averaging(Averaging::MonteCarlo)
+            .with_samples(SampleBudget::fixed(n))
+    };
+    for (label, estimator) in [
+        ("jensen-out".to_string(), Estimator::JensenOut),
+        ("sone samples=16".to_string(), Estimator::Sone(sampled(16))),
+        (
+            "sone prefiltered".to_string(),
+            Estimator::Sone(SoneParams::paper()),
+        ),
+        (
+            "kernel samples=64".to_string(),
+            Estimator::Kernel(KernelParams::new().with_averaging(Averaging::MonteCarlo)),
+        ),
+        (
+            "kernel prefiltered".to_string(),
+            Estimator::Kernel(KernelParams::new()),
+        ),
+    ] {
+        bench_estimator(&mut group, &label, estimator, &surface, &field, &pairs);
+    }
+    group.finish();
 }
 
 /// The BVH-mesh scene: sphere, stripe field, pairs of nearby surface points.
@@ -402,6 +475,7 @@ fn averaging(c: &mut Criterion) {
     print_std_table("mesh-stripe", &surface, &field, &mesh_pairs[..64], 64);
     bench_scene(c, "mesh-stripe", &surface, &field, &mesh_pairs);
     bench_projection(c, &surface, &mesh_pairs);
+    bench_uv_mesh(c);
 }
 
 criterion_group!(benches, averaging);

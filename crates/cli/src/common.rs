@@ -89,7 +89,7 @@ pub fn warn_counters(c: &PathCounters) {
         eprintln!(
             "averaging: {} of {} estimates prefiltered (sone: closed-form footprints; kernel: \
              points read in the surface's plane), {} sampled where the surface was too curved \
-             for a flat footprint",
+             for a flat footprint or its texture coordinates were not one affine map",
             c.prefiltered, c.estimates, c.prefilter_fallbacks
         );
     }

@@ -66,7 +66,9 @@ pub struct Diagnostics {
     /// sampling (Sone: up to 1 for the disk + 3 for the ellipses).
     pub field_averages: u8,
     /// Prefiltered averaging was asked for and the field offers it, but the surface was too
-    /// curved for a flat footprint ([`crate::Flatness`]): the regions were sampled instead.
+    /// curved for a flat footprint ([`crate::Flatness`]), or, for a field read through texture
+    /// coordinates, the charts at x_i and x_o disagreed ([`crate::UvChart::between`]): the
+    /// regions were sampled instead.
     pub prefilter_fallback: bool,
     /// Sone: the step-1 disk means ⟨σa⟩, ⟨σs⟩ that entered Eq. (2).
     pub disk_mean: Option<Coefficients>,

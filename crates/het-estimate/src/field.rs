@@ -3,6 +3,7 @@
 use bssrdf_core::Rgb;
 
 use crate::ellipse::PlanarEllipse;
+use crate::uv_chart::UvChart;
 
 /// Absorption and scattering coefficients per colour channel, in 1/length.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -101,11 +102,51 @@ pub trait CoefficientField<P> {
         None
     }
 
-    /// True when [`CoefficientField::ellipse_average`] can answer (for some regions). The
+    /// True when [`CoefficientField::ellipse_average`] (or, for a field that
+    /// [reads texture coordinates](CoefficientField::reads_uv),
+    /// [`CoefficientField::ellipse_average_in_chart`]) can answer (for some regions). The
     /// estimator asks for field averages, checks the surface's flatness and counts fallbacks
     /// only for such fields. Default: false.
     fn has_ellipse_average(&self) -> bool {
         false
+    }
+
+    /// True when the field reads the surface's texture coordinates (a UV-mapped image), so
+    /// that its constant-time averages need the texture coordinates over the region: the
+    /// estimators then ask [`CoefficientField::ellipse_average_in_chart`] and
+    /// [`CoefficientField::averaged_at_points_in_chart`] instead of the chart-free versions,
+    /// with the region's chart from [`crate::SurfaceQuery::uv_chart`] at x_i and x_o
+    /// ([`UvChart::between`]), and sample the region where there is none. Default: false.
+    fn reads_uv(&self) -> bool {
+        false
+    }
+
+    /// [`CoefficientField::ellipse_average`] for a field that
+    /// [reads texture coordinates](CoefficientField::reads_uv): `chart` maps the region's
+    /// plane to them (the region lies in the surface: a flat pair). A UV-mapped image averages
+    /// over the footprint the chart gives (the ellipse's axes mapped by the chart's gradients:
+    /// the UV Jacobian at the region's centre). The default ignores the chart.
+    fn ellipse_average_in_chart(
+        &self,
+        region: &PlanarEllipse,
+        chart: &UvChart,
+    ) -> Option<Coefficients> {
+        let _ = chart;
+        self.ellipse_average(region)
+    }
+
+    /// [`CoefficientField::averaged_at_points`] for a field that
+    /// [reads texture coordinates](CoefficientField::reads_uv): each point of the region's
+    /// plane is read at the coordinates `chart` gives it. The default ignores the chart.
+    #[inline]
+    fn averaged_at_points_in_chart(
+        &self,
+        xs: &[glam::DVec3],
+        chart: &UvChart,
+        out: &mut [Coefficients],
+    ) -> bool {
+        let _ = chart;
+        self.averaged_at_points(xs, out)
     }
 
     /// Optional capability: [`CoefficientField::averaged`] at a point `x` of space, for a field
@@ -184,6 +225,25 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn has_ellipse_average(&self) -> bool {
         (**self).has_ellipse_average()
+    }
+    fn reads_uv(&self) -> bool {
+        (**self).reads_uv()
+    }
+    fn ellipse_average_in_chart(
+        &self,
+        region: &PlanarEllipse,
+        chart: &UvChart,
+    ) -> Option<Coefficients> {
+        (**self).ellipse_average_in_chart(region, chart)
+    }
+    #[inline]
+    fn averaged_at_points_in_chart(
+        &self,
+        xs: &[glam::DVec3],
+        chart: &UvChart,
+        out: &mut [Coefficients],
+    ) -> bool {
+        (**self).averaged_at_points_in_chart(xs, chart, out)
     }
     #[inline]
     fn averaged(&self, p: &P) -> Coefficients {

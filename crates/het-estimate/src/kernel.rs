@@ -335,9 +335,10 @@ where
     };
     let n = params.sample_count() as usize;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
-    // Flat pairs of a field defined in space: the plane's points are the surface's.
+    // Flat pairs of a field defined in space, or read through texture coordinates that are
+    // one affine map over the region: the plane's points are the surface's.
     let in_plane = params.averaging == Averaging::Prefiltered
-        && probe.field.has_point_lookup()
+        && (probe.field.has_point_lookup() || probe.field.reads_uv())
         && probe.flat_for_prefilter(params.flatness, chord.x_hat);
     if in_plane {
         probe.diag.field_averages += 1;

@@ -14,7 +14,8 @@
 //!   σa, σs per colour channel at a surface point and may report bounds (so constant fields
 //!   cost nothing) or an exact/prefiltered ellipse average (so closed forms, summed-area
 //!   tables or EWA can replace sampling; [`prefilter`] has the closed forms for stripes and
-//!   checks, and the fallback criterion on curved surfaces). Geometry and texturing are separate because they vary separately
+//!   checks, and the fallback criterion on curved surfaces; a field read through texture
+//!   coordinates averages through the region's [`UvChart`], which the surface provides). Geometry and texturing are separate because they vary separately
 //!   (one mesh, many textures; one procedural field, many shapes), and because tests and
 //!   benchmarks substitute analytic versions of each (module `analytic`, behind the
 //!   `fixtures` feature). The point type is the
@@ -67,6 +68,7 @@ pub mod sampling;
 pub mod segment;
 pub mod sone;
 pub mod surface;
+pub mod uv_chart;
 
 pub use bssrdf_core::Rgb;
 pub use budget::{MissPolicy, SampleBudget};
@@ -88,3 +90,4 @@ pub use sampler::UniformSource;
 pub use segment::SegmentParams;
 pub use sone::{SoneParams, WidthScattering};
 pub use surface::{Projected, SurfacePoint, SurfaceQuery};
+pub use uv_chart::UvChart;

@@ -11,6 +11,7 @@ use crate::known::sanitise;
 use crate::sampler::UniformSource;
 use crate::sampling::PointSet;
 use crate::surface::{Projected, SurfacePoint, SurfaceQuery};
+use crate::uv_chart::UvChart;
 
 /// Per-channel selection weights (1 = this channel takes the sample, 0 = it does not).
 pub(crate) type Channels = Rgb;
@@ -240,6 +241,9 @@ pub(crate) struct Probe<'a, S: SurfaceQuery + ?Sized, F: ?Sized> {
     pub x_o: &'a S::Point,
     pub diag: Diagnostics,
     endpoints: Option<Coefficients>,
+    /// The averaging region's texture-coordinate chart, for a field that reads them, once
+    /// [`Probe::flat_for_prefilter`] has found one.
+    chart: Option<UvChart>,
 }
 
 impl<'a, S, F> Probe<'a, S, F>
@@ -255,6 +259,7 @@ where
             x_o,
             diag: Diagnostics::default(),
             endpoints: None,
+            chart: None,
         }
     }
 
@@ -315,13 +320,38 @@ where
     /// that its averaging plane stands for the surface (Sone's closed forms, the kernel's
     /// in-plane reading); a pair that is not is recorded as a prefilter fallback.
     pub fn flat_for_prefilter(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
-        let flat = flatness.is_flat(
+        let mut flat = flatness.is_flat(
             self.x_i.normal().normalize(),
             self.x_o.normal().normalize(),
             x_hat,
         );
+        // A field read through texture coordinates also needs them to be one affine map over
+        // the region: the charts at both ends must agree.
+        if flat && self.field.reads_uv() {
+            self.chart = match (
+                self.surface.uv_chart(self.x_i),
+                self.surface.uv_chart(self.x_o),
+            ) {
+                (Some(a), Some(b)) => UvChart::between(&a, &b),
+                _ => None,
+            };
+            flat = self.chart.is_some();
+        }
         self.diag.prefilter_fallback = !flat;
         flat
+    }
+
+    /// The field's constant-time average over `e` ([`CoefficientField::ellipse_average`], or
+    /// [`CoefficientField::ellipse_average_in_chart`] through the region's chart for a field
+    /// that reads texture coordinates); only for a pair [`Probe::flat_for_prefilter`]
+    /// accepted.
+    #[inline]
+    pub fn field_ellipse_average(&self, e: &crate::PlanarEllipse) -> Option<Coefficients> {
+        match &self.chart {
+            Some(chart) => self.field.ellipse_average_in_chart(e, chart),
+            None if self.field.reads_uv() => None,
+            None => self.field.ellipse_average(e),
+        }
     }
 
     /// ½(σ(x_i) + σ(x_o)) (in the averaging space), looked up once per pair (the d'Eon–Irving endpoint reading and the
@@ -458,7 +488,11 @@ where
     /// ([`CoefficientField::averaged_at_points`]), into `out`; `false` (nothing counted, `out`
     /// unspecified) where the field has no value at some point without a surface point.
     pub fn lookup_at_points(&mut self, xs: &[DVec3], out: &mut [Coefficients]) -> bool {
-        if !self.field.averaged_at_points(xs, out) {
+        let read = match &self.chart {
+            Some(chart) => self.field.averaged_at_points_in_chart(xs, chart, out),
+            None => self.field.averaged_at_points(xs, out),
+        };
+        if !read {
             return false;
         }
         for o in out.iter_mut() {

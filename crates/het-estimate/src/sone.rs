@@ -20,7 +20,10 @@
 //! constant-time [`CoefficientField::ellipse_average`] (closed forms for stripes and checks,
 //! see [`crate::prefilter`]), if the field has one and the pair is flat by
 //! [`SoneParams::flatness`]; a curved pair is sampled and flagged
-//! ([`crate::Diagnostics::prefilter_fallback`]). [`Averaging::MonteCarlo`] always samples.
+//! ([`crate::Diagnostics::prefilter_fallback`]). A field read through texture coordinates
+//! ([`CoefficientField::reads_uv`]) is averaged through the region's chart
+//! ([`crate::UvChart::between`]: the UV Jacobian at the region's centre), and sampled (and
+//! flagged) where the charts at x_i and x_o disagree. [`Averaging::MonteCarlo`] always samples.
 //!
 //! # Colour
 //! Eq. (2) gives one width per channel, so each channel has its own ellipse. One unit-disk
@@ -237,7 +240,7 @@ where
     // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
     let disk = chord.ellipse(chord.half_len);
     let field_disk = if use_field_average {
-        probe.field.ellipse_average(&disk)
+        probe.field_ellipse_average(&disk)
     } else {
         None
     };
@@ -279,7 +282,7 @@ where
     for (g, is_sampled) in sampled.iter_mut().enumerate().take(groups.len) {
         let e = chord.ellipse(groups.semi_minor[g]);
         let field_avg = if use_field_average {
-            probe.field.ellipse_average(&e)
+            probe.field_ellipse_average(&e)
         } else {
             None
         };

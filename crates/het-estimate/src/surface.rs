@@ -2,6 +2,8 @@
 
 use glam::DVec3;
 
+use crate::uv_chart::UvChart;
+
 /// A point on the surface of the object being shaded.
 pub trait SurfacePoint {
     /// Position in scene units.
@@ -60,6 +62,17 @@ pub trait SurfaceQuery {
             *r = self.project_position(*o, dir);
         }
     }
+
+    /// Optional capability: the texture coordinates around `p` as an affine map (for a mesh,
+    /// the map of `p`'s triangle, taken at `p`), for fields read through texture coordinates
+    /// ([`crate::CoefficientField::reads_uv`]). The estimators build the chart of a flat
+    /// pair's averaging region from the charts at x_i and x_o ([`UvChart::between`]) and
+    /// average such a field in constant time through it; `None` (the default: no texture
+    /// coordinates, or a degenerate triangle) means the region is sampled.
+    fn uv_chart(&self, p: &Self::Point) -> Option<UvChart> {
+        let _ = p;
+        None
+    }
 }
 
 /// The answer of [`SurfaceQuery::project_position`] (a position, by default), or of any
@@ -85,5 +98,8 @@ impl<S: SurfaceQuery + ?Sized> SurfaceQuery for &S {
     }
     fn project_positions(&self, origins: &[DVec3], dir: DVec3, out: &mut [Projected]) {
         (**self).project_positions(origins, dir, out)
+    }
+    fn uv_chart(&self, p: &Self::Point) -> Option<UvChart> {
+        (**self).uv_chart(p)
     }
 }

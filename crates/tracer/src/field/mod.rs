@@ -32,7 +32,7 @@ use bssrdf_core::Rgb;
 use glam::{DVec2, DVec3};
 use het_estimate::pattern::{BinaryPattern, Check, Stripe};
 use het_estimate::prefilter::{PlaneFootprint, check_fraction, stripe_fraction};
-use het_estimate::{CoefficientField, Coefficients, FieldBounds, PlanarEllipse};
+use het_estimate::{CoefficientField, Coefficients, FieldBounds, PlanarEllipse, UvChart};
 
 use crate::error::FieldError;
 use crate::geometry::Hit;
@@ -107,8 +107,9 @@ impl ImageField {
     /// The prefiltered uniform average over the ellipse `e` as it lies in its plane, for a
     /// planar mapping: the ellipse's footprint in texel space averaged through the texture's
     /// summed-area table ([`area_table`]; nearest and bilinear filtering both averaged as
-    /// nearest, error bounds there). `None` for UV mapping (the footprint would follow the
-    /// UV Jacobian, which needs the surface: sampled) and where the table declines.
+    /// nearest, error bounds there). `None` for UV mapping (the footprint follows the UV
+    /// Jacobian, which needs the surface: [`ImageField::ellipse_average_in_chart`]) and where
+    /// the table declines.
     pub fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Rgb> {
         let ImageMapping::Planar { projection, size } = self.mapping else {
             return None;
@@ -124,6 +125,31 @@ impl ImageField {
             ],
             axis_u: [fp.axis_u.x * kx, fp.axis_u.y * ky],
             axis_v: [fp.axis_v.x * kx, fp.axis_v.y * ky],
+        };
+        let avg = self.texture.area_table().ellipse_average(&te, self.wrap)?;
+        Some(Rgb(avg) * self.scale)
+    }
+
+    /// The prefiltered uniform average over the ellipse `e` for a UV mapping, through `chart`,
+    /// the texture coordinates over the ellipse's plane (the UV Jacobian at its centre,
+    /// [`het_estimate::UvChart`]): the ellipse's footprint in texel space averaged through the
+    /// summed-area table, as for a planar mapping. `None` for a planar mapping (see
+    /// [`ImageField::ellipse_average`]) and where the table declines.
+    pub fn ellipse_average_in_chart(&self, e: &PlanarEllipse, chart: &UvChart) -> Option<Rgb> {
+        if self.mapping != ImageMapping::Uv {
+            return None;
+        }
+        let (w, h) = (self.texture.width as f64, self.texture.height as f64);
+        let (c, a, b) = (
+            chart.uv_at(e.center),
+            chart.map_vector(e.semi_major),
+            chart.map_vector(e.semi_minor),
+        );
+        // Texel coordinates: x = u·w, y = (1 − v)·h (rows run along −v), as `at` reads them.
+        let te = area_table::TexelEllipse {
+            centre: [c.x * w, (1.0 - c.y) * h],
+            axis_u: [a.x * w, -a.y * h],
+            axis_v: [b.x * w, -b.y * h],
         };
         let avg = self.texture.area_table().ellipse_average(&te, self.wrap)?;
         Some(Rgb(avg) * self.scale)
@@ -329,7 +355,8 @@ impl Field {
     /// flat-footprint reading of Eq. (3)), in constant time: the constant itself, or the
     /// pattern's closed form through the planar projection ([`het_estimate::prefilter`]), or a
     /// planar image's summed-area average ([`ImageField::ellipse_average`], whose table is
-    /// built on this first call). `None` for UV-mapped images (sampled) and where a closed
+    /// built on this first call). `None` for UV-mapped images (they need the texture
+    /// coordinates over the plane: [`Field::ellipse_average_in_chart`]) and where a closed
     /// form or the table declines.
     pub fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Rgb> {
         match self {
@@ -346,9 +373,29 @@ impl Field {
         }
     }
 
-    /// True when [`Field::ellipse_average`] can answer: every field but UV-mapped images.
-    pub fn has_ellipse_average(&self) -> bool {
-        self.is_volumetric()
+    /// [`Field::ellipse_average`], with `chart` the texture coordinates over the ellipse's
+    /// plane: UV-mapped images are averaged through it
+    /// ([`ImageField::ellipse_average_in_chart`]), every other field as without it.
+    pub fn ellipse_average_in_chart(&self, e: &PlanarEllipse, chart: &UvChart) -> Option<Rgb> {
+        match self {
+            Field::Image(f) if f.mapping == ImageMapping::Uv => {
+                f.ellipse_average_in_chart(e, chart)
+            }
+            _ => self.ellipse_average(e),
+        }
+    }
+
+    /// [`Field::eval_points`] at points of a plane whose texture coordinates `chart` gives (a
+    /// UV-mapped image reads each point at `chart.uv_at(p)`).
+    pub fn eval_points_in_chart(&self, ps: &[DVec3], chart: &UvChart, out: &mut [Rgb]) {
+        match self {
+            Field::Image(f) if f.mapping == ImageMapping::Uv => {
+                for (p, o) in ps.iter().zip(out.iter_mut()) {
+                    *o = f.at(*p, chart.uv_at(*p));
+                }
+            }
+            _ => self.eval_points(ps, out),
+        }
     }
 
     /// False only for UV-mapped images (defined on the surface only).
@@ -701,6 +748,49 @@ fn bounds_of(a: &Field, s: &Field) -> FieldBounds {
     }
 }
 
+impl MediumField {
+    /// Both fields' region averages by `average`, in the averaging space; `None` if either
+    /// declines, and always for an artist medium inverted before averaging (the mean of a
+    /// nonlinear function of the textures has no summed-area table).
+    #[inline]
+    fn both_averages(&self, average: impl Fn(&Field) -> Option<Rgb>) -> Option<Coefficients> {
+        if self.artist.is_some() && !self.inverts_after() {
+            return None;
+        }
+        Some(Coefficients {
+            sigma_a: average(&self.sigma_a)?,
+            sigma_s: average(&self.sigma_s)?,
+        })
+    }
+
+    /// Both fields at every point of `xs` by `eval` (a chunk at a time), into `out`, in the
+    /// averaging space.
+    #[inline]
+    fn read_points(
+        &self,
+        xs: &[DVec3],
+        out: &mut [Coefficients],
+        eval: impl Fn(&Field, &[DVec3], &mut [Rgb]),
+    ) {
+        let mut buf = [Rgb::ZERO; het_estimate::CHUNK];
+        for (xs, out) in xs.chunks(buf.len()).zip(out.chunks_mut(buf.len())) {
+            let b = &mut buf[..xs.len()];
+            eval(&self.sigma_a, xs, b);
+            for (o, v) in out.iter_mut().zip(b.iter()) {
+                o.sigma_a = *v;
+            }
+            eval(&self.sigma_s, xs, b);
+            for (o, v) in out.iter_mut().zip(b.iter()) {
+                o.sigma_s = *v;
+            }
+        }
+        if self.artist.is_some() {
+            out.iter_mut()
+                .for_each(|c| *c = self.in_averaging_space(*c));
+        }
+    }
+}
+
 impl CoefficientField<Hit> for MediumField {
     #[inline]
     fn coefficients(&self, p: &Hit) -> Coefficients {
@@ -722,21 +812,37 @@ impl CoefficientField<Hit> for MediumField {
     /// artist medium inverted before averaging (the mean of a nonlinear function of the
     /// textures has no summed-area table).
     fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
-        if self.artist.is_some() && !self.inverts_after() {
-            return None;
-        }
-        Some(Coefficients {
-            sigma_a: self.sigma_a.ellipse_average(e)?,
-            sigma_s: self.sigma_s.ellipse_average(e)?,
-        })
+        self.both_averages(|f| f.ellipse_average(e))
     }
 
-    /// True when neither field is a UV-mapped image (and the medium is not an artist medium
-    /// inverted before averaging).
+    /// True unless the medium is an artist medium inverted before averaging: every field has a
+    /// constant-time average for some regions (UV-mapped images through a chart,
+    /// [`CoefficientField::ellipse_average_in_chart`]).
     fn has_ellipse_average(&self) -> bool {
-        (self.artist.is_none() || self.inverts_after())
-            && self.sigma_a.has_ellipse_average()
-            && self.sigma_s.has_ellipse_average()
+        self.artist.is_none() || self.inverts_after()
+    }
+
+    /// True when either field is a UV-mapped image.
+    fn reads_uv(&self) -> bool {
+        !self.volumetric
+    }
+
+    /// Both fields' [`Field::ellipse_average_in_chart`]; `None` as for
+    /// [`CoefficientField::ellipse_average`].
+    fn ellipse_average_in_chart(&self, e: &PlanarEllipse, chart: &UvChart) -> Option<Coefficients> {
+        self.both_averages(|f| f.ellipse_average_in_chart(e, chart))
+    }
+
+    /// Each field at every point, UV-mapped images at the coordinates `chart` gives
+    /// ([`Field::eval_points_in_chart`]): what surface hits at those points would read.
+    fn averaged_at_points_in_chart(
+        &self,
+        xs: &[DVec3],
+        chart: &UvChart,
+        out: &mut [Coefficients],
+    ) -> bool {
+        self.read_points(xs, out, |f, xs, b| f.eval_points_in_chart(xs, chart, b));
+        true
     }
 
     /// The colour and mean free path for an artist medium inverted after averaging; σa and σs
@@ -766,22 +872,7 @@ impl CoefficientField<Hit> for MediumField {
         if !self.is_volumetric() {
             return false;
         }
-        let mut buf = [Rgb::ZERO; het_estimate::CHUNK];
-        for (xs, out) in xs.chunks(buf.len()).zip(out.chunks_mut(buf.len())) {
-            let b = &mut buf[..xs.len()];
-            self.sigma_a.eval_points(xs, b);
-            for (o, v) in out.iter_mut().zip(b.iter()) {
-                o.sigma_a = *v;
-            }
-            self.sigma_s.eval_points(xs, b);
-            for (o, v) in out.iter_mut().zip(b.iter()) {
-                o.sigma_s = *v;
-            }
-        }
-        if self.artist.is_some() {
-            out.iter_mut()
-                .for_each(|c| *c = self.in_averaging_space(*c));
-        }
+        self.read_points(xs, out, |f, xs, b| f.eval_points(xs, b));
         true
     }
 

@@ -22,7 +22,7 @@ use obvhs::{Boundable, BvhBuildParams};
 
 use super::tlas::{Tlas, slab};
 use super::watertight::{LeafTri, ShearedRay, refine_f64};
-use het_estimate::Projected;
+use het_estimate::{Projected, UvChart};
 
 use super::{Hit, OFFSET_REL, Ray, TriangleMesh};
 
@@ -619,6 +619,17 @@ impl Geometry {
             let hit = self.make_hit(object, c.leaf, ray, shift + c.t as f64 * obj.inv_scale);
             f(&hit);
         }
+    }
+
+    /// The texture coordinates around `hit` as an affine map: the linear interpolation over
+    /// its triangle ([`UvChart::of_triangle`]), taken at the hit. `None` for a mesh without
+    /// texture coordinates or a triangle of zero area.
+    pub fn uv_chart(&self, hit: &Hit) -> Option<UvChart> {
+        let mesh = self.meshes.get(hit.object as usize)?;
+        let uvs = mesh.uvs.as_ref()?;
+        let idx = mesh.triangles.get(hit.prim as usize)?;
+        let uv = idx.map(|k| uvs[k as usize].as_dvec2());
+        UvChart::of_triangle(mesh.triangle_vertices(hit.prim as usize), uv, hit.p, hit.uv)
     }
 
     /// Builds the full hit record for leaf `leaf` of `object`: barycentrics and distance

@@ -53,6 +53,11 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
         self.geometry
             .project_positions_onto_box(self.object, origins, dir, out)
     }
+
+    /// The chart of the hit's triangle ([`Geometry::uv_chart`]).
+    fn uv_chart(&self, p: &Hit) -> Option<het_estimate::UvChart> {
+        self.geometry.uv_chart(p)
+    }
 }
 
 impl ObjectSurface<'_> {

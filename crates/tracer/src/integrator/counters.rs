@@ -45,7 +45,9 @@ pub struct PathCounters {
     /// (constant-time) average instead of sampling.
     pub prefiltered: u64,
     /// Estimates where prefiltered averaging applied to the field but the surface was too
-    /// curved for a flat footprint (`het_estimate::Flatness`), so the regions were sampled.
+    /// curved for a flat footprint (`het_estimate::Flatness`), or the texture coordinates of a
+    /// UV-mapped field were not one affine map over the region (`het_estimate::UvChart`), so
+    /// the regions were sampled.
     pub prefilter_fallbacks: u64,
     /// Profile evaluations whose estimated coefficients the profile rejected; those channels
     /// contribute 0, so a non-zero count means a bias (never expected: scenes are validated
