@@ -33,11 +33,6 @@ enum Read {
     UvKinked,
 }
 
-/// [`image_scene_read`], planar.
-fn image_scene(filter: Filter) -> (Scene, Arc<Texture>) {
-    image_scene_read(filter, Read::Planar)
-}
-
 /// A 16 × 16 texture of σa values in [0.005, 0.1] (per channel, fixed seed), spread over the
 /// 20 × 20 region the camera sees, read as `read` says.
 fn image_scene_read(filter: Filter, read: Read) -> (Scene, Arc<Texture>) {
@@ -152,20 +147,35 @@ fn prefiltered_image_render_agrees_with_monte_carlo_at_256_samples() {
     }
 }
 
-/// The summed-area table is built by the first prefiltered average and by nothing else: not by
-/// the path tracer, Jensen's estimator or Monte Carlo averaging.
+/// The summed-area table is built when a render that reads region averages (Sone,
+/// prefiltered) is prepared, before any sample, and by nothing else: not by the path tracer,
+/// Jensen's estimator, Monte Carlo averaging or the kernel (which reads points, not regions),
+/// whether planar- or UV-mapped.
 #[test]
 fn area_tables_are_built_only_for_prefiltered_averaging() {
-    let (scene, tex) = image_scene(Filter::Nearest);
-    for method in [
-        "jensen-out".parse::<Method>().unwrap(),
-        sone(4, Averaging::MonteCarlo),
-    ] {
-        run(&scene, method, 9);
-        assert!(!tex.has_area_table(), "{method:?} built a table");
+    use bssrdf_core::Scattering;
+    use tracer::integrator::{PathIntegrator, PathOptions};
+    let options = PathOptions {
+        scattering: Scattering::Multiple,
+        max_depth: 8,
+    };
+    for read in [Read::Planar, Read::Uv] {
+        let (scene, tex) = image_scene_read(Filter::Nearest, read);
+        let mut methods = vec![
+            "jensen-out".parse::<Method>().unwrap(),
+            sone(4, Averaging::MonteCarlo),
+            kernel(8, Averaging::Prefiltered),
+        ];
+        if read == Read::Planar {
+            methods.push(Method::PathTraced);
+        }
+        for method in methods {
+            run(&scene, method, 9);
+            assert!(!tex.has_area_table(), "{read:?}: {method:?} built a table");
+        }
+        PathIntegrator::new(&scene, sone(4, Averaging::Prefiltered), options).unwrap();
+        assert!(tex.has_area_table(), "{read:?}: not built when prepared");
     }
-    run(&scene, sone(4, Averaging::Prefiltered), 9);
-    assert!(tex.has_area_table());
 }
 
 fn kernel(samples: u32, averaging: Averaging) -> Method {

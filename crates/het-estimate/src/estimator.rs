@@ -75,6 +75,14 @@ impl Estimator {
         Named::name(self)
     }
 
+    /// True when the estimator asks fields for constant-time region averages
+    /// ([`CoefficientField::ellipse_average`]): `sone` with [`crate::Averaging::Prefiltered`].
+    /// A renderer builds what those averages read (summed-area tables) when it prepares a
+    /// material, and for such estimators only.
+    pub fn reads_region_averages(&self) -> bool {
+        matches!(self, Estimator::Sone(p) if p.averaging == crate::Averaging::Prefiltered)
+    }
+
     /// Validates the parameters and resolves the per-material constants (⟨θ²⟩ for Sone:
     /// the exact value costs ~1 µs; the kernel's table: a few ms the first time a process
     /// sees a given η, then shared), so do this once per material, outside the pixel loop.

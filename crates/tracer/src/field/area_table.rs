@@ -13,10 +13,12 @@
 //! the mean is removed) and the remainder, `clamp` continues the edge rows and columns
 //! linearly ([`AreaTable::rect_integral`]).
 //!
-//! Built lazily, once per texture, on the first prefiltered average
-//! ([`super::Texture::area_table`], a `OnceLock`): the scene does not know at load time which
-//! method will render it (the command line may override `render.averaging`), and textures
-//! that only the path tracer, Jensen's methods or Monte Carlo averaging read never build one.
+//! Built once per texture ([`super::Texture::area_table`], a `OnceLock`) when a render that
+//! reads region averages is prepared (`MediumField::build_area_tables`, called by
+//! `PathIntegrator::new` for `sone` with prefiltered averaging), else on the first prefiltered
+//! average: the scene does not know at load time which method will render it (the command
+//! line may override `render.averaging`), and textures that only the path tracer, Jensen's
+//! methods, the kernel or Monte Carlo averaging read never build one.
 //! Memory: `(W + 1)(H + 1)` × 24 bytes, twice the decoded texture.
 //!
 //! # Ellipse average (derivation: `docs/physics.md#prefiltered-averages`)

@@ -355,7 +355,7 @@ impl Field {
     /// flat-footprint reading of Eq. (3)), in constant time: the constant itself, or the
     /// pattern's closed form through the planar projection ([`het_estimate::prefilter`]), or a
     /// planar image's summed-area average ([`ImageField::ellipse_average`], whose table is
-    /// built on this first call). `None` for UV-mapped images (they need the texture
+    /// built on the first call unless [`MediumField::build_area_tables`] built it). `None` for UV-mapped images (they need the texture
     /// coordinates over the plane: [`Field::ellipse_average_in_chart`]) and where a closed
     /// form or the table declines.
     pub fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Rgb> {
@@ -723,6 +723,22 @@ impl MediumField {
     /// 1 / the smallest mean free path after its floor).
     pub fn majorant(&self) -> Rgb {
         self.majorant
+    }
+
+    /// Builds the summed-area tables of the image fields whose region averages an estimator
+    /// may ask for (every image, unless the medium is an artist medium inverted before
+    /// averaging, which has no region averages). Each texture's table is built once and shared
+    /// (`Texture::area_table`); a render calls this while it is prepared, so that no sample
+    /// waits for a table.
+    pub fn build_area_tables(&self) {
+        if !CoefficientField::<Hit>::has_ellipse_average(self) {
+            return;
+        }
+        for field in [&self.sigma_a, &self.sigma_s] {
+            if let Field::Image(f) = field {
+                f.texture.area_table();
+            }
+        }
     }
 
     /// Channel-wise bounds of both coefficients (σa and σs, for every parametrisation).

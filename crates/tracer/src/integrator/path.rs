@@ -402,6 +402,10 @@ impl<'s> PathIntegrator<'s> {
                                 (hi - lo).max_element(),
                             )
                             .map_err(|(what, e)| RenderError::param(&object.name, what, e))?;
+                            // The tables Sone's prefiltered averages read, before any sample.
+                            if estimator.reads_region_averages() {
+                                t.medium.build_area_tables();
+                            }
                             if t.shape_correction {
                                 b.correction = Some(
                                     ShapeCorrection::build(
