@@ -318,7 +318,9 @@ where
 
     /// Whether the pair is flat by `flatness` along the chord's direction `x_hat` (unit), so
     /// that its averaging plane stands for the surface (Sone's closed forms, the kernel's
-    /// in-plane reading); a pair that is not is recorded as a prefilter fallback.
+    /// in-plane reading), and, for a field that reads texture coordinates, whether the charts
+    /// at x_i and x_o are one affine map ([`UvChart::between`], kept for the reads); a pair
+    /// that is not is recorded as a prefilter fallback.
     pub fn flat_for_prefilter(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
         let mut flat = flatness.is_flat(
             self.x_i.normal().normalize(),
