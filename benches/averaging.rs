@@ -27,7 +27,9 @@
 //!   timings);
 //! * `plane-one-band`: the stripe preset's values in bands 10⁵ wide, so that every footprint
 //!   lies in one band and the closed form does no band work: `sone prefiltered` there is the
-//!   estimate's fixed cost (chord, widths, footprints), beside `jensen-out` only;
+//!   estimate's fixed cost (chord, widths, footprints), beside `jensen-out` and `floor`, the
+//!   least arithmetic the estimate needs written out straight (chord, two stripe fractions,
+//!   one width of Eq. 2: what no implementation can avoid);
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
 //!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
 //!   pairs of surface points at most 8 apart: every projection is two BVH rays.
@@ -439,7 +441,8 @@ fn bench_projection(c: &mut Criterion, surface: &ObjectSurface<'_>, pairs: &[(Hi
     group.finish();
 }
 
-/// `averaging/plane-one-band` (see the module docs): the prefiltered estimate's fixed cost.
+/// `averaging/plane-one-band` (see the module docs): the prefiltered estimate's fixed cost,
+/// and `floor`, the least arithmetic it needs.
 fn bench_one_band(c: &mut Criterion, pairs: &[(PlanePoint, PlanePoint)]) {
     let field = StripeField {
         pattern: Stripe::new(1e5, std::f64::consts::FRAC_PI_4),
@@ -452,7 +455,49 @@ fn bench_one_band(c: &mut Criterion, pairs: &[(PlanePoint, PlanePoint)]) {
     ] {
         bench_estimator(&mut group, label, estimator, &Plane, &field, pairs);
     }
+    let theta2 = Estimator::Sone(SoneParams::paper())
+        .prepare(G, ETA)
+        .ok()
+        .and_then(|p| p.mean_square_angle())
+        .expect("valid benchmark parameters");
+    let mut i = 0usize;
+    group.bench_function("floor", |b| {
+        b.iter(|| {
+            let (x_i, x_o) = &pairs[i % pairs.len()];
+            i = i.wrapping_add(1);
+            black_box(sone_floor(&field, theta2, black_box(x_i), black_box(x_o)))
+        })
+    });
     group.finish();
+}
+
+/// The least arithmetic of one prefiltered Sone estimate on the plane, for `floor`: the
+/// chord (its length and direction; the plane's normal is z, so the flatness test and the
+/// projection into the pattern's plane are free), the disk's and the ellipse's stripe
+/// fractions, and one width of Eq. (2) (a grey field). No bounds, clamps, colour channels,
+/// diagnostics or generic surface and field: what any implementation of the estimate must
+/// compute, not one to use (the estimator is tested; this is not).
+fn sone_floor(field: &StripeField, theta2: f64, x_i: &PlanePoint, x_o: &PlanePoint) -> f64 {
+    use het_bssrdf::het_estimate::path_integral::width;
+    use het_bssrdf::het_estimate::prefilter::{FootprintWeight, PlaneFootprint, stripe_fraction};
+    let diff = glam::DVec2::new(x_o.x - x_i.x, x_o.y - x_i.y);
+    let d = diff.length();
+    let x_hat = diff / d;
+    let minor = glam::DVec2::new(-x_hat.y, x_hat.x);
+    let centre = glam::DVec2::new(0.5 * (x_i.x + x_o.x), 0.5 * (x_i.y + x_o.y));
+    let footprint = |b: f64| PlaneFootprint {
+        centre,
+        axis_u: 0.5 * d * x_hat,
+        axis_v: b * minor,
+        weight: FootprintWeight::Uniform,
+    };
+    let [v0, v1] = field.values;
+    let mix = |f: f64, v: fn(&Coefficients) -> f64| v(&v0) * (1.0 - f) + v(&v1) * f;
+    let f_disk = stripe_fraction(&field.pattern, &footprint(0.5 * d)).unwrap_or(0.0);
+    let (sa, ss) = (mix(f_disk, |c| c.sigma_a[0]), mix(f_disk, |c| c.sigma_s[0]));
+    let w = width(theta2, ss, sa, d).unwrap_or(0.0);
+    let f = stripe_fraction(&field.pattern, &footprint(0.5 * w)).unwrap_or(0.0);
+    mix(f, |c| c.sigma_a[0])
 }
 
 fn averaging(c: &mut Criterion) {
