@@ -86,11 +86,21 @@ pub fn warn_counters(c: &PathCounters) {
         );
     }
     if c.prefiltered + c.prefilter_fallbacks > 0 {
+        let charts = if c.chart_fallbacks > 0 {
+            format!(
+                ", {} where its texture coordinates were not one affine map",
+                c.chart_fallbacks
+            )
+        } else {
+            String::new()
+        };
         eprintln!(
             "averaging: {} of {} estimates prefiltered (sone: closed-form footprints; kernel: \
-             points read in the surface's plane), {} sampled where the surface was too curved \
-             for a flat footprint or its texture coordinates were not one affine map",
-            c.prefiltered, c.estimates, c.prefilter_fallbacks
+             points read in the surface's plane); sampled: {} where the surface was too curved \
+             for a flat footprint{charts}",
+            c.prefiltered,
+            c.estimates,
+            c.prefilter_fallbacks - c.chart_fallbacks
         );
     }
 }

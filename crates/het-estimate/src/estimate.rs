@@ -70,6 +70,9 @@ pub struct Diagnostics {
     /// coordinates, the charts at x_i and x_o disagreed ([`crate::UvChart::between`]): the
     /// regions were sampled instead.
     pub prefilter_fallback: bool,
+    /// Of those, a flat pair whose texture-coordinate charts disagreed (a seam or a stretch
+    /// between x_i and x_o, [`crate::UvChart::between`]).
+    pub chart_fallback: bool,
     /// Sone: the step-1 disk means ⟨σa⟩, ⟨σs⟩ that entered Eq. (2).
     pub disk_mean: Option<Coefficients>,
     /// Sone: the width w of Eq. (2) per channel (scene units); the ellipse's semi-minor axis

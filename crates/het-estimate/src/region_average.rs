@@ -338,6 +338,7 @@ where
                 _ => None,
             };
             flat = self.chart.is_some();
+            self.diag.chart_fallback = !flat;
         }
         self.diag.prefilter_fallback = !flat;
         flat

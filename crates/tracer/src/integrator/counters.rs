@@ -49,6 +49,9 @@ pub struct PathCounters {
     /// UV-mapped field were not one affine map over the region (`het_estimate::UvChart`), so
     /// the regions were sampled.
     pub prefilter_fallbacks: u64,
+    /// Of those, estimates on flat pairs whose texture-coordinate charts disagreed (a UV seam
+    /// or stretch between x_i and x_o).
+    pub chart_fallbacks: u64,
     /// Profile evaluations whose estimated coefficients the profile rejected; those channels
     /// contribute 0, so a non-zero count means a bias (never expected: scenes are validated
     /// with the profiles' own bounds at load).
@@ -65,6 +68,7 @@ impl PathCounters {
         self.estimator_fallbacks += d.fallback as u64;
         self.prefiltered += (d.field_averages > 0) as u64;
         self.prefilter_fallbacks += d.prefilter_fallback as u64;
+        self.chart_fallbacks += d.chart_fallback as u64;
     }
 
     /// The diffuse reflectance profile `R(r)` (1/length², the paper's Eq. 1 kernel) of the
@@ -185,6 +189,7 @@ impl Counters for PathCounters {
         self.estimator_fallbacks += o.estimator_fallbacks;
         self.prefiltered += o.prefiltered;
         self.prefilter_fallbacks += o.prefilter_fallbacks;
+        self.chart_fallbacks += o.chart_fallbacks;
         self.profile_failures += o.profile_failures;
     }
 }
