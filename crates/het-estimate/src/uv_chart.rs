@@ -141,6 +141,16 @@ mod tests {
         DVec2::new(0.1 * x.x + 0.03 * x.y + 0.5, -0.02 * x.x + 0.2 * x.y + 0.25)
     }
 
+    /// The right triangle with legs of 1 along x and y at `offset`, on the plane z = 1.
+    fn unit_triangle(offset: DVec3) -> [DVec3; 3] {
+        [
+            DVec3::Z,
+            DVec3::new(1.0, 0.0, 1.0),
+            DVec3::new(0.0, 1.0, 1.0),
+        ]
+        .map(|p| p + offset)
+    }
+
     fn chart_at(p: [DVec3; 3], origin: DVec3) -> UvChart {
         UvChart::of_triangle(p, p.map(affine), origin, affine(origin)).unwrap()
     }
@@ -168,12 +178,10 @@ mod tests {
 
     #[test]
     fn two_ends_of_one_map_give_its_midpoint_chart() {
-        let t1 = [
-            DVec3::new(0.0, 0.0, 1.0),
-            DVec3::new(1.0, 0.0, 1.0),
-            DVec3::new(0.0, 1.0, 1.0),
-        ];
-        let t2 = t1.map(|p| p + DVec3::new(6.0, 2.0, 0.0));
+        let (t1, t2) = (
+            unit_triangle(DVec3::ZERO),
+            unit_triangle(DVec3::new(6.0, 2.0, 0.0)),
+        );
         let (xi, xo) = (DVec3::new(0.2, 0.2, 1.0), DVec3::new(6.3, 2.1, 1.0));
         let mid = UvChart::between(&chart_at(t1, xi), &chart_at(t2, xo)).unwrap();
         assert!((mid.origin - 0.5 * (xi + xo)).length() < 1e-15);
@@ -183,12 +191,10 @@ mod tests {
 
     #[test]
     fn a_seam_or_a_stretch_between_the_ends_is_refused() {
-        let t1 = [
-            DVec3::new(0.0, 0.0, 1.0),
-            DVec3::new(1.0, 0.0, 1.0),
-            DVec3::new(0.0, 1.0, 1.0),
-        ];
-        let t2 = t1.map(|p| p + DVec3::new(4.0, 0.0, 0.0));
+        let (t1, t2) = (
+            unit_triangle(DVec3::ZERO),
+            unit_triangle(DVec3::new(4.0, 0.0, 0.0)),
+        );
         let (xi, xo) = (DVec3::new(0.2, 0.2, 1.0), DVec3::new(4.2, 0.3, 1.0));
         let a = chart_at(t1, xi);
         // A seam: the second island is the same map shifted by 0.3 in u.
