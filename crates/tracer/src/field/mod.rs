@@ -355,9 +355,9 @@ impl Field {
     /// flat-footprint reading of Eq. (3)), in constant time: the constant itself, or the
     /// pattern's closed form through the planar projection ([`het_estimate::prefilter`]), or a
     /// planar image's summed-area average ([`ImageField::ellipse_average`], whose table is
-    /// built on the first call unless [`MediumField::build_area_tables`] built it). `None` for UV-mapped images (they need the texture
-    /// coordinates over the plane: [`Field::ellipse_average_in_chart`]) and where a closed
-    /// form or the table declines.
+    /// built on the first call unless [`MediumField::build_area_tables`] built it). `None`
+    /// for UV-mapped images (they need the texture coordinates over the plane:
+    /// [`Field::ellipse_average_in_chart`]) and where a closed form or the table declines.
     pub fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Rgb> {
         match self {
             Field::Constant(v) => Some(*v),
