@@ -15,7 +15,7 @@
 //! For 40 pairs of the Figure 4 stripe preset (x_i at the origin, x_o uniform in [−15, 15]²,
 //! d ≥ 1; index-matched, g = 0), with the kernel's weight at the endpoints' mean σa, it
 //! prints the error of the power-mean σ̄a (p = 0.875, the kernel's default) given by each
-//! decomposition against the quadrature's (about 25 s):
+//! decomposition against the quadrature's, then what one decomposition's closed forms cost (about 30 s):
 //!
 //!     cargo run --release --example kernel_rings
 
@@ -106,6 +106,87 @@ fn main() {
             errors[errors.len() - 1]
         );
     }
+    // What the closed forms of one decomposition cost: the region averages of 16 rings and
+    // 8 shell pairs (17 ellipses and 16 disks) for each pair, timed over repetitions.
+    let repeats = 2000;
+    let start = std::time::Instant::now();
+    let mut sink = 0.0;
+    for _ in 0..repeats {
+        for pair in &pairs {
+            sink += region_averages(&stripe, pair, 16, 8);
+        }
+    }
+    let ns = start.elapsed().as_nanos() as f64 / (repeats * pairs.len()) as f64;
+    println!(
+        "16 rings + 8 shells: {ns:.0} ns of closed forms per decomposition (one iteration; {sink:.1})"
+    );
+}
+
+/// The closed forms a decomposition of `rings` rings and `shells` shell pairs reads for
+/// `pair` (their sum, so that none is optimised away).
+fn region_averages(stripe: &Stripe, pair: &Pair, rings: usize, shells: usize) -> f64 {
+    let d = pair.x_o.length();
+    let h = 0.5 * d;
+    let (x_hat, mid) = (pair.x_o / d, 0.5 * pair.x_o);
+    let geometry = Geometry::new(h, pair.sigma_t, rings, shells);
+    let mut sum = 0.0;
+    for k in 0..=rings {
+        let s = geometry.boundary(k);
+        let fp = PlaneFootprint {
+            centre: mid,
+            axis_u: s * x_hat,
+            axis_v: (s * s - h * h).max(0.0).sqrt() * x_hat.perp(),
+            weight: FootprintWeight::Uniform,
+        };
+        sum += stripe_fraction(stripe, &fp).unwrap_or(0.0);
+    }
+    for j in 0..shells {
+        let r = geometry.radius(j);
+        for c in [DVec2::ZERO, pair.x_o] {
+            let fp = PlaneFootprint {
+                centre: c,
+                axis_u: DVec2::new(r, 0.0),
+                axis_v: DVec2::new(0.0, r),
+                weight: FootprintWeight::Uniform,
+            };
+            sum += stripe_fraction(stripe, &fp).unwrap_or(0.0);
+        }
+    }
+    sum
+}
+
+/// The regions of a decomposition: ring boundaries (semi-major axes: h, then geometric in
+/// s − h up to 80 mean free paths beyond the chord, where W₂ has fallen by e^{−80κ} or, at
+/// κ → 0, by its power law) and focal shells' outer radii (geometric from 0.02 to 2h).
+struct Geometry {
+    h: f64,
+    s_max: f64,
+    rings: usize,
+    shells: usize,
+}
+
+impl Geometry {
+    fn new(h: f64, sigma_t: f64, rings: usize, shells: usize) -> Self {
+        Self {
+            h,
+            s_max: h + 80.0 / sigma_t,
+            rings,
+            shells,
+        }
+    }
+
+    fn boundary(&self, k: usize) -> f64 {
+        if k == 0 {
+            return self.h;
+        }
+        let (a, b) = ((0.02f64).ln(), (self.s_max - self.h).ln());
+        self.h + (a + (b - a) * (k - 1) as f64 / (self.rings - 1) as f64).exp()
+    }
+
+    fn radius(&self, j: usize) -> f64 {
+        let (a, b) = ((0.02f64).ln(), (2.0 * self.h).ln());
+        (a + (b - a) * j as f64 / (self.shells.max(2) - 1) as f64).exp()
+    }
 }
 
 /// The W₂-weighted fraction of the stripe's value 1 around `pair`: by quadrature, and by a
@@ -125,21 +206,12 @@ fn fractions(
     let h = 0.5 * d;
     let (x_hat, mid) = (pair.x_o / d, 0.5 * pair.x_o);
     let y_hat = x_hat.perp();
-    // Semi-major axes of the ring boundaries: h, then geometric in s − h up to 80 mean free
-    // paths beyond the chord (W₂ has fallen by e^{-80κ} or, at κ → 0, by its power law).
-    let s_max = h + 80.0 / pair.sigma_t;
-    let boundary = |k: usize| {
-        if k == 0 {
-            return h;
-        }
-        let (a, b) = ((0.02f64).ln(), (s_max - h).ln());
-        h + (a + (b - a) * (k - 1) as f64 / (rings - 1) as f64).exp()
-    };
-    // Outer radii of the focal shells: geometric from 0.02 to 2h (and 0 inside the first).
-    let radius = |j: usize| {
-        let (a, b) = ((0.02f64).ln(), (2.0 * h).ln());
-        (a + (b - a) * j as f64 / (shells.max(2) - 1) as f64).exp()
-    };
+    let geometry = Geometry::new(h, pair.sigma_t, rings, shells);
+    let (s_max, boundary, radius) = (
+        geometry.s_max,
+        |k| geometry.boundary(k),
+        |j| geometry.radius(j),
+    );
     let shell_of = |rho: f64| (0..shells).find(|&j| rho <= radius(j));
     let n = rings + shells;
     // Normal equations of the area-weighted fit, and the exact sums.
