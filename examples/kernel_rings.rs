@@ -15,7 +15,8 @@
 //! For 40 pairs of the Figure 4 stripe preset (x_i at the origin, x_o uniform in [−15, 15]²,
 //! d ≥ 1; index-matched, g = 0), with the kernel's weight at the endpoints' mean σa, it
 //! prints the error of the power-mean σ̄a (p = 0.875, the kernel's default) given by each
-//! decomposition against the quadrature's, then what one decomposition's closed forms cost (about 30 s):
+//! decomposition against the quadrature's, then what one decomposition's closed forms cost
+//! (about 30 s):
 //!
 //!     cargo run --release --example kernel_rings
 
