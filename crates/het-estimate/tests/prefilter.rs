@@ -1,6 +1,7 @@
 //! Prefiltered averaging: the closed forms for stripes and checks against Monte Carlo averages
 //! over the same footprints, the Sone estimator's prefiltered default against its Monte Carlo
-//! path, and the flatness fallback on a curved surface.
+//! path, the flatness fallback on a curved surface, and the texture-coordinate charts'
+//! agreement test over random affine maps.
 //!
 //! Monte Carlo comparisons use independent uniform points (rejection from the square, this
 //! file's own generator) and a fixed seed; the tolerance is 5 standard errors of a Bernoulli
@@ -267,4 +268,82 @@ fn fallback_triggers_on_a_small_sphere_and_is_counted() {
     // Monte Carlo averaging never asks and never flags.
     let m = mc.estimate(&Sphere, &field, &x_i, &x_o, &mut SplitMix64::new(1));
     assert!(!m.diagnostics.prefilter_fallback && m.diagnostics.field_averages == 0);
+}
+
+mod uv_charts {
+    //! `UvChart::between`, the agreement test of the texture coordinates at x_i and x_o, over
+    //! random affine maps, triangles and scales (1e-4 to 1e4 texture units per scene unit).
+    use glam::{DVec2, DVec3};
+    use het_estimate::UvChart;
+    use proptest::prelude::*;
+
+    /// A random affine map on the plane z = `z`, its gradients scaled by `scale`.
+    fn map(g: [f64; 4], offset: [f64; 2], scale: f64) -> impl Fn(DVec3) -> DVec2 {
+        move |x: DVec3| {
+            DVec2::new(
+                offset[0] + scale * (g[0] * x.x + g[1] * x.y),
+                offset[1] + scale * (g[2] * x.x + g[3] * x.y),
+            )
+        }
+    }
+
+    /// The chart at `at` of the triangle with corners `at + corners`, on the plane z = 2.
+    fn chart(f: &impl Fn(DVec3) -> DVec2, at: DVec3, corners: [DVec2; 3]) -> Option<UvChart> {
+        let p = corners.map(|c| at + DVec3::new(c.x, c.y, 0.0));
+        UvChart::of_triangle(p, p.map(f), at, f(at))
+    }
+
+    fn corners() -> impl Strategy<Value = [DVec2; 3]> {
+        (0.1f64..3.0, 0.1f64..3.0, 0.0f64..6.28).prop_map(|(a, b, t)| {
+            let (s, c) = t.sin_cos();
+            [
+                DVec2::new(-0.3 * a * c, -0.3 * a * s),
+                DVec2::new(a * c, a * s),
+                DVec2::new(-b * s, b * c),
+            ]
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// One affine map seen from two triangles: accepted, symmetric to the bit, and the
+        /// midpoint chart is the map; a seam beyond the tolerance, or one end's gradients 2.5 %
+        /// larger, is refused.
+        #[test]
+        fn charts_of_one_map_agree_and_a_seam_or_stretch_does_not(
+            g in prop::array::uniform4(-1.0f64..1.0),
+            offset in prop::array::uniform2(-5.0f64..5.0),
+            log_scale in -4.0f64..4.0,
+            ci in corners(),
+            co in corners(),
+            xi in prop::array::uniform2(-10.0f64..10.0),
+            xo in prop::array::uniform2(-10.0f64..10.0),
+        ) {
+            let det = g[0] * g[3] - g[1] * g[2];
+            prop_assume!(det.abs() > 0.05);
+            let scale = 10f64.powf(log_scale);
+            let f = map(g, offset, scale);
+            let (xi, xo) = (DVec3::new(xi[0], xi[1], 2.0), DVec3::new(xo[0], xo[1], 2.0));
+            prop_assume!((xo - xi).length() > 0.1);
+            let a = chart(&f, xi, ci).unwrap();
+            let b = chart(&f, xo, co).unwrap();
+            let mid = UvChart::between(&a, &b).expect("one affine map");
+            prop_assert_eq!(Some(mid), UvChart::between(&b, &a));
+            for x in [xi, xo, DVec3::new(3.0, -7.0, 2.0)] {
+                let want = f(x);
+                let err = (mid.uv_at(x) - want).length();
+                prop_assert!(err <= 1e-9 * (1.0 + want.length()), "{} at {:?}", err, x);
+            }
+            // A seam: the far end's coordinates shifted by 3 % of the chord's reach.
+            let reach = 0.02
+                * (a.grad_u.length_squared() + a.grad_v.length_squared()).sqrt()
+                * (xo - xi).length();
+            let seam = UvChart { uv: b.uv + DVec2::new(1.5 * reach + 1e-5 * (1.0 + b.uv.length()), 0.0), ..b };
+            prop_assert!(UvChart::between(&a, &seam).is_none());
+            // A stretch: the far end's gradients 2.5 % larger.
+            let stretched = UvChart { grad_u: 1.025 * b.grad_u, grad_v: 1.025 * b.grad_v, ..b };
+            prop_assert!(UvChart::between(&a, &stretched).is_none());
+        }
+    }
 }
