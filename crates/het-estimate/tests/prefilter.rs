@@ -294,7 +294,7 @@ mod uv_charts {
     }
 
     fn corners() -> impl Strategy<Value = [DVec2; 3]> {
-        (0.1f64..3.0, 0.1f64..3.0, 0.0f64..6.28).prop_map(|(a, b, t)| {
+        (0.1f64..3.0, 0.1f64..3.0, 0.0f64..std::f64::consts::TAU).prop_map(|(a, b, t)| {
             let (s, c) = t.sin_cos();
             [
                 DVec2::new(-0.3 * a * c, -0.3 * a * s),
