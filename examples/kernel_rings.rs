@@ -32,7 +32,7 @@ const VALUES: [f64; 2] = [0.005, 0.1];
 /// Quadrature nodes in μ (across the confocal ellipses) and ν (around them).
 const NODES: (usize, usize) = (600, 720);
 
-/// One pair: the exact W₂-weighted fraction of value 1, and the ring masses on the way.
+/// One pair: x_o (x_i is the origin) and the material of its kernel weight.
 struct Pair {
     x_o: DVec2,
     /// σt' (σs' = 1 + σa, g = 0) and κ = σtr/σt' of the weight.
@@ -123,43 +123,21 @@ fn main() {
     );
 }
 
-/// The closed forms a decomposition of `rings` rings and `shells` shell pairs reads for
-/// `pair` (their sum, so that none is optimised away).
+/// The closed forms one decomposition of `rings` rings and `shells` shell pairs reads for
+/// `pair` (their total area of value 1, so that none is optimised away).
 fn region_averages(stripe: &Stripe, pair: &Pair, rings: usize, shells: usize) -> f64 {
-    let d = pair.x_o.length();
-    let h = 0.5 * d;
-    let (x_hat, mid) = (pair.x_o / d, 0.5 * pair.x_o);
-    let geometry = Geometry::new(h, pair.sigma_t, rings, shells);
-    let mut sum = 0.0;
-    for k in 0..=rings {
-        let s = geometry.boundary(k);
-        let fp = PlaneFootprint {
-            centre: mid,
-            axis_u: s * x_hat,
-            axis_v: (s * s - h * h).max(0.0).sqrt() * x_hat.perp(),
-            weight: FootprintWeight::Uniform,
-        };
-        sum += stripe_fraction(stripe, &fp).unwrap_or(0.0);
-    }
-    for j in 0..shells {
-        let r = geometry.radius(j);
-        for c in [DVec2::ZERO, pair.x_o] {
-            let fp = PlaneFootprint {
-                centre: c,
-                axis_u: DVec2::new(r, 0.0),
-                axis_v: DVec2::new(0.0, r),
-                weight: FootprintWeight::Uniform,
-            };
-            sum += stripe_fraction(stripe, &fp).unwrap_or(0.0);
-        }
-    }
-    sum
+    let geometry = Geometry::new(pair, rings, shells);
+    geometry.regions(stripe).iter().map(|r| r.1).sum()
 }
 
-/// The regions of a decomposition: ring boundaries (semi-major axes: h, then geometric in
-/// s − h up to 80 mean free paths beyond the chord, where W₂ has fallen by e^{−80κ} or, at
-/// κ → 0, by its power law) and focal shells' outer radii (geometric from 0.02 to 2h).
+/// The regions of a decomposition about a pair's chord: ring boundaries (semi-major axes: h,
+/// then geometric in s − h up to 80 mean free paths beyond the chord, where W₂ has fallen by
+/// e^{−80κ} or, at κ → 0, by its power law) and focal shells' outer radii (geometric from
+/// 0.02 to 2h).
 struct Geometry {
+    x_o: DVec2,
+    mid: DVec2,
+    x_hat: DVec2,
     h: f64,
     s_max: f64,
     rings: usize,
@@ -167,15 +145,21 @@ struct Geometry {
 }
 
 impl Geometry {
-    fn new(h: f64, sigma_t: f64, rings: usize, shells: usize) -> Self {
+    fn new(pair: &Pair, rings: usize, shells: usize) -> Self {
+        let d = pair.x_o.length();
+        let h = 0.5 * d;
         Self {
+            x_o: pair.x_o,
+            mid: 0.5 * pair.x_o,
+            x_hat: pair.x_o / d,
             h,
-            s_max: h + 80.0 / sigma_t,
+            s_max: h + 80.0 / pair.sigma_t,
             rings,
             shells,
         }
     }
 
+    /// The semi-major axis of ring boundary `k` (0: the chord itself).
     fn boundary(&self, k: usize) -> f64 {
         if k == 0 {
             return self.h;
@@ -184,9 +168,53 @@ impl Geometry {
         self.h + (a + (b - a) * (k - 1) as f64 / (self.rings - 1) as f64).exp()
     }
 
+    /// The outer radius of shell `j`.
     fn radius(&self, j: usize) -> f64 {
         let (a, b) = ((0.02f64).ln(), (2.0 * self.h).ln());
         (a + (b - a) * j as f64 / (self.shells.max(2) - 1) as f64).exp()
+    }
+
+    /// Each region's (area, area of value 1): the rings, then the shell pairs, as differences
+    /// of the closed forms of the confocal ellipses and of the disks about both foci that bound
+    /// them (each boundary evaluated once).
+    fn regions(&self, stripe: &Stripe) -> Vec<(f64, f64)> {
+        let average = |centre: DVec2, axis_u: DVec2, axis_v: DVec2| {
+            let fp = PlaneFootprint {
+                centre,
+                axis_u,
+                axis_v,
+                weight: FootprintWeight::Uniform,
+            };
+            stripe_fraction(stripe, &fp).unwrap_or(0.0)
+        };
+        let ellipse = |s: f64| {
+            let b = (s * s - self.h * self.h).max(0.0).sqrt();
+            let area = std::f64::consts::PI * s * b;
+            let ones = area * average(self.mid, s * self.x_hat, b * self.x_hat.perp());
+            (area, ones)
+        };
+        let disks = |r: f64| {
+            let area = std::f64::consts::PI * r * r;
+            let (u, v) = (DVec2::new(r, 0.0), DVec2::new(0.0, r));
+            let ones = area * (average(DVec2::ZERO, u, v) + average(self.x_o, u, v));
+            (2.0 * area, ones)
+        };
+        let difference =
+            |outer: (f64, f64), inner: (f64, f64)| (outer.0 - inner.0, outer.1 - inner.1);
+        let mut regions = Vec::with_capacity(self.rings + self.shells);
+        let mut inner = ellipse(self.boundary(0));
+        for k in 1..=self.rings {
+            let outer = ellipse(self.boundary(k));
+            regions.push(difference(outer, inner));
+            inner = outer;
+        }
+        let mut inner = (0.0, 0.0);
+        for j in 0..self.shells {
+            let outer = disks(self.radius(j));
+            regions.push(difference(outer, inner));
+            inner = outer;
+        }
+        regions
     }
 }
 
@@ -203,17 +231,10 @@ fn fractions(
     rings: usize,
     shells: usize,
 ) -> (f64, f64) {
-    let d = pair.x_o.length();
-    let h = 0.5 * d;
-    let (x_hat, mid) = (pair.x_o / d, 0.5 * pair.x_o);
+    let geometry = Geometry::new(pair, rings, shells);
+    let (h, mid, x_hat) = (geometry.h, geometry.mid, geometry.x_hat);
     let y_hat = x_hat.perp();
-    let geometry = Geometry::new(h, pair.sigma_t, rings, shells);
-    let (s_max, boundary, radius) = (
-        geometry.s_max,
-        |k| geometry.boundary(k),
-        |j| geometry.radius(j),
-    );
-    let shell_of = |rho: f64| (0..shells).find(|&j| rho <= radius(j));
+    let shell_of = |rho: f64| (0..shells).find(|&j| rho <= geometry.radius(j));
     let n = rings + shells;
     // Normal equations of the area-weighted fit, and the exact sums.
     let mut gram = vec![0.0; n * n];
@@ -221,7 +242,7 @@ fn fractions(
     let (mut total, mut ones) = (0.0, 0.0);
     // Elliptic coordinates: q = mid + h(cosh μ cos ν x̂ + sinh μ sin ν ŷ),
     // dA = h²(sinh²μ + sin²ν) dμ dν.
-    let mu_max = (s_max / h).acosh();
+    let mu_max = (geometry.s_max / h).acosh();
     let (dmu, dnu) = (
         mu_max / NODES.0 as f64,
         std::f64::consts::TAU / NODES.1 as f64,
@@ -229,7 +250,10 @@ fn fractions(
     for i in 0..NODES.0 {
         let mu = (i as f64 + 0.5) * dmu;
         let s = h * mu.cosh();
-        let ring = (1..=rings).find(|&k| s <= boundary(k)).unwrap_or(rings) - 1;
+        let ring = (1..=rings)
+            .find(|&k| s <= geometry.boundary(k))
+            .unwrap_or(rings)
+            - 1;
         for j in 0..NODES.1 {
             let nu = (j as f64 + 0.5) * dnu;
             let q = mid + h * mu.cosh() * nu.cos() * x_hat + h * mu.sinh() * nu.sin() * y_hat;
@@ -254,49 +278,7 @@ fn fractions(
             }
         }
     }
-    // Each region's area and its area of value 1, from the closed forms: confocal ellipses
-    // for the rings, disks about both foci for the shells.
-    let ellipse = |s: f64| {
-        let b = (s * s - h * h).max(0.0).sqrt();
-        let fp = PlaneFootprint {
-            centre: mid,
-            axis_u: s * x_hat,
-            axis_v: b * y_hat,
-            weight: FootprintWeight::Uniform,
-        };
-        let area = std::f64::consts::PI * s * b;
-        (area, area * stripe_fraction(stripe, &fp).unwrap_or(0.0))
-    };
-    let disks = |r: f64| {
-        let area = std::f64::consts::PI * r * r;
-        let ones: f64 = [DVec2::ZERO, pair.x_o]
-            .iter()
-            .map(|&c| {
-                let fp = PlaneFootprint {
-                    centre: c,
-                    axis_u: DVec2::new(r, 0.0),
-                    axis_v: DVec2::new(0.0, r),
-                    weight: FootprintWeight::Uniform,
-                };
-                area * stripe_fraction(stripe, &fp).unwrap_or(0.0)
-            })
-            .sum();
-        (2.0 * area, ones)
-    };
-    let mut regions = Vec::with_capacity(n);
-    for k in 1..=rings {
-        let (outer, inner) = (ellipse(boundary(k)), ellipse(boundary(k - 1)));
-        regions.push((outer.0 - inner.0, outer.1 - inner.1));
-    }
-    for j in 0..shells {
-        let outer = disks(radius(j));
-        let inner = if j == 0 {
-            (0.0, 0.0)
-        } else {
-            disks(radius(j - 1))
-        };
-        regions.push((outer.0 - inner.0, outer.1 - inner.1));
-    }
+    let regions = geometry.regions(stripe);
     let coefficients = if shells == 0 {
         // Without overlaps the fit is each ring's mass over its area.
         (0..n).map(|k| rhs[k] / gram[k * n + k]).collect()
