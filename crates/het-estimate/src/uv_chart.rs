@@ -155,6 +155,15 @@ mod tests {
         UvChart::of_triangle(p, p.map(affine), origin, affine(origin)).unwrap()
     }
 
+    /// The charts at `xi`, on the unit triangle at the origin, and at `xo`, on the unit
+    /// triangle at `offset`.
+    fn end_charts(offset: DVec3, xi: DVec3, xo: DVec3) -> (UvChart, UvChart) {
+        (
+            chart_at(unit_triangle(DVec3::ZERO), xi),
+            chart_at(unit_triangle(offset), xo),
+        )
+    }
+
     #[test]
     fn a_triangle_chart_reproduces_the_linear_coordinates() {
         let p = [
@@ -178,12 +187,9 @@ mod tests {
 
     #[test]
     fn two_ends_of_one_map_give_its_midpoint_chart() {
-        let (t1, t2) = (
-            unit_triangle(DVec3::ZERO),
-            unit_triangle(DVec3::new(6.0, 2.0, 0.0)),
-        );
         let (xi, xo) = (DVec3::new(0.2, 0.2, 1.0), DVec3::new(6.3, 2.1, 1.0));
-        let mid = UvChart::between(&chart_at(t1, xi), &chart_at(t2, xo)).unwrap();
+        let (a, b) = end_charts(DVec3::new(6.0, 2.0, 0.0), xi, xo);
+        let mid = UvChart::between(&a, &b).unwrap();
         assert!((mid.origin - 0.5 * (xi + xo)).length() < 1e-15);
         let x = DVec3::new(3.0, -4.0, 1.0);
         assert!((mid.uv_at(x) - affine(x)).length() < 1e-13);
@@ -191,28 +197,23 @@ mod tests {
 
     #[test]
     fn a_seam_or_a_stretch_between_the_ends_is_refused() {
-        let (t1, t2) = (
-            unit_triangle(DVec3::ZERO),
-            unit_triangle(DVec3::new(4.0, 0.0, 0.0)),
-        );
         let (xi, xo) = (DVec3::new(0.2, 0.2, 1.0), DVec3::new(4.2, 0.3, 1.0));
-        let a = chart_at(t1, xi);
+        let (a, b) = end_charts(DVec3::new(4.0, 0.0, 0.0), xi, xo);
+        let shifted = |du: f64| UvChart {
+            uv: b.uv + DVec2::new(du, 0.0),
+            ..b
+        };
         // A seam: the second island is the same map shifted by 0.3 in u.
-        let mut seam = chart_at(t2, xo);
-        seam.uv.x += 0.3;
-        assert!(UvChart::between(&a, &seam).is_none());
+        assert!(UvChart::between(&a, &shifted(0.3)).is_none());
         // A small shift, within 2 % of the chord's texture length (0.4): accepted.
-        let mut small = chart_at(t2, xo);
-        small.uv.x += 0.004;
-        assert!(UvChart::between(&a, &small).is_some());
+        assert!(UvChart::between(&a, &shifted(0.004)).is_some());
         // A stretch: the second triangle's u grows 5 % faster.
         let stretched = UvChart {
             grad_u: 1.05 * a.grad_u,
-            ..chart_at(t2, xo)
+            ..b
         };
         assert!(UvChart::between(&a, &stretched).is_none());
         // Symmetric, and bit for bit the same midpoint either way.
-        let b = chart_at(t2, xo);
         assert_eq!(UvChart::between(&a, &b), UvChart::between(&b, &a));
     }
 }
