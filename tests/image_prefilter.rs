@@ -124,12 +124,16 @@ fn prefiltered_vs_monte_carlo(filter: Filter, read: Read, samples: u32, seed: u6
 }
 
 /// At 64 samples per stage the Monte Carlo image's own noise dominates the distance; the
-/// 256-sample variant (ignored: slow) measures the README's number.
+/// 256-sample variant (ignored: slow) measures the README's number. The UV-mapped image is
+/// compared with Monte Carlo averaging of the UV field itself (every point projected onto the
+/// mesh and read at its interpolated coordinates).
 #[test]
 fn prefiltered_image_render_agrees_with_monte_carlo() {
-    for filter in [Filter::Nearest, Filter::Bilinear] {
-        let d = prefiltered_vs_monte_carlo(filter, Read::Planar, 64, 9);
-        assert!(d < 0.05, "{filter:?}: relative L2 {d}");
+    for read in [Read::Planar, Read::Uv] {
+        for filter in [Filter::Nearest, Filter::Bilinear] {
+            let d = prefiltered_vs_monte_carlo(filter, read, 64, 9);
+            assert!(d < 0.05, "{read:?} {filter:?}: relative L2 {d}");
+        }
     }
 }
 
@@ -188,10 +192,10 @@ fn kernel(samples: u32, averaging: Averaging) -> Method {
 
 /// A UV-mapped image whose texture coordinates are one affine map: Sone's prefiltered
 /// footprints follow the UV Jacobian, so the render is the planar-projected render of the same
-/// field (whose footprints are tested against Monte Carlo above), up to the f32 rounding of the
-/// stored texture coordinates, with every estimate that has a chord prefiltered; and it agrees
-/// with Monte Carlo averaging of the UV field itself (every point projected onto the mesh and
-/// read at its interpolated coordinates).
+/// field, up to the f32 rounding of the stored texture coordinates, with as many estimates
+/// prefiltered (every one that has a chord: `prefiltered_vs_monte_carlo` checks the counts).
+/// Both are compared with Monte Carlo averaging in
+/// `prefiltered_image_render_agrees_with_monte_carlo`.
 #[test]
 fn uv_mapped_image_is_prefiltered_through_its_chart() {
     let filter = Filter::Nearest;
@@ -200,22 +204,10 @@ fn uv_mapped_image_is_prefiltered_through_its_chart() {
     let method = sone(64, Averaging::Prefiltered);
     let a = run(&planar, method, 9);
     let b = run(&uv, method, 9);
-    assert!(
-        b.counters.prefiltered > b.counters.estimates / 2,
-        "{:?}",
-        b.counters
-    );
     assert_eq!(b.counters.prefilter_fallbacks, 0, "{:?}", b.counters);
     assert_eq!(a.counters.prefiltered, b.counters.prefiltered);
     let d = rel_l2(&b.pixels, &a.pixels);
     assert!(d < 1e-4, "UV against planar: relative L2 {d}");
-    let mc = run(&uv, sone(64, Averaging::MonteCarlo), 9);
-    assert_eq!(mc.counters.prefiltered, 0);
-    let d = rel_l2(&b.pixels, &mc.pixels);
-    assert!(
-        d < 0.05,
-        "UV prefiltered against Monte Carlo: relative L2 {d}"
-    );
 }
 
 /// The kernel reads a UV-mapped image's points in the plane through the chart: the same points
