@@ -339,7 +339,7 @@ where
     // one affine map over the region: the plane's points are the surface's.
     let in_plane = params.averaging == Averaging::Prefiltered
         && (probe.field.has_point_lookup() || probe.field.reads_uv())
-        && probe.flat_for_prefilter(params.flatness, chord.x_hat);
+        && probe.plane_stands_for_surface(params.flatness, chord.x_hat);
     if in_plane {
         probe.diag.field_averages += 1;
     }

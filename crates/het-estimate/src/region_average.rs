@@ -242,7 +242,7 @@ pub(crate) struct Probe<'a, S: SurfaceQuery + ?Sized, F: ?Sized> {
     pub diag: Diagnostics,
     endpoints: Option<Coefficients>,
     /// The averaging region's texture-coordinate chart, for a field that reads them, once
-    /// [`Probe::flat_for_prefilter`] has found one.
+    /// [`Probe::plane_stands_for_surface`] has found one.
     chart: Option<UvChart>,
 }
 
@@ -321,7 +321,7 @@ where
     /// in-plane reading), and, for a field that reads texture coordinates, whether the charts
     /// at x_i and x_o are one affine map ([`UvChart::between`], kept for the reads); a pair
     /// that is not is recorded as a prefilter fallback.
-    pub fn flat_for_prefilter(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
+    pub fn plane_stands_for_surface(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
         let mut flat = flatness.is_flat(
             self.x_i.normal().normalize(),
             self.x_o.normal().normalize(),
@@ -346,7 +346,7 @@ where
 
     /// The field's constant-time average over `e` ([`CoefficientField::ellipse_average`], or
     /// [`CoefficientField::ellipse_average_in_chart`] through the region's chart for a field
-    /// that reads texture coordinates); only for a pair [`Probe::flat_for_prefilter`]
+    /// that reads texture coordinates); only for a pair [`Probe::plane_stands_for_surface`]
     /// accepted.
     #[inline]
     pub fn field_ellipse_average(&self, e: &crate::PlanarEllipse) -> Option<Coefficients> {

@@ -235,7 +235,7 @@ where
     // Prefiltered averages only where a flat footprint stands for the projected region.
     let use_field_average = params.averaging == Averaging::Prefiltered
         && probe.field.has_ellipse_average()
-        && probe.flat_for_prefilter(params.flatness, chord.x_hat);
+        && probe.plane_stands_for_surface(params.flatness, chord.x_hat);
 
     // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
     let disk = chord.ellipse(chord.half_len);

@@ -745,26 +745,7 @@ impl MediumField {
     pub fn field_bounds(&self) -> FieldBounds {
         self.bounds
     }
-}
 
-/// Channel-wise bounds of two fields.
-fn bounds_of(a: &Field, s: &Field) -> FieldBounds {
-    let min = Coefficients {
-        sigma_a: a.min(),
-        sigma_s: s.min(),
-    };
-    let max = Coefficients {
-        sigma_a: a.max(),
-        sigma_s: s.max(),
-    };
-    if min == max {
-        FieldBounds::constant(min)
-    } else {
-        FieldBounds { min, max }
-    }
-}
-
-impl MediumField {
     /// Both fields' region averages by `average`, in the averaging space; `None` if either
     /// declines, and always for an artist medium inverted before averaging (the mean of a
     /// nonlinear function of the textures has no summed-area table).
@@ -804,6 +785,23 @@ impl MediumField {
             out.iter_mut()
                 .for_each(|c| *c = self.in_averaging_space(*c));
         }
+    }
+}
+
+/// Channel-wise bounds of two fields.
+fn bounds_of(a: &Field, s: &Field) -> FieldBounds {
+    let min = Coefficients {
+        sigma_a: a.min(),
+        sigma_s: s.min(),
+    };
+    let max = Coefficients {
+        sigma_a: a.max(),
+        sigma_s: s.max(),
+    };
+    if min == max {
+        FieldBounds::constant(min)
+    } else {
+        FieldBounds { min, max }
     }
 }
 
