@@ -277,7 +277,8 @@ mod uv_charts {
     use het_estimate::UvChart;
     use proptest::prelude::*;
 
-    /// A random affine map on the plane z = `z`, its gradients scaled by `scale`.
+    /// The affine map (x, y, z) ↦ offset + scale·G·(x, y), G = [[g0, g1], [g2, g3]] (z, along the
+    /// normal of the charts' plane, does not count).
     fn map(g: [f64; 4], offset: [f64; 2], scale: f64) -> impl Fn(DVec3) -> DVec2 {
         move |x: DVec3| {
             DVec2::new(
