@@ -87,9 +87,9 @@ pub struct RegionFlags {
     /// or `monte-carlo` (always sample and project).
     #[arg(long, value_parser = crate::choices::averaging())]
     pub averaging: Option<het_estimate::Averaging>,
-    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w/2` (default: the paper
-    /// calls w the length of the minor axis) or `w` (closer to the path tracer on the beam
-    /// presets and the checker half-space; docs/physics.md#path-width).
+    /// Sone's semi-minor axis b from the path width w of Eq. (2): `w` (default: closer to the
+    /// path tracer on the beam presets and the checker half-space;
+    /// docs/physics.md#path-width) or `w/2` (the paper calls w the length of the minor axis).
     #[arg(long, value_parser = crate::choices::semi_minor())]
     pub semi_minor: Option<het_estimate::SemiMinorAxis>,
 }

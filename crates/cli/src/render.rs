@@ -114,7 +114,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             estimator: scene
                 .settings()
                 .estimator
-                .unwrap_or(Estimator::Sone(SoneParams::paper())),
+                .unwrap_or(Estimator::Sone(SoneParams::new())),
             profile: None,
         },
     };

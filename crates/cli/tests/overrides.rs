@@ -149,10 +149,10 @@ fn sidecar_of_run(cmd: &mut Command, out: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap()).unwrap()
 }
 
-/// `--semi-minor w` sizes Sone's ellipse with b = w instead of w/2: the beam map changes (on
-/// the check preset the ellipse then covers other cells), the sidecar records the reading
-/// (`w/2` by default), the render sidecar's estimator parameters carry it, and the flag is
-/// refused for an estimator without Sone's ellipse.
+/// `--semi-minor w/2` sizes Sone's ellipse with the paper's b = w/2 instead of the default
+/// b = w: the beam map changes (on the check preset the ellipse then covers other cells), the
+/// sidecar records the reading (`w` by default), the render sidecar's estimator parameters
+/// carry it, and the flag is refused for an estimator without Sone's ellipse.
 #[test]
 fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
     let dir = tempfile::tempdir().unwrap();
@@ -167,8 +167,8 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
         );
         (v, std::fs::read(&out).unwrap())
     };
-    let (half, half_exr) = map("half.exr", &["--method", "sone"]);
-    let (full, full_exr) = map("full.exr", &["--method", "sone", "--semi-minor", "w"]);
+    let (full, full_exr) = map("full.exr", &["--method", "sone"]);
+    let (half, half_exr) = map("half.exr", &["--method", "sone", "--semi-minor", "w/2"]);
     assert_eq!(half["semi_minor"], "w/2");
     assert_eq!(full["semi_minor"], "w");
     assert_ne!(half_exr, full_exr, "b = w gave the same map as b = w/2");
@@ -194,21 +194,21 @@ fn semi_minor_reaches_sones_ellipse_and_the_sidecars() {
 
     let scene_path = tiny_slab(dir.path(), 4, "");
     let out = dir.path().join("slab.exr");
-    let v = sidecar_of_run(
-        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
-            .args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
-            .args([
-                "--spp",
-                "1",
-                "--semi-minor",
-                "w",
-                "--out",
-                out.to_str().unwrap(),
-            ]),
-        &out,
-    );
-    let params = v["estimator_parameters"].as_str().unwrap();
-    assert!(params.contains("semi_minor: Width"), "{params}");
+    // The default is b = w; the flag selects the paper's b = w/2.
+    for (flag, recorded) in [
+        (None, "semi_minor: Width"),
+        (Some("w/2"), "semi_minor: HalfWidth"),
+    ] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"));
+        cmd.args(["render", scene_path.to_str().unwrap(), "--method", "sone"])
+            .args(["--spp", "1", "--out", out.to_str().unwrap()]);
+        if let Some(b) = flag {
+            cmd.args(["--semi-minor", b]);
+        }
+        let v = sidecar_of_run(&mut cmd, &out);
+        let params = v["estimator_parameters"].as_str().unwrap();
+        assert!(params.contains(recorded), "{flag:?}: {params}");
+    }
 }
 
 /// A scene file's `averaging` reaches the render when `--averaging` is absent, and the flag

@@ -161,8 +161,11 @@ fn mkdir(path: &Path) -> Result<(), ReproduceError> {
     })
 }
 
+/// A built-in method by name, Sone in the paper's literal reading (b = w/2,
+/// [`het_estimate::SoneParams::paper`]): these are the paper's experiments.
 fn method(name: &str) -> Method {
-    name.parse().expect("built-in method names")
+    let m: Method = name.parse().expect("built-in method names");
+    m.with_semi_minor(Some(het_estimate::SemiMinorAxis::HalfWidth))
 }
 
 /// Every value rounded to `f32`, as an EXR holds it (see [`crate::ledger`]: references are
@@ -530,4 +533,22 @@ fn errors_csv(rows: &[ErrorRow]) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use het_estimate::SemiMinorAxis;
+    use tracer::integrator::Method;
+
+    /// `reproduce` runs the paper's Sone (b = w/2), not the command line's default (b = w).
+    #[test]
+    fn reproduce_runs_the_papers_sone() {
+        assert_eq!(
+            super::method("sone").semi_minor(),
+            Some(SemiMinorAxis::HalfWidth)
+        );
+        let default: Method = "sone".parse().unwrap();
+        assert_eq!(default.semi_minor(), Some(SemiMinorAxis::Width));
+        assert_eq!(super::method("kernel").semi_minor(), None);
+    }
 }

@@ -52,7 +52,7 @@ impl Named for Estimator {
         Estimator::JensenOut,
         Estimator::Endpoints,
         Estimator::Segment(SegmentParams::new()),
-        Estimator::Sone(SoneParams::paper()),
+        Estimator::Sone(SoneParams::new()),
         Estimator::Kernel(KernelParams::new()),
     ];
     fn name(self) -> &'static str {

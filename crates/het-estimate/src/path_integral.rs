@@ -16,16 +16,17 @@
 //! (2-D radial) distance of paths from the chord at its midpoint (docs/physics.md#path-width, derived there): w is an RMS
 //! radius.
 //!
-//! # Reading choices (options, with the defaults the paper's text supports best)
+//! # Reading choices (options; the defaults are the readings the path tracer favours)
 //! * ⟨θ²⟩: [`MeanSquareAngle::Exact`] (default) is the exact Henyey–Greenstein value
 //!   `∫ θ² p dω` (`bssrdf_core::hg::mean_square_angle`, ~1 µs: computed once per material by
 //!   `Estimator::prepare`); [`MeanSquareAngle::SmallAngle`] is `2(1 − g)`. The paper does not
 //!   say which it used; isotropic media violate the small-angle assumption either way.
 //! * The ellipse's semi-minor axis b: the paper calls w "the length of the minor axis" right
 //!   after calling d "the length of the major axis", so read literally both are full lengths
-//!   and `b = w/2` ([`SemiMinorAxis::HalfWidth`], default). Physically w is a one-sided RMS
-//!   spread, which suggests `b = w` ([`SemiMinorAxis::Width`]). The path-tracer comparison
-//!   decides; both are available.
+//!   and `b = w/2` ([`SemiMinorAxis::HalfWidth`], the paper's reading). Physically w is a
+//!   one-sided RMS spread, which suggests `b = w` ([`SemiMinorAxis::Width`]). The path-tracer
+//!   comparison decided for `b = w` (the default): it is closer on both beam presets, the
+//!   checker half-space and end to end (docs/physics.md#path-width). Both are available.
 //!
 //! # Numerics
 //! The direct form is used when its intermediate products are normal and finite (everything
@@ -76,10 +77,12 @@ impl Named for MeanSquareAngle {
 /// How the width w of Eq. (2) sets the ellipse's semi-minor axis b.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum SemiMinorAxis {
-    /// `b = w/2`: w is the full minor axis (the paper's literal wording). Default.
-    #[default]
+    /// `b = w/2`: w is the full minor axis (the paper's literal wording;
+    /// [`crate::SoneParams::paper`]).
     HalfWidth,
-    /// `b = w`: w is the semi-minor axis (w read as a one-sided RMS spread).
+    /// `b = w`: w is the semi-minor axis (w read as a one-sided RMS spread). Default: closer
+    /// to the path tracer on every scene measured (docs/physics.md#path-width).
+    #[default]
     Width,
 }
 

@@ -8,7 +8,8 @@
 //! 1. ⟨σs⟩, ⟨σa⟩: area means over the disk of radius d/2 centred at m in that plane (§3.1),
 //!    each sample x' projected to the surface by the two rays ±n_i* from x' (nearer hit;
 //!    §3.2, Figure 3);
-//! 2. w from Eq. (2) with those means ([`crate::path_integral::width`]); b = w/2 or w;
+//! 2. w from Eq. (2) with those means ([`crate::path_integral::width`]); b = w (default) or
+//!    w/2 (the paper's literal wording, [`SoneParams::paper`]);
 //! 3. σ̄s, σ̄a: area means (Eq. (3)) over the ellipse with semi-axes d/2 along x̂ and b along
 //!    n_i* × x̂, projected likewise. The measure is area in the ellipse's plane (not surface
 //!    area after projection), as the paper's sampling implies.
@@ -57,8 +58,9 @@ use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
 
-/// Parameters of the `sone` estimator. Defaults follow the paper's reading
-/// ([`SoneParams::paper`]).
+/// Parameters of the `sone` estimator. Defaults ([`SoneParams::new`]) follow the paper's
+/// reading ([`SoneParams::paper`]) except for the ellipse's semi-minor axis, b = w, which
+/// the path-tracer comparison favours over the literal b = w/2 (docs/physics.md#path-width).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct SoneParams {
@@ -68,7 +70,7 @@ pub struct SoneParams {
     pub ellipse: SampleBudget,
     /// ⟨θ²⟩ in Eq. (2): exact HG value (default) or 2(1 − g).
     pub mean_square_angle: MeanSquareAngle,
-    /// Semi-minor axis from w: w/2 (default, the literal reading) or w.
+    /// Semi-minor axis from w: w (default) or w/2 (the literal reading).
     pub semi_minor: SemiMinorAxis,
     /// Which scattering coefficient (and ⟨θ²⟩) Eq. (2) uses for an anisotropic medium.
     pub width_scattering: WidthScattering,
@@ -129,8 +131,19 @@ impl crate::names::Named for WidthScattering {
 named_display_fromstr!(WidthScattering);
 
 impl SoneParams {
-    /// The paper's reading: exact ⟨θ²⟩, b = w/2, hits only, 16 disk + 32 ellipse samples
-    /// (the paper gives no counts; see the benchmark's standard-deviation table to choose).
+    /// The defaults: the paper's reading ([`SoneParams::paper`]) with b = w, the semi-minor
+    /// axis the path-tracer comparison favours (closer on both beam presets, on the checker
+    /// half-space and end to end; docs/physics.md#path-width). `reproduce` runs
+    /// [`SoneParams::paper`].
+    pub const fn new() -> Self {
+        let mut p = Self::paper();
+        p.semi_minor = SemiMinorAxis::Width;
+        p
+    }
+
+    /// The paper's literal reading: exact ⟨θ²⟩, b = w/2, hits only, 16 disk + 32 ellipse
+    /// samples (the paper gives no counts; see the benchmark's standard-deviation table to
+    /// choose).
     pub const fn paper() -> Self {
         Self {
             disk: SampleBudget::fixed(16),
@@ -144,11 +157,11 @@ impl SoneParams {
         }
     }
 
-    /// The paper's reading with error-controlled sampling, for reference renders: each stage
+    /// The defaults with error-controlled sampling, for reference renders: each stage
     /// samples until the estimated relative standard error of every averaged channel is 1%
     /// (at most 4096 points per stage).
     pub const fn reference() -> Self {
-        Self::paper().with_samples(SampleBudget::TargetRelError {
+        Self::new().with_samples(SampleBudget::TargetRelError {
             rel_se: 0.01,
             max: NonZeroU32::new(4096).unwrap(),
         })
@@ -170,7 +183,7 @@ impl SoneParams {
 
 impl Default for SoneParams {
     fn default() -> Self {
-        Self::paper()
+        Self::new()
     }
 }
 

@@ -75,7 +75,7 @@ impl Method {
     }
 
     /// The same method with Sone's semi-minor axis reading of Eq. (2) replaced by
-    /// `semi_minor` (b = w/2, the literal reading and default, or b = w); other methods and
+    /// `semi_minor` (b = w, the default, or b = w/2, the literal reading); other methods and
     /// `None` leave it unchanged.
     pub fn with_semi_minor(self, semi_minor: Option<het_estimate::SemiMinorAxis>) -> Self {
         match (self, semi_minor) {

@@ -413,6 +413,7 @@ impl<'s> PathIntegrator<'s> {
                                         scene.geometry(),
                                         index as u32,
                                         &t.medium,
+                                        t.correction_seed,
                                         observer,
                                     )
                                     .ok_or_else(|| {

@@ -45,8 +45,9 @@
 //!   from random numbers keyed by the step's index, so that the two walks stay in step
 //!   however many null collisions each takes.
 //! * B by probe sets on the body and on the tangent plane with the same random numbers.
-//! * Points drawn uniformly by area on the object's mesh (fixed seed per object, so renders
-//!   stay deterministic whatever the thread count), about one per h² of surface with h half
+//! * Points drawn uniformly by area on the object's mesh (the material's fixed
+//!   `correction_seed`, keyed per object and point, so renders stay deterministic whatever
+//!   the thread count), about one per h² of surface with h half
 //!   the material's diffusion length, bounded by the object's extent. The raw sums are pooled
 //!   over each point's neighbourhood (a Gaussian of width h, weighted by the agreement of the
 //!   normals so that the two faces of a thin part do not mix) before dividing, with the
@@ -76,8 +77,14 @@ use crate::integrator::warnings::light_reach;
 use crate::rng::Rng;
 use crate::volume::{direction_about, orthonormal_basis};
 
-/// Seed of the correction's random numbers (combined with the object's index and the sample).
-const SEED: u64 = 0x005a_4ec0_77ec;
+/// Which random numbers a sample point's walks and probes draw: the correction's seed
+/// (`Translucent::correction_seed`), combined with the object's index, the point's `index`
+/// and the walk or probe.
+#[derive(Debug, Clone, Copy)]
+struct PointKey {
+    seed: u64,
+    index: u64,
+}
 /// Walks per sample point, channel and direction node.
 pub const WALKS_PER_NODE: u32 = 12;
 /// Probe sets per sample point for B.
@@ -317,11 +324,13 @@ impl Grid {
 
 impl ShapeCorrection {
     /// Measures the correction for `object` rendered by `bssrdf` with `medium`.
+    /// `seed` keys every random number it draws.
     pub fn build(
         bssrdf: &BssrdfObject,
         geometry: &Geometry,
         object: u32,
         medium: &MediumField,
+        seed: u64,
         observer: &dyn PrepareObserver,
     ) -> Option<Self> {
         let t0 = std::time::Instant::now();
@@ -341,6 +350,10 @@ impl ShapeCorrection {
             cdf.push(acc);
         }
         let surface = ObjectSurface { geometry, object };
+        let key = |i: usize| PointKey {
+            seed,
+            index: i as u64,
+        };
         let grey = medium.is_grey();
         // Progress: the walks at each point, then (a faster stage) each fixed-point step's
         // responses.
@@ -354,7 +367,7 @@ impl ShapeCorrection {
             .filter_map(|i| {
                 steps
                     .step(|| {
-                        let mut rng = Rng::from_keys(SEED, &[object as u64, i as u64]);
+                        let mut rng = Rng::from_keys(seed, &[object as u64, i as u64]);
                         let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
                         let coeffs = medium.at_surface(x_o.p, x_o.uv);
                         // In a heterogeneous medium the light x_o sees may come from its most
@@ -366,7 +379,7 @@ impl ShapeCorrection {
                         };
                         let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
                         let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
-                            point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, i as u64)
+                            point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, key(i))
                         });
                         Some((x_o, coeffs, sums))
                     })
@@ -422,14 +435,9 @@ impl ShapeCorrection {
                     steps
                         .step(|| {
                             sums.as_ref()?;
-                            Some(body_response(
-                                bssrdf,
-                                &surface,
-                                x,
-                                *coeffs,
-                                i as u64,
-                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
-                            ))
+                            Some(body_response(bssrdf, &surface, x, *coeffs, key(i), |x_i| {
+                                corr.at(x_i.p, x_i.ns).incident_mean(&weights)
+                            }))
                         })
                         .flatten()
                 })
@@ -632,7 +640,7 @@ fn point_sums(
     coeffs: Coefficients,
     field: Option<&MediumField>,
     grey: bool,
-    index: u64,
+    key: PointKey,
 ) -> Sums {
     let object = surface.object as u64;
     let plane = TangentPlane {
@@ -676,9 +684,9 @@ fn point_sums(
                 let d = j * PHI_NODES + k;
                 let w_o = node_direction(x_o.ns, j, k);
                 for m in 0..WALKS_PER_NODE as u64 {
-                    let keys = [object, index, 1, (d as u64) << 32 | m];
-                    let mut rb = Rng::from_keys(SEED, &keys);
-                    let mut rh = Rng::from_keys(SEED, &keys);
+                    let keys = [object, key.index, 1, (d as u64) << 32 | m];
+                    let mut rb = Rng::from_keys(key.seed, &keys);
+                    let mut rh = Rng::from_keys(key.seed, &keys);
                     p_body[d][ch] += walk.escape(&Boundary::Body(surface), x_o, w_o, &mut rb);
                     p_half[d][ch] += walk.escape(&Boundary::Plane(&plane), x_o, w_o, &mut rh);
                 }
@@ -692,11 +700,11 @@ fn point_sums(
         }
     }
     // B: probes, all channels at once.
-    let b_body = body_response(bssrdf, surface, x_o, coeffs, index, |_| Rgb::ONE);
+    let b_body = body_response(bssrdf, surface, x_o, coeffs, key, |_| Rgb::ONE);
     let mut b_half = Rgb::ZERO;
     let mut counters = PathCounters::default();
     for k in 0..PROBES_PER_POINT as u64 {
-        let mut rng = Rng::from_keys(SEED, &[object, index, 2, k]);
+        let mut rng = Rng::from_keys(key.seed, &[object, key.index, 2, k]);
         for hit in bssrdf.probe_set(&plane, x_o, coeffs, &mut rng).iter() {
             let r = (hit.hit.p - x_o.p).length();
             b_half += counters.eval_profile(&bssrdf.family, coeffs, r) * hit.weight;
@@ -831,13 +839,13 @@ fn body_response(
     surface: &ObjectSurface<'_>,
     x_o: &Hit,
     coeffs: Coefficients,
-    index: u64,
+    key: PointKey,
     g: impl Fn(&Hit) -> Rgb,
 ) -> Rgb {
     let mut sum = Rgb::ZERO;
     let mut counters = PathCounters::default();
     for k in 0..PROBES_PER_POINT as u64 {
-        let mut rng = Rng::from_keys(SEED, &[surface.object as u64, index, 2, k]);
+        let mut rng = Rng::from_keys(key.seed, &[surface.object as u64, key.index, 2, k]);
         for hit in bssrdf.probe_set(surface, x_o, coeffs, &mut rng).iter() {
             let (r, _) = bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters);
             sum += r * g(&hit.hit) * hit.weight;
@@ -1252,6 +1260,9 @@ mod tests {
     use bssrdf_core::ProfileModel;
     use std::sync::atomic::{AtomicU64, Ordering::SeqCst};
 
+    /// The seed of the materials built here ([`Translucent::new`]'s).
+    const SEED: u64 = Translucent::DEFAULT_CORRECTION_SEED;
+
     fn corrected(mesh: TriangleMesh, albedo: f64, eta: f64) -> (Geometry, BssrdfObject) {
         let field = MediumField::homogeneous(Coefficients::grey(1.0 - albedo, albedo)).unwrap();
         corrected_in(mesh, field, eta)
@@ -1270,7 +1281,8 @@ mod tests {
         )
         .unwrap();
         b.correction = Some(
-            ShapeCorrection::build(&b, &geometry, 0, &field, &NoObserver).expect("not stopped"),
+            ShapeCorrection::build(&b, &geometry, 0, &field, t.correction_seed, &NoObserver)
+                .expect("not stopped"),
         );
         (geometry, b)
     }
@@ -1332,7 +1344,7 @@ mod tests {
         );
         let plain = b.correction.as_ref().unwrap();
         let watcher = Watcher::stopping_after(u64::MAX);
-        let watched = ShapeCorrection::build(&b, &geometry, 0, &field, &watcher).unwrap();
+        let watched = ShapeCorrection::build(&b, &geometry, 0, &field, SEED, &watcher).unwrap();
         let (units, done) = watcher.counts();
         // Every point's walks, then every point found at each fixed-point step.
         assert_eq!(units, (plain.samples.len() * (1 + ITERATIONS)) as u64);
@@ -1345,9 +1357,19 @@ mod tests {
                 .all(|(a, b)| a.f == b.f)
         );
         assert_eq!(plain.samples.len(), watched.samples.len());
+        // Another seed draws other points and walks: another estimate of the same thing.
+        let reseeded = ShapeCorrection::build(&b, &geometry, 0, &field, 7, &NoObserver).unwrap();
+        assert!(
+            plain
+                .samples
+                .iter()
+                .zip(&reseeded.samples)
+                .any(|(a, b)| a.f != b.f),
+            "the seed changed no factor"
+        );
 
         let stopping = Watcher::stopping_after(5);
-        assert!(ShapeCorrection::build(&b, &geometry, 0, &field, &stopping).is_none());
+        assert!(ShapeCorrection::build(&b, &geometry, 0, &field, SEED, &stopping).is_none());
         let (units, done) = stopping.counts();
         let threads = rayon::current_num_threads() as u64;
         assert!(
@@ -1358,7 +1380,7 @@ mod tests {
         for blink in [10, plain.samples.len() as u64 + 5] {
             let blinking = Watcher::blinking_at(blink);
             assert!(
-                ShapeCorrection::build(&b, &geometry, 0, &field, &blinking).is_none(),
+                ShapeCorrection::build(&b, &geometry, 0, &field, SEED, &blinking).is_none(),
                 "poll {blink}"
             );
         }
@@ -1628,7 +1650,8 @@ mod tests {
             )
             .unwrap();
             let corr =
-                ShapeCorrection::build(&b, &geometry, 0, &field, &NoObserver).expect("not stopped");
+                ShapeCorrection::build(&b, &geometry, 0, &field, t.correction_seed, &NoObserver)
+                    .expect("not stopped");
             let x = hit_from_above(
                 &geometry,
                 DVec3::ZERO,

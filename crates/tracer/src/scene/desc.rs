@@ -315,6 +315,9 @@ pub struct TranslucentDesc {
     /// Scale the BSSRDF by the shape correction measured in the object (default false;
     /// `Translucent::shape_correction`).
     pub shape_correction: Option<bool>,
+    /// Seed of the shape correction's random numbers (only with `shape_correction = true`;
+    /// `Translucent::correction_seed`).
+    pub shape_correction_seed: Option<u64>,
     /// With the tabulated profile, scale it by the half-space's angular coupling (default
     /// true; `Translucent::angular_coupling`).
     pub angular_coupling: Option<bool>,

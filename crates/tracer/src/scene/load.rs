@@ -628,6 +628,12 @@ impl Cx {
             }
             (g, a) => g.or(a).unwrap_or(0.0),
         };
+        if d.shape_correction_seed.is_some() && d.shape_correction != Some(true) {
+            return Err(self.invalid(
+                &format!("{key}.shape_correction_seed"),
+                "a seed for the shape correction, which is off: add `shape_correction = true`",
+            ));
+        }
         // Validate the scalar values now with placeholder constant fields (so that unused
         // materials are checked too).
         let probe = Translucent {
@@ -638,6 +644,9 @@ impl Cx {
             profile,
             thickness_aware: d.thickness_aware.unwrap_or(true),
             shape_correction: d.shape_correction.unwrap_or(false),
+            correction_seed: d
+                .shape_correction_seed
+                .unwrap_or(Translucent::DEFAULT_CORRECTION_SEED),
             angular_coupling: d.angular_coupling.unwrap_or(true),
             unit_scale: d.unit_scale,
             key: key.to_string(),

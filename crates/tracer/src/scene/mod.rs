@@ -128,6 +128,10 @@ pub struct Translucent {
     /// preparation costs seconds to minutes (more with higher albedo and larger objects).
     /// Scene key `shape_correction`; default false.
     pub shape_correction: bool,
+    /// Seed of the shape correction's random numbers (scene key `shape_correction_seed`;
+    /// default [`Translucent::DEFAULT_CORRECTION_SEED`]). The correction is a Monte Carlo
+    /// measurement made once per render; another seed shows its own spread.
+    pub correction_seed: u64,
     /// Whether a BSSRDF render with the tabulated profile scales it by the half-space's
     /// angular coupling T(α, μ_i, μ_o) (`bssrdf_core::tabulated::angular`, docs/tabulated-profile.md):
     /// exact for a flat half-space in every pair of directions, not only at normal incidence.
@@ -142,6 +146,9 @@ pub struct Translucent {
 }
 
 impl Translucent {
+    /// The shape correction's seed when the scene gives none.
+    pub const DEFAULT_CORRECTION_SEED: u64 = 0x005a_4ec0_77ec;
+
     /// What a BSSRDF render of this material prepares once: the profile family of `model` (or
     /// the material's own `profile`, or [`ProfileModel::default_for`] its η) counting `scattering`, with the material's
     /// g and η, and `estimator` prepared for its g. The error names the failing part
@@ -176,6 +183,7 @@ impl Translucent {
             profile: None,
             thickness_aware: true,
             shape_correction: false,
+            correction_seed: Self::DEFAULT_CORRECTION_SEED,
             angular_coupling: true,
             unit_scale: 1.0,
             line: None,

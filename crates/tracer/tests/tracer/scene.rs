@@ -617,3 +617,37 @@ fn the_default_profile_is_tabulated_where_it_applies() {
         );
     }
 }
+
+/// `shape_correction_seed` reaches the material (the correction's own Monte Carlo seed);
+/// without it the material has the default seed; given while the correction is off, it is an
+/// error naming the key.
+#[test]
+fn shape_correction_seed_is_read_and_needs_the_correction() {
+    use tracer::scene::{Material, Translucent};
+    let with = |keys: &str| MINIMAL.replace("sigma_s = 1.0\n", &format!("sigma_s = 1.0\n{keys}"));
+    let seed_of = |text: &str| {
+        let s = Scene::from_toml_str(text, Path::new("."), "s.toml").unwrap();
+        match &s.objects()[0].material {
+            Material::Translucent(t) => (t.shape_correction, t.correction_seed),
+            other => panic!("not translucent: {other:?}"),
+        }
+    };
+    assert_eq!(
+        seed_of(&with(
+            "shape_correction = true\nshape_correction_seed = 7\n"
+        )),
+        (true, 7)
+    );
+    assert_eq!(
+        seed_of(&with("shape_correction = true\n")),
+        (true, Translucent::DEFAULT_CORRECTION_SEED)
+    );
+    for off in ["", "shape_correction = false\n"] {
+        let e = load_err(&with(&format!("{off}shape_correction_seed = 7\n")));
+        check(
+            &e,
+            "material[0].shape_correction_seed",
+            &["shape_correction = true"],
+        );
+    }
+}
