@@ -81,7 +81,8 @@ pub enum SemiMinorAxis {
     /// [`crate::SoneParams::paper`]).
     HalfWidth,
     /// `b = w`: w is the semi-minor axis (w read as a one-sided RMS spread). Default: closer
-    /// to the path tracer on every scene measured (docs/physics.md#path-width).
+    /// to the path tracer on both beam presets, the checker half-space and the bunny, though
+    /// not on every figure measured (docs/physics.md#path-width).
     #[default]
     Width,
 }

@@ -77,13 +77,32 @@ use crate::integrator::warnings::light_reach;
 use crate::rng::Rng;
 use crate::volume::{direction_about, orthonormal_basis};
 
-/// Which random numbers a sample point's walks and probes draw: the correction's seed
-/// (`Translucent::correction_seed`), combined with the object's index, the point's `index`
-/// and the walk or probe.
+/// Which random numbers a sample point draws: the correction's seed
+/// (`Translucent::correction_seed`), combined with the object's index and the point's.
+/// Every generator of the correction comes from here, so the keys are spelled once.
 #[derive(Debug, Clone, Copy)]
 struct PointKey {
     seed: u64,
+    object: u64,
     index: u64,
+}
+
+impl PointKey {
+    /// Stream of the walks ([`PointKey::rng`]); `k` packs the direction node and the walk.
+    const WALKS: u64 = 1;
+    /// Stream of the probe sets; the body's and the tangent plane's share it, so that their
+    /// probes are paired (common random numbers).
+    const PROBES: u64 = 2;
+
+    /// The generator that places the point on the surface.
+    fn placement(self) -> Rng {
+        Rng::from_keys(self.seed, &[self.object, self.index])
+    }
+
+    /// The generator of draw `k` of `stream` ([`PointKey::WALKS`] or [`PointKey::PROBES`]).
+    fn rng(self, stream: u64, k: u64) -> Rng {
+        Rng::from_keys(self.seed, &[self.object, self.index, stream, k])
+    }
 }
 /// Walks per sample point, channel and direction node.
 pub const WALKS_PER_NODE: u32 = 12;
@@ -352,6 +371,7 @@ impl ShapeCorrection {
         let surface = ObjectSurface { geometry, object };
         let key = |i: usize| PointKey {
             seed,
+            object: object as u64,
             index: i as u64,
         };
         let grey = medium.is_grey();
@@ -367,7 +387,7 @@ impl ShapeCorrection {
             .filter_map(|i| {
                 steps
                     .step(|| {
-                        let mut rng = Rng::from_keys(seed, &[object as u64, i as u64]);
+                        let mut rng = key(i).placement();
                         let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
                         let coeffs = medium.at_surface(x_o.p, x_o.uv);
                         // In a heterogeneous medium the light x_o sees may come from its most
@@ -642,7 +662,6 @@ fn point_sums(
     grey: bool,
     key: PointKey,
 ) -> Sums {
-    let object = surface.object as u64;
     let plane = TangentPlane {
         p0: x_o.p,
         n: x_o.ng,
@@ -684,9 +703,9 @@ fn point_sums(
                 let d = j * PHI_NODES + k;
                 let w_o = node_direction(x_o.ns, j, k);
                 for m in 0..WALKS_PER_NODE as u64 {
-                    let keys = [object, key.index, 1, (d as u64) << 32 | m];
-                    let mut rb = Rng::from_keys(key.seed, &keys);
-                    let mut rh = Rng::from_keys(key.seed, &keys);
+                    let draw = (d as u64) << 32 | m;
+                    let mut rb = key.rng(PointKey::WALKS, draw);
+                    let mut rh = key.rng(PointKey::WALKS, draw);
                     p_body[d][ch] += walk.escape(&Boundary::Body(surface), x_o, w_o, &mut rb);
                     p_half[d][ch] += walk.escape(&Boundary::Plane(&plane), x_o, w_o, &mut rh);
                 }
@@ -704,7 +723,7 @@ fn point_sums(
     let mut b_half = Rgb::ZERO;
     let mut counters = PathCounters::default();
     for k in 0..PROBES_PER_POINT as u64 {
-        let mut rng = Rng::from_keys(key.seed, &[object, key.index, 2, k]);
+        let mut rng = key.rng(PointKey::PROBES, k);
         for hit in bssrdf.probe_set(&plane, x_o, coeffs, &mut rng).iter() {
             let r = (hit.hit.p - x_o.p).length();
             b_half += counters.eval_profile(&bssrdf.family, coeffs, r) * hit.weight;
@@ -845,7 +864,7 @@ fn body_response(
     let mut sum = Rgb::ZERO;
     let mut counters = PathCounters::default();
     for k in 0..PROBES_PER_POINT as u64 {
-        let mut rng = Rng::from_keys(key.seed, &[surface.object as u64, key.index, 2, k]);
+        let mut rng = key.rng(PointKey::PROBES, k);
         for hit in bssrdf.probe_set(surface, x_o, coeffs, &mut rng).iter() {
             let (r, _) = bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters);
             sum += r * g(&hit.hit) * hit.weight;
