@@ -91,10 +91,7 @@ fn main() {
         let want = family.profile(0.05, 1.0).unwrap().total() / std::f64::consts::PI
             * PROBE_ENERGY_FRACTION;
         for est in ["jensen-out", "sone"] {
-            let method = Method::Bssrdf {
-                estimator: est.parse().unwrap(),
-                profile: Some(model),
-            };
+            let method = Method::bssrdf(est.parse().unwrap(), Some(model));
             row(
                 &format!("{model}, {est}"),
                 half_space::mean_and_se(&scene, method, Scattering::Multiple, 256, 16),

@@ -61,10 +61,7 @@ fn constant_colour_half_space_renders_as_its_colour_for_every_profile() {
         for eta in [1.0, 1.3] {
             for colour in [Rgb::new(0.8, 0.5, 0.2), Rgb::splat(0.3)] {
                 let scene = uniform_half_space(artist_medium(colour, 1.0, model, eta), model, eta);
-                let method = Method::Bssrdf {
-                    estimator: "jensen-in".parse().unwrap(),
-                    profile: Some(model),
-                };
+                let method = Method::bssrdf("jensen-in".parse().unwrap(), Some(model));
                 let (m, se) = mean_and_se_rgb(&scene, method, 256, 8);
                 for k in 0..3 {
                     let want = expected(colour[k], eta);
@@ -204,10 +201,7 @@ fn painted_box_renders_under_every_estimator() {
             .build()
             .unwrap();
         for estimator in <het_estimate::Estimator as het_estimate::Named>::ALL {
-            let method = Method::Bssrdf {
-                estimator: *estimator,
-                profile: Some(model),
-            };
+            let method = Method::bssrdf(*estimator, Some(model));
             let (m, _) = mean_and_se_rgb(&scene, method, 8, 2);
             for k in 0..3 {
                 assert!(
@@ -297,10 +291,7 @@ fn radius_limits_render_finite() {
         );
     }
     for estimator in <het_estimate::Estimator as het_estimate::Named>::ALL {
-        let method = Method::Bssrdf {
-            estimator: *estimator,
-            profile: None,
-        };
+        let method = Method::bssrdf(*estimator, None);
         let (m, _) = mean_and_se_rgb(&huge, method, 4, 2);
         for k in 0..3 {
             assert!(

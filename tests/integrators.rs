@@ -77,10 +77,7 @@ fn bssrdf_render_of_a_half_space_matches_the_dipole_closed_form() {
     let r_tot = 0.5 * alpha * (-root).exp() * (1.0 + (-4.0 / 3.0 * a * root).exp());
     let want = r_tot / std::f64::consts::PI * tracer::integrator::probe::PROBE_ENERGY_FRACTION;
     for name in ["jensen-out", "endpoints", "segment", "sone"] {
-        let method = Method::Bssrdf {
-            estimator: name.parse().unwrap(),
-            profile: Some(ProfileModel::Dipole),
-        };
+        let method = Method::bssrdf(name.parse().unwrap(), Some(ProfileModel::Dipole));
         let (m, se) = mean_and_se(&scene, method, Scattering::Multiple, 64, 8);
         let tol = 4.0 * se + 3e-4 * want;
         assert!(

@@ -144,24 +144,10 @@ fn check_reciprocity(scene: &Scene, count: usize) {
     let mut s_jensen_differs = 0;
     for e in estimators() {
         let prepared = e.prepare(material.g, material.eta).unwrap();
-        let integrator = PathIntegrator::new(
-            scene,
-            Method::Bssrdf {
-                estimator: e,
-                profile: None,
-            },
-            OPTIONS,
-        )
-        .unwrap();
-        let jensen_out = PathIntegrator::new(
-            scene,
-            Method::Bssrdf {
-                estimator: Estimator::JensenOut,
-                profile: None,
-            },
-            OPTIONS,
-        )
-        .unwrap();
+        let integrator = PathIntegrator::new(scene, Method::bssrdf(e, None), OPTIONS).unwrap();
+        let jensen_out =
+            PathIntegrator::new(scene, Method::bssrdf(Estimator::JensenOut, None), OPTIONS)
+                .unwrap();
         for (k, (a, b)) in list.iter().enumerate() {
             normals_differ += usize::from(a.ns != b.ns);
             let rng = || Rng::from_keys(9, &[k as u64]);
@@ -379,10 +365,7 @@ fn camera_traced(scene: &Scene, estimator: Estimator, spp: u32) -> Blocks {
 
 /// [`camera_traced`] with seeds `first..first + SEEDS`.
 fn camera_traced_seeds(scene: &Scene, estimator: Estimator, spp: u32, first: u64) -> Blocks {
-    let method = Method::Bssrdf {
-        estimator,
-        profile: None,
-    };
+    let method = Method::bssrdf(estimator, None);
     let integrator = PathIntegrator::new(scene, method, OPTIONS).unwrap();
     let images: Vec<Vec<Rgb>> = (0..SEEDS)
         .map(|s| {
@@ -405,10 +388,7 @@ fn light_traced_seeds(
     paths: u64,
     first: u64,
 ) -> Blocks {
-    let method = Method::Bssrdf {
-        estimator,
-        profile: None,
-    };
+    let method = Method::bssrdf(estimator, None);
     let tracer = LightTracer::new(scene, method, OPTIONS)
         .unwrap()
         .with_roles(roles);
@@ -560,7 +540,7 @@ fn light_traced_sone_agrees_with_camera_traced_sone_with_the_shape_correction() 
                 "ball",
                 primitives::icosphere(DVec3::new(0.0, 0.0, -1.0), 1.0, 4),
                 Material::Translucent(Translucent {
-                    shape_correction: corrected,
+                    shape_correction: Some(corrected),
                     ..Translucent::new("m", field, 0.0, 1.0)
                 }),
             )
@@ -583,15 +563,7 @@ fn light_traced_sone_agrees_with_camera_traced_sone_with_the_shape_correction() 
 #[test]
 fn light_traced_renders_are_identical_whatever_the_thread_count() {
     let scene = slab_scene(1.3, 8, true);
-    let tracer = LightTracer::new(
-        &scene,
-        Method::Bssrdf {
-            estimator: sone(),
-            profile: None,
-        },
-        OPTIONS,
-    )
-    .unwrap();
+    let tracer = LightTracer::new(&scene, Method::bssrdf(sone(), None), OPTIONS).unwrap();
     // More than one batch of chunks, and a last chunk that is not full.
     let opts = LightTraceOptions {
         paths: 70 * 4096 + 123,
@@ -615,10 +587,7 @@ fn light_traced_renders_are_identical_whatever_the_thread_count() {
 fn light_tracer_refuses_what_it_cannot_render() {
     use tracer::integrator::LightTraceError;
     let scene = slab_scene(1.0, 4, false);
-    let sone_method = Method::Bssrdf {
-        estimator: sone(),
-        profile: None,
-    };
+    let sone_method = Method::bssrdf(sone(), None);
     assert!(matches!(
         LightTracer::new(&scene, Method::PathTraced, OPTIONS),
         Err(LightTraceError::NotBssrdf)

@@ -183,7 +183,7 @@ pub fn shape_scene_with(
 ) -> Scene {
     shape_scene_material(shape, medium, bunny, |m| Translucent {
         thickness_aware,
-        shape_correction,
+        shape_correction: Some(shape_correction),
         ..m
     })
 }
@@ -316,8 +316,5 @@ pub fn ratio((a, sa): (f64, f64), (b, sb): (f64, f64)) -> (f64, f64) {
 /// The BSSRDF method used for homogeneous shapes: the estimator plays no part (a constant
 /// field short-circuits), so the cheapest one, with `profile`.
 pub fn bssrdf(profile: ProfileModel) -> Method {
-    Method::Bssrdf {
-        estimator: "jensen-out".parse().unwrap(),
-        profile: Some(profile),
-    }
+    Method::bssrdf("jensen-out".parse().unwrap(), Some(profile))
 }

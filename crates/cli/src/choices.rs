@@ -46,9 +46,9 @@ where
     }
 }
 
-/// `pt` or an estimator name.
+/// `pt`, `auto` or an estimator name.
 pub fn method() -> Choice<Method> {
-    let mut names = vec!["pt"];
+    let mut names = vec!["pt", "auto"];
     names.extend(Estimator::ALL.iter().map(|e| e.name()));
     by_name(names)
 }
@@ -91,4 +91,9 @@ pub fn invert() -> Choice<tracer::field::InvertAt> {
             .map(|i| i.name())
             .collect(),
     )
+}
+
+/// A shape-correction choice (`auto`, `on`, `off`).
+pub fn correction() -> Choice<tracer::integrator::Correction> {
+    by_name(tracer::integrator::Correction::NAMES.to_vec())
 }

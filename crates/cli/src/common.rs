@@ -85,22 +85,19 @@ pub fn warn_counters(c: &PathCounters) {
             c.estimator_fallbacks
         );
     }
-    if c.prefiltered + c.prefilter_fallbacks > 0 {
+    if c.prefiltered + c.prefilter_fallbacks + c.lifted > 0 {
         let charts = if c.chart_fallbacks > 0 {
             format!(
-                ", {} where its texture coordinates were not one affine map",
+                " ({} of them where the texture coordinates were not one affine map)",
                 c.chart_fallbacks
             )
         } else {
             String::new()
         };
         eprintln!(
-            "averaging: {} of {} estimates prefiltered (sone: closed-form footprints; kernel: \
-             points read in the surface's plane); sampled: {} where the surface was too curved \
-             for a flat footprint{charts}",
-            c.prefiltered,
-            c.estimates,
-            c.prefilter_fallbacks - c.chart_fallbacks
+            "averaging: of {} estimates, {} read a region in closed form, {} sampled a region on \
+             the surface's local quadric (no rays), {} projected a region by rays{charts}",
+            c.estimates, c.prefiltered, c.lifted, c.prefilter_fallbacks
         );
     }
 }

@@ -40,11 +40,20 @@ pub enum Trace {
 pub struct Args {
     /// The scene file (TOML).
     scene: PathBuf,
-    /// `pt` (the path-traced reference) or a BSSRDF estimator: jensen-in, jensen-out,
-    /// endpoints, segment, sone, kernel. Default: the scene's `render.estimator`, else `sone`.
+    /// `auto` (default): each translucent object with the scene's `render.estimator` (else
+    /// `sone`) where a half-space profile fits, and the path tracer inside objects too small
+    /// for one (the sidecar's `objects` says which). `pt`: the path-traced reference
+    /// everywhere. An estimator (jensen-in, jensen-out, endpoints, segment, sone, kernel): that
+    /// BSSRDF on every object.
     #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
-    /// Profile model for BSSRDF methods (default: each material's, else dipole).
+    /// Shape correction of BSSRDF objects (docs/shapes.md): `auto` (default) corrects the
+    /// objects too small for a half-space profile, unless their material says
+    /// `shape_correction = false`; `on` corrects every one, `off` none.
+    #[arg(long, value_parser = crate::choices::correction())]
+    shape_correction: Option<tracer::integrator::Correction>,
+    /// Profile model for BSSRDF methods (default: each material's, else the tabulated exact
+    /// profile where it applies (η ≤ 1.6), else photon beam diffusion).
     #[arg(long, value_parser = crate::choices::profile())]
     profile: Option<ProfileModel>,
     /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
@@ -110,13 +119,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let method = match args.method {
         Some(m) => m,
-        None => Method::Bssrdf {
-            estimator: scene
+        None => Method::auto(
+            scene
                 .settings()
                 .estimator
                 .unwrap_or(Estimator::Sone(SoneParams::new())),
-            profile: None,
-        },
+        ),
+    };
+    if args.shape_correction.is_some() && method == Method::PathTraced {
+        bail!("--shape-correction does not apply to `pt`: it corrects BSSRDF objects");
+    }
+    let method = match args.shape_correction {
+        Some(c) => method.with_correction(c),
+        None => method,
     };
     check_method_flags(
         &[method],

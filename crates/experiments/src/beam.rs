@@ -617,6 +617,7 @@ pub fn run_method(
         tracer::integrator::Method::Bssrdf {
             estimator,
             profile: p,
+            ..
         } => bssrdf_map(setup, estimator, p.unwrap_or(profile), sub, seed, progress),
     }
 }

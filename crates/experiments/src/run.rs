@@ -86,6 +86,8 @@ pub struct RenderOutcome {
     pub warnings: Vec<String>,
     /// What the preparation did that a user may want to know (see [`PathIntegrator::notes`]).
     pub notes: Vec<String>,
+    /// How each translucent object was rendered (see [`PathIntegrator::object_plans`]).
+    pub objects: Vec<(String, tracer::integrator::plan::ObjectPlan)>,
     /// True when the render was interrupted: `spp` counts the completed passes only.
     pub interrupted: bool,
     /// True for a checkpoint written while the render goes on (`spp` so far).
@@ -113,6 +115,7 @@ impl RenderOutcome {
             method,
             warnings: Vec::new(),
             notes: Vec::new(),
+            objects: Vec::new(),
             interrupted: false,
             checkpoint: true,
         }
@@ -214,6 +217,7 @@ pub fn render_prepared(
         method: integrator.method().name().to_string(),
         warnings: integrator.warnings().to_vec(),
         notes: integrator.notes(),
+        objects: integrator.object_plans(),
         interrupted,
         checkpoint: false,
     }
@@ -354,6 +358,19 @@ pub fn write_render(
         "wall_seconds": outcome.seconds,
         "prepare_seconds": outcome.prepare_seconds,
         "notes": outcome.notes,
+        "objects": outcome
+            .objects
+            .iter()
+            .map(|(name, p)| json!({
+                "name": name,
+                "rendered_by": match job.method {
+                    Method::Bssrdf { estimator, .. } if !p.path_traced => estimator.name(),
+                    _ => "pt",
+                },
+                "shape_correction": p.corrected,
+                "optically_small": p.small,
+            }))
+            .collect::<Vec<_>>(),
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,

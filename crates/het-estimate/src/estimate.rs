@@ -65,11 +65,16 @@ pub struct Diagnostics {
     /// Ellipse averages answered by [`crate::CoefficientField::ellipse_average`] instead of
     /// sampling (Sone: up to 1 for the disk + 3 for the ellipses).
     pub field_averages: u8,
-    /// Prefiltered averaging was asked for and the field offers it, but the surface was too
-    /// curved for a flat footprint ([`crate::Flatness`]), or, for a field read through texture
-    /// coordinates, the charts at x_i and x_o disagreed ([`crate::UvChart::between`]): the
-    /// regions were sampled instead.
+    /// Prefiltered averaging was asked for, but some region had to be projected by rays
+    /// ([`crate::Flatness`]): the surface departs too far from its local quadric there (a
+    /// crease, a corner, a thin part, a region spanning much of a small object), or, for a
+    /// field read through texture coordinates, the charts at x_i and x_o disagreed
+    /// ([`crate::UvChart::between`]).
     pub prefilter_fallback: bool,
+    /// Some region was sampled at points placed on the pair's local quadric, without rays
+    /// ([`crate::local_surface`]): the surface was too curved for the flat footprint, but
+    /// smooth enough for the quadric.
+    pub lifted: bool,
     /// Of those, a flat pair whose texture-coordinate charts disagreed (a seam or a stretch
     /// between x_i and x_o, [`crate::UvChart::between`]).
     pub chart_fallback: bool,

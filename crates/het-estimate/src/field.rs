@@ -102,6 +102,25 @@ pub trait CoefficientField<P> {
         None
     }
 
+    /// Optional capability for curved surfaces: the length L (scene units) that scales how
+    /// the field's reading over `region` moves when the surface departs from the region's
+    /// plane: displacing every point by at most δ along `region.normal` moves the region's
+    /// average by about (2/π)·δ/L of the field's contrast at most
+    /// (`docs/physics.md#prefiltered-averages`, "Curved surfaces"). With ĝ the unit direction
+    /// in which a displacement along the normal moves the field's own coordinates, s the
+    /// field's feature size along ĝ (a stripe's or a check's width, a texel) and h the
+    /// region's half extent along ĝ in those coordinates, L = max(s, h)/|sensitivity|
+    /// (|sensitivity| the fraction of a normal displacement that moves the coordinates:
+    /// |ĝ·n| for a stripe, the sine of the normal's angle to a planar projection's axis). A
+    /// field that does not change along the normal (a constant, a planar projection seen
+    /// along its axis, texture coordinates, which a chart reads in the tangent plane) returns
+    /// `f64::INFINITY`. `None` (the default): unknown; the estimators then prefilter only
+    /// pairs that are flat by [`crate::Flatness`]'s angle test, and project the rest.
+    fn displacement_scale(&self, region: &PlanarEllipse) -> Option<f64> {
+        let _ = region;
+        None
+    }
+
     /// True when [`CoefficientField::ellipse_average`] (or, for a field that
     /// [reads texture coordinates](CoefficientField::reads_uv),
     /// [`CoefficientField::ellipse_average_in_chart`]) can answer (for some regions). The
@@ -225,6 +244,9 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     }
     fn has_ellipse_average(&self) -> bool {
         (**self).has_ellipse_average()
+    }
+    fn displacement_scale(&self, region: &PlanarEllipse) -> Option<f64> {
+        (**self).displacement_scale(region)
     }
     fn reads_uv(&self) -> bool {
         (**self).reads_uv()

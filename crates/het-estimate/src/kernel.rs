@@ -335,14 +335,26 @@ where
     };
     let n = params.sample_count() as usize;
     let miss_endpoints = params.misses == MissPolicy::Endpoints;
-    // Flat pairs of a field defined in space, or read through texture coordinates that are
-    // one affine map over the region: the plane's points are the surface's.
-    let in_plane = params.averaging == Averaging::Prefiltered
+    // Points near the chord are read on the pair's local quadric (in the plane, where the
+    // pair is flat) for a field defined in space, or read through texture coordinates that
+    // are one affine map over the region; the others are projected by rays.
+    let lift_radius = if params.averaging == Averaging::Prefiltered
         && (probe.field.has_point_lookup() || probe.field.reads_uv())
-        && probe.plane_stands_for_surface(params.flatness, chord.x_hat);
-    if in_plane {
-        probe.diag.field_averages += 1;
-    }
+    {
+        probe.prepare_prefilter(params.flatness, &chord);
+        let radius = probe.lifting_radius(&chord.ellipse(chord.half_len));
+        if radius > 0.0 {
+            probe.diag.field_averages += 1;
+            if radius < f64::INFINITY {
+                probe.diag.lifted = true;
+            }
+        } else {
+            probe.diag.prefilter_fallback = true;
+        }
+        radius
+    } else {
+        0.0
+    };
     let set = DiskPoints::new(rng);
     // Uninitialised storage: zeroing 72 KiB per estimate would cost more than the estimate.
     let mut store = [const { MaybeUninit::<Sample>::uninit() }; KernelParams::MAX_SAMPLES as usize];
@@ -353,7 +365,6 @@ where
     // stored samples.
     let mut origins = [DVec3::ZERO; CHUNK];
     let mut found = [None; CHUNK];
-    let mut read = [Coefficients::default(); CHUNK];
     let (mut rho, mut inv_q) = ([(0.0, 0.0); CHUNK], [0.0; CHUNK]);
     for first in (0..n).step_by(CHUNK) {
         let m = CHUNK.min(n - first);
@@ -363,13 +374,13 @@ where
             rho[j] = proposal.distances(p);
             inv_q[j] = proposal.inv_pdf(rho[j]);
         }
-        if in_plane && probe.lookup_at_points(&origins[..m], &mut read[..m]) {
-            for (f, &c) in found[..m].iter_mut().zip(&read[..m]) {
-                *f = Some(c);
-            }
-        } else {
-            probe.project_values(&origins[..m], chord.normal, &mut found[..m]);
-        }
+        probe.lift_or_project(
+            &origins[..m],
+            chord.mid,
+            lift_radius,
+            chord.normal,
+            &mut found[..m],
+        );
         if miss_endpoints {
             for f in &mut found[..m] {
                 f.get_or_insert_with(|| probe.endpoints());

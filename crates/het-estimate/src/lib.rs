@@ -57,6 +57,7 @@ pub mod green;
 pub mod kernel;
 pub mod kernel_table;
 mod known;
+pub mod local_surface;
 pub mod path_integral;
 pub mod pattern;
 mod point_lookup;
@@ -80,6 +81,7 @@ pub use field::{CoefficientField, Coefficients, FieldBounds};
 /// use the same glam version as this crate.
 pub use glam;
 pub use kernel::KernelParams;
+pub use local_surface::Curvature;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use prefilter::{Averaging, Flatness};

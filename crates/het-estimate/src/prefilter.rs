@@ -73,38 +73,64 @@ impl Averaging {
     }
 }
 
-/// When a flat footprint stands for the projected region: the fallback criterion of
-/// prefiltered averaging.
+/// When a flat footprint, or the pair's local surface model, stands for the projected region:
+/// the fallback criterion of prefiltered averaging (`docs/physics.md#prefiltered-averages`,
+/// "Curved surfaces").
 ///
-/// A pair (x_i, x_o) is *flat* when the normals at x_i and x_o differ by at most
-/// `max_normal_angle`, and the chord leaves each tangent plane by at most that angle
-/// (|n·x̂| ≤ sin θ, which on a sphere of radius R is θ = d/(2R)). Otherwise the region is
-/// sampled and the estimate is counted in [`crate::Diagnostics::prefilter_fallback`], so that
-/// accuracy never drops silently.
+/// # By error
+/// Where the surface reports its curvature ([`crate::SurfaceQuery::curvature`]; a surface that
+/// does not is taken as flat between the ends, its curvature counted as model error) and the
+/// field says how displacements along the plane's normal move its readings
+/// ([`crate::CoefficientField::displacement_scale`], a length L), each region is read
+/// * in closed form (the flat footprint) when the surface stays within `tolerance`·L of the
+///   region's plane: the height of the pair's local quadric over the region plus the bound on
+///   its error ([`crate::local_surface`]);
+/// * at points placed on the model without rays, when the model's error alone is within
+///   `tolerance`·L (and the model bends by at most [`crate::local_surface::MAX_BEND`] over the
+///   region);
+/// * by projection rays otherwise (creases, corners, thin parts, regions that span much of a
+///   small object), counted in [`crate::Diagnostics::prefilter_fallback`].
 ///
-/// What the bound means: on a surface of curvature radius R, a chord of length d ≤ θR sags by
-/// about d²/(8R) ≤ θd/8 below its midpoint; a flat footprint shifts the projected points by
-/// at most that, i.e. ≤ 0.44 % of the chord at the default θ = 2°. The criterion sees only
-/// the two end normals: a bump between x_i and x_o, or curvature across the chord beyond the
-/// endpoints' reach (a minor axis b ≫ d/2), is not detected.
+/// A displacement δ of the points along the normal moves a band or cell edge of the field
+/// across the region by δ/L of the footprint (L = max(feature, footprint extent)/|sensitivity|,
+/// see the field's method), so the average moves by about (2/π)·δ/L of the contrast at most.
+///
+/// # By angle
+/// For fields that do not give L (the trait's default), the older test applies: a pair is
+/// *flat* when the normals at x_i and x_o differ by at most `max_normal_angle`, and the chord
+/// leaves each tangent plane by at most that angle (|n·x̂| ≤ sin θ, which on a sphere of
+/// radius R is θ = d/(2R)); otherwise the region is projected by rays. On a surface of
+/// curvature radius R, a chord of length d ≤ θR sags by about d²/(8R) ≤ θd/8 below its
+/// midpoint: ≤ 0.44 % of the chord at the default θ = 2°. That test sees only the two end
+/// normals: a bump between x_i and x_o, or curvature across the chord beyond the endpoints'
+/// reach (a minor axis b ≫ d/2), is not detected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Flatness {
     /// θ, radians (default 2° = 0.0349), with its sine and cosine.
     max_normal_angle: f64,
     sin: f64,
     cos: f64,
+    /// The largest displacement of a region's points along its normal, as a fraction of the
+    /// field's displacement scale L, that a reading may leave unaccounted (default 0.05).
+    tolerance: f64,
 }
 
 impl Flatness {
-    /// θ = 2° (its sine and cosine are those `sin_cos` gives, checked by a test).
+    /// The default displacement tolerance: 5 % of the field's displacement scale, an error of
+    /// at most about 3 % of the field's contrast in one region's average (type docs).
+    pub const DEFAULT_TOLERANCE: f64 = 0.05;
+
+    /// θ = 2° (its sine and cosine are those `sin_cos` gives, checked by a test), tolerance
+    /// [`Flatness::DEFAULT_TOLERANCE`].
     pub const DEFAULT: Flatness = Flatness {
         max_normal_angle: 2.0 * std::f64::consts::PI / 180.0,
         sin: 0.03489949670250097,
         cos: 0.9993908270190958,
+        tolerance: Self::DEFAULT_TOLERANCE,
     };
 
-    /// The criterion with θ = `max_normal_angle` radians; a negative or non-finite angle is
-    /// an error.
+    /// The criterion with θ = `max_normal_angle` radians and the default tolerance; a
+    /// negative or non-finite angle is an error.
     pub fn new(max_normal_angle: f64) -> Result<Self, bssrdf_core::ParamError> {
         let theta =
             crate::names::check_non_negative("flatness.max_normal_angle", max_normal_angle)?;
@@ -113,7 +139,16 @@ impl Flatness {
             max_normal_angle: theta,
             sin,
             cos,
+            tolerance: Self::DEFAULT_TOLERANCE,
         })
+    }
+
+    /// The same criterion with displacement tolerance `tolerance` (a fraction of the field's
+    /// displacement scale; 0 admits only regions the model says are exactly flat); a
+    /// negative or non-finite value is an error.
+    pub fn with_tolerance(self, tolerance: f64) -> Result<Self, bssrdf_core::ParamError> {
+        let tolerance = crate::names::check_non_negative("flatness.tolerance", tolerance)?;
+        Ok(Self { tolerance, ..self })
     }
 
     /// θ, radians.
@@ -121,8 +156,13 @@ impl Flatness {
         self.max_normal_angle
     }
 
+    /// The displacement tolerance (a fraction of the field's displacement scale).
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
     /// True when the pair with unit normals `n_i`, `n_o` and unit chord direction `x_hat`
-    /// is flat by the criterion above. Non-finite input is not flat.
+    /// is flat by the angle test above. Non-finite input is not flat.
     #[inline]
     pub fn is_flat(&self, n_i: DVec3, n_o: DVec3, x_hat: DVec3) -> bool {
         let (sin, cos) = (self.sin, self.cos);

@@ -8,6 +8,7 @@ use crate::budget::{REPLICATES, SampleBudget};
 use crate::estimate::Diagnostics;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::sanitise;
+use crate::local_surface::{Curvature, End, LocalSurface};
 use crate::sampler::UniformSource;
 use crate::sampling::PointSet;
 use crate::surface::{Projected, SurfacePoint, SurfaceQuery};
@@ -242,8 +243,37 @@ pub(crate) struct Probe<'a, S: SurfaceQuery + ?Sized, F: ?Sized> {
     pub diag: Diagnostics,
     endpoints: Option<Coefficients>,
     /// The averaging region's texture-coordinate chart, for a field that reads them, once
-    /// [`Probe::plane_stands_for_surface`] has found one.
+    /// [`Probe::prepare_prefilter`] has found one.
     chart: Option<UvChart>,
+    /// The pair's local surface model and the angle test's verdict, once
+    /// [`Probe::prepare_prefilter`] has run ([`Prefilter`]).
+    prefilter: Option<Prefilter>,
+    /// How far from the plane projections look first ([`SurfaceQuery::project_within`]): the
+    /// size of the region being sampled (∞ until one is).
+    reach: f64,
+}
+
+/// What [`Probe::prepare_prefilter`] found for a pair: the local quadric (`None` where the
+/// ends contradict every smooth surface, [`LocalSurface::new`]), whether the pair passes
+/// [`crate::Flatness`]'s angle test (used for fields without a displacement scale), and the
+/// criterion.
+#[derive(Debug, Clone, Copy)]
+struct Prefilter {
+    model: Option<LocalSurface>,
+    angle_flat: bool,
+    flatness: crate::Flatness,
+}
+
+/// How one region's coefficients are read (the criterion: [`crate::Flatness`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Reading {
+    /// The field's constant-time average over the flat footprint.
+    ClosedForm,
+    /// Points placed on the pair's local quadric ([`LocalSurface::lift`]) and read there,
+    /// without rays.
+    Lifted,
+    /// Points projected onto the surface by rays (paper §3.2).
+    Rays,
 }
 
 impl<'a, S, F> Probe<'a, S, F>
@@ -260,6 +290,8 @@ where
             diag: Diagnostics::default(),
             endpoints: None,
             chart: None,
+            prefilter: None,
+            reach: f64::INFINITY,
         }
     }
 
@@ -316,20 +348,30 @@ where
         }
     }
 
-    /// Whether the pair is flat by `flatness` along the chord's direction `x_hat` (unit), so
-    /// that its averaging plane stands for the surface (Sone's closed forms, the kernel's
-    /// in-plane reading), and, for a field that reads texture coordinates, whether the charts
-    /// at x_i and x_o are one affine map ([`UvChart::between`], kept for the reads); a pair
-    /// that is not is recorded as a prefilter fallback.
-    pub fn plane_stands_for_surface(&mut self, flatness: crate::Flatness, x_hat: DVec3) -> bool {
-        let mut flat = flatness.is_flat(
-            self.x_i.normal().normalize(),
-            self.x_o.normal().normalize(),
-            x_hat,
+    /// Prepares prefiltered reading for the pair on `chord` under `flatness`: fits the local
+    /// quadric to the two ends ([`LocalSurface`]; a surface without curvature is taken as
+    /// flat between them, its curvature counted as the model's error), runs the angle test
+    /// for fields without a displacement scale, and, for a field that reads texture
+    /// coordinates, takes the region's chart from the charts at x_i and x_o
+    /// ([`UvChart::between`], kept for the reads; a pair whose charts disagree is recorded as a
+    /// chart fallback). Then [`Probe::reading`] decides region by region.
+    pub fn prepare_prefilter(&mut self, flatness: crate::Flatness, chord: &crate::chord::Chord) {
+        let end = |p: &S::Point| End {
+            position: p.position(),
+            normal: p.normal().normalize(),
+            curvature: self.surface.curvature(p).unwrap_or(Curvature::ZERO),
+        };
+        let (e_i, e_o) = (end(self.x_i), end(self.x_o));
+        let model = LocalSurface::new(
+            chord.mid,
+            chord.half_len,
+            chord.x_hat,
+            chord.minor_dir,
+            chord.normal,
+            [&e_i, &e_o],
         );
-        // A field read through texture coordinates also needs them to be one affine map over
-        // the region: the charts at both ends must agree.
-        if flat && self.field.reads_uv() {
+        let angle_flat = flatness.is_flat(e_i.normal, e_o.normal, chord.x_hat);
+        if model.is_some() && self.field.reads_uv() {
             self.chart = match (
                 self.surface.uv_chart(self.x_i),
                 self.surface.uv_chart(self.x_o),
@@ -337,17 +379,100 @@ where
                 (Some(a), Some(b)) => UvChart::between(&a, &b),
                 _ => None,
             };
-            flat = self.chart.is_some();
-            self.diag.chart_fallback = !flat;
+            self.diag.chart_fallback = self.chart.is_none();
         }
-        self.diag.prefilter_fallback = !flat;
-        flat
+        self.prefilter = Some(Prefilter {
+            model,
+            angle_flat,
+            flatness,
+        });
+    }
+
+    /// How to read the region `e` of a pair [`Probe::prepare_prefilter`] prepared
+    /// ([`crate::Flatness`]): in closed form (only if `closed_form`, the field offering an
+    /// ellipse average), at points lifted onto the local quadric (for a field read at points
+    /// of space or through a chart), or by rays. A region read by rays is recorded as a
+    /// prefilter fallback, one read on the quadric as lifted.
+    pub fn reading(&mut self, e: &crate::PlanarEllipse, closed_form: bool) -> Reading {
+        let reading = self.decide(e, closed_form);
+        match reading {
+            Reading::Rays => self.diag.prefilter_fallback = true,
+            Reading::Lifted => self.diag.lifted = true,
+            Reading::ClosedForm => {}
+        }
+        reading
+    }
+
+    /// [`Probe::reading`] without the records.
+    fn decide(&self, e: &crate::PlanarEllipse, closed_form: bool) -> Reading {
+        let Some(Prefilter {
+            model: Some(model),
+            angle_flat,
+            flatness,
+        }) = self.prefilter
+        else {
+            return Reading::Rays;
+        };
+        let reads_uv = self.field.reads_uv();
+        if reads_uv && self.chart.is_none() {
+            return Reading::Rays;
+        }
+        let points = self.field.has_point_lookup() || reads_uv;
+        match self.field.displacement_scale(e) {
+            // The angle test; the plane stands for the surface (the model is flat there).
+            None if angle_flat && closed_form => Reading::ClosedForm,
+            None if angle_flat && points => Reading::Lifted,
+            None => Reading::Rays,
+            Some(scale) => {
+                if !model.covers(e) {
+                    return Reading::Rays;
+                }
+                let tolerance = flatness.tolerance() * scale;
+                let error = model.model_error(e);
+                if closed_form && model.max_height(e) + error <= tolerance {
+                    Reading::ClosedForm
+                } else if points && error <= tolerance {
+                    Reading::Lifted
+                } else {
+                    Reading::Rays
+                }
+            }
+        }
+    }
+
+    /// The largest distance from the chord's midpoint within which points of the plane may be
+    /// lifted onto the local quadric and read there (by [`Probe::reading`]'s criterion for
+    /// regions of that radius, the field's displacement scale taken for the step-1 disk
+    /// `disk`, the smallest region and so the most demanding); 0 where none may.
+    pub fn lifting_radius(&self, disk: &crate::PlanarEllipse) -> f64 {
+        let Some(Prefilter {
+            model: Some(model),
+            angle_flat,
+            flatness,
+        }) = self.prefilter
+        else {
+            return 0.0;
+        };
+        let reads_uv = self.field.reads_uv();
+        if !(self.field.has_point_lookup() || reads_uv) || (reads_uv && self.chart.is_none()) {
+            return 0.0;
+        }
+        match self.field.displacement_scale(disk) {
+            None if angle_flat => f64::INFINITY,
+            None => 0.0,
+            Some(scale) => model.lifting_radius(flatness.tolerance() * scale),
+        }
+    }
+
+    /// The pair's local quadric, where [`Probe::prepare_prefilter`] found one.
+    pub fn model(&self) -> Option<&LocalSurface> {
+        self.prefilter.as_ref().and_then(|p| p.model.as_ref())
     }
 
     /// The field's constant-time average over `e` ([`CoefficientField::ellipse_average`], or
     /// [`CoefficientField::ellipse_average_in_chart`] through the region's chart for a field
-    /// that reads texture coordinates); only for a pair [`Probe::plane_stands_for_surface`]
-    /// accepted.
+    /// that reads texture coordinates); only for a region [`Probe::reading`] reads in closed
+    /// form.
     #[inline]
     pub fn field_ellipse_average(&self, e: &crate::PlanarEllipse) -> Option<Coefficients> {
         match &self.chart {
@@ -402,29 +527,104 @@ where
     }
 
     /// [`Probe::project_and_add`] at the points `centre + u.x·semi_major + u.y·semi_minor` of
-    /// the ellipse `e` for the unit-disk points `us`, in order, projected along its normal: the
-    /// positions are asked for [`CHUNK`] at a time ([`SurfaceQuery::project_positions`]) and
-    /// the field read at them together ([`CoefficientField::averaged_at_points`]).
-    pub fn project_ellipse_points(
+    /// the ellipse `e` for the unit-disk points `us`, in order, projected along its normal (the
+    /// positions are asked for [`CHUNK`] at a time, [`SurfaceQuery::project_positions`], and
+    /// the field read at them together, [`CoefficientField::averaged_at_points`]); or, with
+    /// [`Reading::Lifted`], the same points placed on the pair's local quadric and read there
+    /// without rays (the field's point or chart reads; a chunk the field cannot read that way
+    /// is projected).
+    pub fn read_ellipse_points(
         &mut self,
         e: &crate::PlanarEllipse,
         us: &[glam::DVec2],
         channels: Channels,
         miss_endpoints: bool,
         acc: &mut Accumulator,
+        reading: Reading,
     ) {
+        let model = match reading {
+            Reading::Lifted => self.model().copied(),
+            _ => None,
+        };
+        self.reach = e.semi_major.length().max(e.semi_minor.length());
         for us in us.chunks(CHUNK) {
             let mut origins = [DVec3::ZERO; CHUNK];
             for (o, &u) in origins.iter_mut().zip(us) {
                 *o = e.point(u);
             }
-            self.project_chunk(
-                &origins[..us.len()],
-                e.normal,
-                channels,
-                miss_endpoints,
-                acc,
-            );
+            let origins = &origins[..us.len()];
+            if let Some(model) = &model {
+                let mut lifted = [DVec3::ZERO; CHUNK];
+                for (l, &o) in lifted.iter_mut().zip(origins) {
+                    *l = model.lift(o);
+                }
+                let mut values = [Coefficients::default(); CHUNK];
+                if self.lookup_at_points(&lifted[..us.len()], &mut values[..us.len()]) {
+                    for c in &values[..us.len()] {
+                        acc.add(c, channels);
+                    }
+                    continue;
+                }
+            }
+            self.project_chunk(origins, e.normal, channels, miss_endpoints, acc);
+        }
+    }
+
+    /// The values at the points `origins` of the plane (at most [`CHUNK`]), into `out`: those
+    /// within `radius` of the chord's midpoint `mid` lifted onto the local quadric and read
+    /// there ([`Probe::lifting_radius`]), the others projected along `dir` by rays
+    /// ([`Probe::project_values`]; `None` for a miss).
+    pub fn lift_or_project(
+        &mut self,
+        origins: &[DVec3],
+        mid: DVec3,
+        radius: f64,
+        dir: DVec3,
+        out: &mut [Option<Coefficients>],
+    ) {
+        debug_assert!(origins.len() <= CHUNK && out.len() == origins.len());
+        // Projections look first as far from the plane as the chunk's points are from the
+        // midpoint.
+        self.reach = origins
+            .iter()
+            .map(|&o| (o - mid).length_squared())
+            .fold(0.0, f64::max)
+            .sqrt();
+        let model = match self.model() {
+            Some(m) if radius > 0.0 => *m,
+            _ => return self.project_values(origins, dir, out),
+        };
+        let r2 = radius * radius;
+        // Lifted points first, read together; then the others, projected together.
+        let (mut near, mut far) = ([DVec3::ZERO; CHUNK], [DVec3::ZERO; CHUNK]);
+        let (mut n_near, mut n_far) = (0, 0);
+        for &o in origins {
+            if (o - mid).length_squared() <= r2 {
+                near[n_near] = model.lift(o);
+                n_near += 1;
+            } else {
+                far[n_far] = o;
+                n_far += 1;
+            }
+        }
+        let mut near_values = [Coefficients::default(); CHUNK];
+        if n_near > 0 && !self.lookup_at_points(&near[..n_near], &mut near_values[..n_near]) {
+            // The field reads no points: project every one.
+            return self.project_values(origins, dir, out);
+        }
+        let mut far_values = [None; CHUNK];
+        if n_far > 0 {
+            self.project_values(&far[..n_far], dir, &mut far_values[..n_far]);
+        }
+        let (mut i, mut j) = (0, 0);
+        for (&o, slot) in origins.iter().zip(out.iter_mut()) {
+            if (o - mid).length_squared() <= r2 {
+                *slot = Some(near_values[i]);
+                i += 1;
+            } else {
+                *slot = far_values[j];
+                j += 1;
+            }
         }
     }
 
@@ -524,7 +724,7 @@ where
     /// The coefficients at [`SurfaceQuery::project`]'s hit, `None` on a miss (uncounted).
     #[inline]
     fn lookup_projected(&mut self, origin: DVec3, dir: DVec3) -> Option<Coefficients> {
-        let hit = self.surface.project(origin, dir)?;
+        let hit = self.surface.project_within(origin, dir, self.reach)?;
         debug_assert!(hit.position().is_finite());
         Some(self.lookup(&hit))
     }

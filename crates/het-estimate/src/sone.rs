@@ -53,7 +53,7 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::prefilter::{Averaging, Flatness};
-use crate::region_average::{Accumulator, Channels, Probe, average_chunks};
+use crate::region_average::{Accumulator, Channels, Probe, Reading, average_chunks};
 use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
@@ -245,17 +245,28 @@ where
         }
     };
 
-    // Prefiltered averages only where a flat footprint stands for the projected region.
-    let use_field_average = params.averaging == Averaging::Prefiltered
-        && probe.field.has_ellipse_average()
-        && probe.plane_stands_for_surface(params.flatness, chord.x_hat);
+    // Prefiltered averaging: each region in closed form, on the local quadric, or by rays,
+    // by the criterion of `params.flatness`.
+    let closed_form = probe.field.has_ellipse_average();
+    let prefiltered = params.averaging == Averaging::Prefiltered
+        && (closed_form || probe.field.has_point_lookup() || probe.field.reads_uv());
+    if prefiltered {
+        probe.prepare_prefilter(params.flatness, &chord);
+    }
+    let reading = |probe: &mut Probe<'_, S, F>, e: &crate::PlanarEllipse| {
+        if prefiltered {
+            probe.reading(e, closed_form)
+        } else {
+            Reading::Rays
+        }
+    };
 
     // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
     let disk = chord.ellipse(chord.half_len);
-    let field_disk = if use_field_average {
-        probe.field_ellipse_average(&disk)
-    } else {
-        None
+    let disk_reading = reading(probe, &disk);
+    let field_disk = match disk_reading {
+        Reading::ClosedForm => probe.field_ellipse_average(&disk),
+        _ => None,
     };
     let disk_mean = match field_disk {
         Some(c) => {
@@ -263,9 +274,10 @@ where
             sanitise(c)
         }
         None => {
+            let lift = sampled_reading(disk_reading, probe);
             let averaged =
                 average_chunks::<DiskPoints, _>(params.disk, known.varying(), rng, |us, acc| {
-                    probe.project_ellipse_points(&disk, us, Rgb::ONE, miss_endpoints, acc)
+                    probe.read_ellipse_points(&disk, us, Rgb::ONE, miss_endpoints, acc, lift)
                 });
             probe.diag.samples += averaged.samples;
             note_se(averaged.rel_se);
@@ -291,25 +303,25 @@ where
     // Step 3: Eq. (3) over each distinct ellipse; field averages first, then sampling.
     let groups = Ellipses::group(b, wanted);
     let mut acc = Accumulator::default();
-    let mut sampled = [false; 3];
-    for (g, is_sampled) in sampled.iter_mut().enumerate().take(groups.len) {
+    let mut sampled: [Option<Reading>; 3] = [None; 3];
+    for (g, how) in sampled.iter_mut().enumerate().take(groups.len) {
         let e = chord.ellipse(groups.semi_minor[g]);
-        let field_avg = if use_field_average {
-            probe.field_ellipse_average(&e)
-        } else {
-            None
+        let r = reading(probe, &e);
+        let field_avg = match r {
+            Reading::ClosedForm => probe.field_ellipse_average(&e),
+            _ => None,
         };
         match field_avg {
             Some(c) => {
                 probe.diag.field_averages += 1;
                 acc.add(&sanitise(c), groups.channels[g]);
             }
-            None => *is_sampled = true,
+            None => *how = Some(sampled_reading(r, probe)),
         }
     }
-    if sampled.iter().any(|&s| s) {
+    if sampled.iter().any(|s| s.is_some()) {
         let mut tracked_channels = Rgb::ZERO;
-        for g in (0..groups.len).filter(|&g| sampled[g]) {
+        for g in (0..groups.len).filter(|&g| sampled[g].is_some()) {
             tracked_channels += groups.channels[g];
         }
         let (va, vs) = known.varying();
@@ -321,9 +333,12 @@ where
             (va * tracked_channels, vs * tracked_channels),
             rng,
             |us, acc| {
-                for g in (0..groups.len).filter(|&g| sampled[g]) {
-                    let e = &ellipses[g];
-                    probe.project_ellipse_points(e, us, groups.channels[g], miss_endpoints, acc);
+                for g in 0..groups.len {
+                    if let Some(how) = sampled[g] {
+                        let e = &ellipses[g];
+                        let ch = groups.channels[g];
+                        probe.read_ellipse_points(e, us, ch, miss_endpoints, acc, how);
+                    }
                 }
             },
         );
@@ -344,4 +359,21 @@ where
     probe.diag.width = Some(w);
     probe.diag.rel_std_error = rel_se;
     mean
+}
+
+/// How a region whose closed form was not used is sampled: on the local quadric where its
+/// reading allows (a [`Reading::ClosedForm`] whose closed form declined reads its points on
+/// the quadric too, where the field reads points), by rays otherwise.
+fn sampled_reading<S, F>(reading: Reading, probe: &Probe<'_, S, F>) -> Reading
+where
+    S: SurfaceQuery + ?Sized,
+    F: CoefficientField<S::Point> + ?Sized,
+{
+    match reading {
+        Reading::ClosedForm if probe.field.has_point_lookup() || probe.field.reads_uv() => {
+            Reading::Lifted
+        }
+        Reading::Lifted => Reading::Lifted,
+        _ => Reading::Rays,
+    }
 }

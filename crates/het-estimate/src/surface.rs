@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 
+use crate::local_surface::Curvature;
 use crate::uv_chart::UvChart;
 
 /// A point on the surface of the object being shaded.
@@ -39,6 +40,18 @@ pub trait SurfaceQuery {
     /// being shaded; `None` when neither ray hits it (paper §3.2, Figure 3).
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point>;
 
+    /// [`SurfaceQuery::project`], told that the nearer hit usually lies within `reach` of
+    /// `origin` (the estimators pass the size of the region the point belongs to: a surface
+    /// departs from an averaging plane through two of its points by about that much at most).
+    /// The answer must be `project`'s: a surface may search both rays within `reach` first
+    /// (short rays visit few nodes of a BVH) and beyond it only where neither hits there. The
+    /// default calls `project`.
+    #[inline]
+    fn project_within(&self, origin: DVec3, dir: DVec3, reach: f64) -> Option<Self::Point> {
+        let _ = reach;
+        self.project(origin, dir)
+    }
+
     /// Optional capability: where [`SurfaceQuery::project`]'s hit lies, when the surface can
     /// say it without building a point (an analytic shape, such as a box, whose crossing is a
     /// plane equation rather than a traversal). The estimators ask it for fields defined in
@@ -73,6 +86,19 @@ pub trait SurfaceQuery {
         let _ = p;
         None
     }
+
+    /// Optional capability: the surface's curvature at `p` ([`Curvature`]: the second
+    /// fundamental form as a world-space tensor, positive on convex bodies). The estimators
+    /// fit a quadric to the pair's two ends with it ([`crate::local_surface`]), which lets
+    /// them prefilter on curved surfaces and place sample points on the quadric instead of
+    /// projecting them by rays, wherever the quadric's error bound allows
+    /// ([`crate::Flatness`]). `None` (the default) is read as flat between the ends, the
+    /// normals' disagreement with that counted as the model's error: correct, but it admits
+    /// only nearly flat pairs.
+    fn curvature(&self, p: &Self::Point) -> Option<Curvature> {
+        let _ = p;
+        None
+    }
 }
 
 /// The answer of [`SurfaceQuery::project_position`] (a position, by default), or of any
@@ -92,6 +118,9 @@ impl<S: SurfaceQuery + ?Sized> SurfaceQuery for &S {
     type Point = S::Point;
     fn project(&self, origin: DVec3, dir: DVec3) -> Option<Self::Point> {
         (**self).project(origin, dir)
+    }
+    fn project_within(&self, origin: DVec3, dir: DVec3, reach: f64) -> Option<Self::Point> {
+        (**self).project_within(origin, dir, reach)
     }
     fn project_position(&self, origin: DVec3, dir: DVec3) -> Projected {
         (**self).project_position(origin, dir)

@@ -95,20 +95,49 @@ impl UvChart {
             && self.grad_v.is_finite()
     }
 
+    /// The unit normal of the chart's tangent plane, ∇u × ∇v normalised (its sign follows the
+    /// map's orientation); `None` for a degenerate chart.
+    fn plane_normal(&self) -> Option<DVec3> {
+        self.grad_u.cross(self.grad_v).try_normalize()
+    }
+
+    /// The chart with its gradients turned by the smallest rotation that takes its tangent
+    /// plane's normal `n` to the unit vector `m` (Rodrigues' formula with w = n × m,
+    /// c = n·m: v ↦ v + w × v + w × (w × v)/(1 + c); exact, and the identity where n = m).
+    fn turned(&self, n: DVec3, m: DVec3) -> UvChart {
+        let (w, c) = (n.cross(m), n.dot(m));
+        let turn = |v: DVec3| v + w.cross(v) + w.cross(w.cross(v)) / (1.0 + c);
+        UvChart {
+            grad_u: turn(self.grad_u),
+            grad_v: turn(self.grad_v),
+            ..*self
+        }
+    }
+
     /// The chart at the midpoint of `a.origin` and `b.origin` (the averaging region's centre
     /// for a pair whose charts these are), when `a` and `b` are one affine map within
     /// [`UvChart::TOLERANCE`] (module docs): their gradients differ by at most that fraction
     /// of the larger one's size, and each predicts the other's coordinates within that
     /// fraction of the chord's texture-space length. The midpoint chart has the mean
     /// gradients and the mean coordinates. `None` otherwise: the region is to be sampled.
+    ///
+    /// On a curved surface the two tangent planes differ: each chart's gradients are first
+    /// turned into the mean tangent plane (normal n_a + n_b) by the smallest rotation, so that
+    /// a parameterisation that follows the surface (one that does not stretch or twist between
+    /// the ends) passes wherever the surface bends, and the mean chart lies in the mean plane.
+    /// Symmetric in `a` and `b`, bit for bit.
     pub fn between(a: &UvChart, b: &UvChart) -> Option<UvChart> {
         let tol = Self::TOLERANCE;
         let scale = a.scale().max(b.scale());
         if !(scale > 0.0 && scale.is_finite() && a.is_finite() && b.is_finite()) {
             return None;
         }
-        let grad_diff = ((a.grad_u - b.grad_u).length_squared()
-            + (a.grad_v - b.grad_v).length_squared())
+        let (na, nb) = (a.plane_normal()?, b.plane_normal()?);
+        // Opposite orientations (a mirrored island) are not one map.
+        let mean = (na + nb).try_normalize().filter(|_| na.dot(nb) > 0.0)?;
+        let (ta, tb) = (a.turned(na, mean), b.turned(nb, mean));
+        let grad_diff = ((ta.grad_u - tb.grad_u).length_squared()
+            + (ta.grad_v - tb.grad_v).length_squared())
         .sqrt();
         if grad_diff > tol * scale {
             return None;
@@ -126,8 +155,8 @@ impl UvChart {
         Some(UvChart {
             origin: 0.5 * (a.origin + b.origin),
             uv: 0.5 * (a.uv + b.uv),
-            grad_u: 0.5 * (a.grad_u + b.grad_u),
-            grad_v: 0.5 * (a.grad_v + b.grad_v),
+            grad_u: 0.5 * (ta.grad_u + tb.grad_u),
+            grad_v: 0.5 * (ta.grad_v + tb.grad_v),
         })
     }
 }

@@ -27,3 +27,5 @@ mod ply;
 mod scene;
 #[path = "tracer/textures.rs"]
 mod textures;
+#[path = "tracer/uv_interior.rs"]
+mod uv_interior;

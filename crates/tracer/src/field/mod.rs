@@ -398,6 +398,73 @@ impl Field {
         }
     }
 
+    /// How displacements along the region's normal move this field's reading over the region
+    /// `e` ([`CoefficientField::displacement_scale`]): L = max(s, h)/|sensitivity| (scene
+    /// units), with the sensitivity the part of a unit normal displacement that moves the
+    /// pattern's coordinate (|ĝ·n| for a stripe of direction ĝ; the sine of the normal's angle
+    /// to the projection axis for checks and planar images, ĝ the normal's direction in the
+    /// plane), s the feature size along ĝ (the width; for an image the distance across one
+    /// texel along ĝ) and h the region's half extent along ĝ. `f64::INFINITY` where the
+    /// reading does not move: constants, a normal along the projection axis, UV-mapped images
+    /// (their chart reads points in the tangent plane).
+    pub fn displacement_scale(&self, e: &PlanarEllipse) -> f64 {
+        let n = e.normal;
+        // Half extent of the region along the unit vector g.
+        let half_extent =
+            |g: DVec3| (g.dot(e.semi_major).powi(2) + g.dot(e.semi_minor).powi(2)).sqrt();
+        let across = |axis: Axis| {
+            let a = axis.unit();
+            let pn = n - n.dot(a) * a;
+            let sens = pn.length();
+            (sens, if sens > 0.0 { pn / sens } else { DVec3::ZERO })
+        };
+        let scale = |feature: f64, sens: f64, g: DVec3| {
+            if sens > 0.0 {
+                feature.max(half_extent(g)) / sens
+            } else {
+                f64::INFINITY
+            }
+        };
+        match self {
+            _ if self.is_constant() => f64::INFINITY,
+            Field::Constant(_) => f64::INFINITY,
+            Field::Pattern {
+                pattern: Pattern::Stripe(stripe),
+                projection,
+                ..
+            } => {
+                let (cos, sin) = stripe.direction();
+                let g = projection.plane_vector(cos, sin);
+                scale(stripe.width(), n.dot(g).abs(), g)
+            }
+            Field::Pattern {
+                pattern: Pattern::Check(check),
+                projection,
+                ..
+            } => {
+                let (sens, g) = across(projection.axis);
+                scale(check.width, sens, g)
+            }
+            Field::Image(f) => match f.mapping {
+                ImageMapping::Uv => f64::INFINITY,
+                ImageMapping::Planar { projection, size } => {
+                    let (sens, g) = across(projection.axis);
+                    // Texels crossed per unit length along g.
+                    let (gs, gt) = projection.st_vector(g);
+                    let per_length = ((gs * f.texture.width as f64 / size[0]).powi(2)
+                        + (gt * f.texture.height as f64 / size[1]).powi(2))
+                    .sqrt();
+                    let texel = if per_length > 0.0 {
+                        1.0 / per_length
+                    } else {
+                        f64::INFINITY
+                    };
+                    scale(texel, sens, g)
+                }
+            },
+        }
+    }
+
     /// False only for UV-mapped images (defined on the surface only).
     pub fn is_volumetric(&self) -> bool {
         !matches!(
@@ -539,6 +606,55 @@ pub struct MediumField {
     majorant: Rgb,
     grey: bool,
     volumetric: bool,
+    /// For a medium with a UV-mapped field, on one object: the texture coordinates inside
+    /// its body ([`MediumField::with_interior`]).
+    interior: Option<Arc<UvInterior>>,
+}
+
+/// The texture coordinates inside a body: those of the nearest point of its surface. What a
+/// UV-mapped medium means below the surface for the path tracer, and what the estimators
+/// already assume when they take the surface's coefficients to continue below it.
+#[derive(Debug)]
+pub struct UvInterior {
+    tree: crate::geometry::closest::ClosestPointTree,
+    /// Texture coordinates at each triangle's vertices (mesh order).
+    uvs: Vec<[DVec2; 3]>,
+}
+
+/// Identity, not contents: two interiors are equal when they are the same one (a medium is
+/// compared with its clones, which share it).
+impl PartialEq for UvInterior {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+impl UvInterior {
+    /// The interior of `mesh`; `None` for a mesh without texture coordinates or triangles.
+    pub fn new(mesh: &crate::geometry::TriangleMesh) -> Option<Self> {
+        let uvs = mesh.uvs.as_ref()?;
+        if mesh.triangles.is_empty() {
+            return None;
+        }
+        Some(Self {
+            tree: crate::geometry::closest::ClosestPointTree::new(mesh),
+            uvs: mesh
+                .triangles
+                .iter()
+                .map(|t| t.map(|k| uvs[k as usize].as_dvec2()))
+                .collect(),
+        })
+    }
+
+    /// The texture coordinates of the surface point nearest to `p` (barycentric
+    /// interpolation over its triangle, as a hit there reads them).
+    #[inline]
+    pub fn uv_at(&self, p: DVec3) -> Option<DVec2> {
+        let n = self.tree.nearest(p)?;
+        let t = self.uvs[n.prim as usize];
+        let [b1, b2] = n.bary;
+        Some((1.0 - b1 - b2) * t[0] + b1 * t[1] + b2 * t[2])
+    }
 }
 
 impl MediumField {
@@ -549,6 +665,7 @@ impl MediumField {
             majorant: bounds.max.sigma_a + bounds.max.sigma_s,
             grey: sigma_a.is_grey() && sigma_s.is_grey(),
             volumetric: sigma_a.is_volumetric() && sigma_s.is_volumetric(),
+            interior: None,
             bounds,
             raw_bounds: bounds,
             artist: None,
@@ -576,6 +693,7 @@ impl MediumField {
             majorant: bounds.max.sigma_a + bounds.max.sigma_s,
             grey: colour.is_grey() && mfp.is_grey(),
             volumetric: colour.is_volumetric() && mfp.is_volumetric(),
+            interior: None,
             bounds,
             raw_bounds,
             artist: Some(map),
@@ -652,14 +770,39 @@ impl MediumField {
     }
 
     /// Coefficients at a point of the volume (for the path tracer): cheap, no allocation (an
-    /// artist medium costs three table lookups more). Meaningful only when
-    /// [`MediumField::is_volumetric`].
+    /// artist medium costs three table lookups more). Meaningful when
+    /// [`MediumField::is_volumetric`], or, for a medium with UV-mapped fields, once
+    /// [`MediumField::with_interior`] gave it its body: those fields are then read at the
+    /// texture coordinates of the nearest surface point (a closest-point search, ≈ a ray's
+    /// cost).
     #[inline]
     pub fn at_point(&self, p: DVec3) -> Coefficients {
+        if !self.volumetric
+            && let Some(uv) = self.interior.as_ref().and_then(|i| i.uv_at(p))
+        {
+            return self.at_surface(p, uv);
+        }
         self.to_sigma(Coefficients {
             sigma_a: self.sigma_a.at_point(p),
             sigma_s: self.sigma_s.at_point(p),
         })
+    }
+
+    /// The same medium filling the body of `mesh`: a UV-mapped field is read inside it at the
+    /// texture coordinates of the nearest surface point ([`UvInterior`]), so that the path
+    /// tracer can walk it. Unchanged for a medium defined in space, or where the mesh has no
+    /// texture coordinates.
+    pub fn with_interior(mut self, mesh: &crate::geometry::TriangleMesh) -> Self {
+        if !self.volumetric {
+            self.interior = UvInterior::new(mesh).map(Arc::new);
+        }
+        self
+    }
+
+    /// True when the path tracer can read the medium inside a body: defined in space, or
+    /// given its body ([`MediumField::with_interior`]).
+    pub fn is_path_traceable(&self) -> bool {
+        self.volumetric || self.interior.is_some()
     }
 
     /// Coefficients at a surface point with texture coordinates `uv`.
@@ -834,6 +977,16 @@ impl CoefficientField<Hit> for MediumField {
     /// [`CoefficientField::ellipse_average_in_chart`]).
     fn has_ellipse_average(&self) -> bool {
         self.artist.is_none() || self.inverts_after()
+    }
+
+    /// The smaller of the two fields' [`Field::displacement_scale`] (an artist medium's colour
+    /// and mean free path fields, whichever space it averages in).
+    fn displacement_scale(&self, e: &PlanarEllipse) -> Option<f64> {
+        Some(
+            self.sigma_a
+                .displacement_scale(e)
+                .min(self.sigma_s.displacement_scale(e)),
+        )
     }
 
     /// True when either field is a UV-mapped image.

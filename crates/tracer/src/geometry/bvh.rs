@@ -93,6 +93,9 @@ struct ObjectAccel {
     phi: DVec3,
     /// The extents when the mesh is its own bounding box ([`TriangleMesh::box_extent`]).
     box_extent: Option<DVec3>,
+    /// Per-vertex curvature tensors ([`super::curvature`]), computed on the first
+    /// [`Geometry::curvature`] query (only the BSSRDF estimators ask).
+    curvature: std::sync::OnceLock<Option<Vec<[f32; 6]>>>,
 }
 
 /// Scene geometry: triangle meshes (object id = index) with their BVHs, and the ray queries.
@@ -222,6 +225,7 @@ impl ObjectAccel {
                 plo: lo - box_pad(lo, hi),
                 phi: hi + box_pad(lo, hi),
                 box_extent: None,
+                curvature: std::sync::OnceLock::new(),
             };
         }
         let scaled: Vec<[Vec3A; 3]> = mesh
@@ -267,6 +271,7 @@ impl ObjectAccel {
             plo: lo - box_pad(lo, hi),
             phi: hi + box_pad(lo, hi),
             box_extent: mesh.box_extent(),
+            curvature: std::sync::OnceLock::new(),
         }
     }
 
@@ -630,6 +635,17 @@ impl Geometry {
         let idx = mesh.triangles.get(hit.prim as usize)?;
         let uv = idx.map(|k| uvs[k as usize].as_dvec2());
         UvChart::of_triangle(mesh.triangle_vertices(hit.prim as usize), uv, hit.p, hit.uv)
+    }
+
+    /// The surface's curvature at `hit` (module `geometry::curvature`: RUS04's per-vertex tensors from
+    /// the shading normals, interpolated); the object's tensors are computed on the first
+    /// call. `None` for an empty mesh.
+    pub fn curvature(&self, hit: &Hit) -> Option<het_estimate::Curvature> {
+        let mesh = self.meshes.get(hit.object as usize)?;
+        let tensors = self.objects[hit.object as usize]
+            .curvature
+            .get_or_init(|| super::curvature::vertex_tensors(mesh));
+        super::curvature::at_hit(mesh, tensors.as_ref()?, hit)
     }
 
     /// Builds the full hit record for leaf `leaf` of `object`: barycentrics and distance

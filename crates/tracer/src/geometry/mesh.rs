@@ -312,14 +312,29 @@ impl TriangleMesh {
         Ok(())
     }
 
-    /// Welded vertex ids (by exact position) for topology.
+    /// Welded vertex ids for topology: positions that agree to within 2⁻²⁴ of the mesh's
+    /// extent are one vertex (each coordinate rounded to that grid). Files split vertices
+    /// along texture seams and at poles, where a generator's `sin(2π)` or `sin(π)` leaves a
+    /// residue of 1e-16 that f32 storage keeps: exact equality would call such a sphere open.
     fn welded_ids(&self) -> (Vec<u32>, usize) {
+        let (lo, hi) = self.bounds();
+        let extent = (hi - lo).max_element();
+        let step = if extent.is_finite() && extent > 0.0 {
+            extent / (1u64 << 24) as f64
+        } else {
+            0.0
+        };
         let mut map = std::collections::HashMap::with_capacity(self.positions.len());
         let ids = self
             .positions
             .iter()
             .map(|p| {
-                let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                let key = if step > 0.0 {
+                    let q = ((*p - lo) / step).round();
+                    [q.x.to_bits(), q.y.to_bits(), q.z.to_bits()]
+                } else {
+                    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+                };
                 let next = map.len() as u32;
                 *map.entry(key).or_insert(next)
             })

@@ -23,6 +23,8 @@
 //! corners, edges and face diagonals all hit; the BVH agrees with a brute-force f64 scan.
 
 mod bvh;
+pub mod closest;
+mod curvature;
 #[cfg(feature = "gltf")]
 pub mod gltf;
 #[cfg(feature = "gltf")]

@@ -39,6 +39,20 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
         }
     }
 
+    /// `project`, searching both rays within `reach` first (short rays visit
+    /// few BVH nodes) and beyond it only where neither hits there: the same hit.
+    #[inline]
+    fn project_within(&self, origin: DVec3, dir: DVec3, reach: f64) -> Option<Hit> {
+        match self.geometry.project_onto_box(self.object, origin, dir) {
+            Projected::At(hit) => Some(hit),
+            Projected::Miss => None,
+            Projected::Undecided if reach.is_finite() && reach > 0.0 => {
+                self.project_by_rays_within(origin, dir, reach)
+            }
+            Projected::Undecided => self.project_by_rays(origin, dir),
+        }
+    }
+
     /// On an object that is its own axis-aligned box, the crossing from the box's planes,
     /// without a ray ([`Geometry::project_position_onto_box`]); `Undecided` on other meshes.
     #[inline]
@@ -58,9 +72,43 @@ impl het_estimate::SurfaceQuery for ObjectSurface<'_> {
     fn uv_chart(&self, p: &Hit) -> Option<het_estimate::UvChart> {
         self.geometry.uv_chart(p)
     }
+
+    /// The mesh's curvature at the hit ([`Geometry::curvature`]).
+    fn curvature(&self, p: &Hit) -> Option<het_estimate::Curvature> {
+        self.geometry.curvature(p)
+    }
 }
 
 impl ObjectSurface<'_> {
+    /// [`ObjectSurface::project_by_rays`], looking within `reach` first: a ray each way over
+    /// `[0, reach]` (the second no further than the first's hit); where neither hits, the
+    /// rest of both lines, `[reach, ∞)`. The nearer hit overall, as `project_by_rays` finds
+    /// it (a hit within `reach` on one side is nearer than any beyond it on either).
+    fn project_by_rays_within(&self, origin: DVec3, dir: DVec3, reach: f64) -> Option<Hit> {
+        let g = self.geometry;
+        let fwd = g.intersect_object(self.object, &Ray::segment(origin, dir, reach));
+        let t_max = fwd.map_or(reach, |h| h.t);
+        let back = g.intersect_object(self.object, &Ray::segment(origin, -dir, t_max));
+        match (fwd, back) {
+            (Some(f), Some(b)) => return Some(if b.t < f.t { b } else { f }),
+            (Some(h), None) | (None, Some(h)) => return Some(h),
+            (None, None) => {}
+        }
+        // The rest, overlapping the first search a little (the f32 traversal rounds its
+        // bounds): a hit there was not found within `reach`, so it is beyond it.
+        let from = 0.999 * reach;
+        let fwd = g.intersect_object(
+            self.object,
+            &Ray::with_range(origin, dir, from, f64::INFINITY),
+        );
+        let t_max = fwd.map_or(f64::INFINITY, |h| h.t);
+        let back = g.intersect_object(self.object, &Ray::with_range(origin, -dir, from, t_max));
+        match (fwd, back) {
+            (Some(f), Some(b)) => Some(if b.t < f.t { b } else { f }),
+            (f, b) => f.or(b),
+        }
+    }
+
     /// [`het_estimate::SurfaceQuery::project`] by a ray each way, on any mesh.
     fn project_by_rays(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
         let fwd = self
@@ -152,6 +200,37 @@ mod tests {
         assert_eq!(
             sphere.project_onto_box(0, DVec3::ZERO, DVec3::Z),
             Projected::Undecided
+        );
+    }
+
+    /// Looking within a reach first finds `project`'s hit, for every reach, on lines from
+    /// inside, outside and near a sphere.
+    #[test]
+    fn projection_within_a_reach_is_the_projection() {
+        let g = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, 10.0, 4)]);
+        let s = ObjectSurface::new(&g, 0);
+        let (mut hits, mut near) = (0, 0);
+        for k in 0..3000 {
+            let t = k as f64;
+            let u = DVec3::new((0.37 * t).sin(), (0.71 * t).cos(), (1.13 * t).sin());
+            let origin = 12.0 * u;
+            let dir =
+                DVec3::new((2.3 * t).sin(), (1.7 * t).cos(), (0.9 * t).cos() + 0.2).normalize();
+            let want = s.project(origin, dir);
+            for reach in [1e-3, 0.5, 3.0, 30.0] {
+                let got = s.project_within(origin, dir, reach);
+                assert_eq!(
+                    got.map(|h| (h.p, h.prim)),
+                    want.map(|h| (h.p, h.prim)),
+                    "{k} {reach}"
+                );
+                near += usize::from(got.is_some_and(|h| h.t <= reach));
+            }
+            hits += usize::from(want.is_some());
+        }
+        assert!(
+            hits > 1000 && near > 1000,
+            "{hits} hits, {near} within reach"
         );
     }
 

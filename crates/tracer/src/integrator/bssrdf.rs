@@ -187,7 +187,13 @@ impl BssrdfObject {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> PairWeight {
-        let est = self.estimator.estimate(surface, medium, x_i, x_o, rng);
+        // The estimator draws from a generator of its own, seeded by one draw of the path's:
+        // however many numbers an estimate takes (none for a closed form, hundreds for
+        // sampling), the path's own numbers stay the same, so renders that differ only in
+        // how they average (prefiltered or sampled, 16 or 256 points) follow the same paths
+        // and can be compared pixel by pixel.
+        let mut own = Rng::from_keys(rng.next_u64(), &[]);
+        let est = self.estimator.estimate(surface, medium, x_i, x_o, &mut own);
         counters.record_estimate(&est.diagnostics);
         let (rd, reflection) = self.weigh(surface, est.coefficients, x_i, x_o, counters);
         PairWeight {

@@ -44,11 +44,15 @@ pub struct PathCounters {
     /// Estimates with at least one region average answered by the field's prefiltered
     /// (constant-time) average instead of sampling.
     pub prefiltered: u64,
-    /// Estimates where prefiltered averaging applied to the field but the surface was too
-    /// curved for a flat footprint (`het_estimate::Flatness`), or the texture coordinates of a
-    /// UV-mapped field were not one affine map over the region (`het_estimate::UvChart`), so
-    /// the regions were sampled.
+    /// Estimates where prefiltered averaging applied but some region was projected by rays
+    /// (`het_estimate::Flatness`): the surface departs too far from the pair's local quadric
+    /// there (a crease, a corner, a thin part, a region spanning much of a small object), or
+    /// the texture coordinates of a UV-mapped field were not one affine map over the region
+    /// (`het_estimate::UvChart`).
     pub prefilter_fallbacks: u64,
+    /// Estimates where some region was sampled at points placed on the pair's local quadric,
+    /// without rays (curved, but smooth enough for the quadric: `het_estimate::local_surface`).
+    pub lifted: u64,
     /// Of those, estimates on flat pairs whose texture-coordinate charts disagreed (a UV seam
     /// or stretch between x_i and x_o).
     pub chart_fallbacks: u64,
@@ -68,6 +72,7 @@ impl PathCounters {
         self.estimator_fallbacks += d.fallback as u64;
         self.prefiltered += (d.field_averages > 0) as u64;
         self.prefilter_fallbacks += d.prefilter_fallback as u64;
+        self.lifted += d.lifted as u64;
         self.chart_fallbacks += d.chart_fallback as u64;
     }
 
@@ -189,6 +194,7 @@ impl Counters for PathCounters {
         self.estimator_fallbacks += o.estimator_fallbacks;
         self.prefiltered += o.prefiltered;
         self.prefilter_fallbacks += o.prefilter_fallbacks;
+        self.lifted += o.lifted;
         self.chart_fallbacks += o.chart_fallbacks;
         self.profile_failures += o.profile_failures;
     }

@@ -10,18 +10,26 @@ use super::Method;
 
 impl FromStr for Method {
     type Err = String;
-    /// `pt`, or an estimator name (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`,
-    /// `kernel`) with the estimator's default parameters and each material's own profile.
+    /// `pt`, `auto` ([`Method::auto`]), or an estimator name (`jensen-in`, `jensen-out`,
+    /// `endpoints`, `segment`, `sone`, `kernel`) with the estimator's default parameters and
+    /// each material's own profile.
     fn from_str(s: &str) -> Result<Self, String> {
-        if s == "pt" {
-            return Ok(Method::PathTraced);
+        match s {
+            "pt" => return Ok(Method::PathTraced),
+            "auto" => {
+                return Ok(Method::auto(Estimator::Sone(
+                    het_estimate::SoneParams::new(),
+                )));
+            }
+            _ => {}
         }
         Estimator::from_str(s)
-            .map(|estimator| Method::Bssrdf {
-                estimator,
-                profile: None,
+            .map(|estimator| Method::bssrdf(estimator, None))
+            .map_err(|e| {
+                format!(
+                    "{e}; or `pt` for the path-traced reference, `auto` for the per-object choice"
+                )
             })
-            .map_err(|e| format!("{e}; or `pt` for the path-traced reference"))
     }
 }
 
@@ -36,23 +44,29 @@ impl Method {
             Method::Bssrdf {
                 estimator: Estimator::Segment(p),
                 profile,
+                policy,
             } => Method::Bssrdf {
                 estimator: Estimator::Segment(p.with_samples(budget)),
                 profile,
+                policy,
             },
             Method::Bssrdf {
                 estimator: Estimator::Sone(p),
                 profile,
+                policy,
             } => Method::Bssrdf {
                 estimator: Estimator::Sone(p.with_samples(budget)),
                 profile,
+                policy,
             },
             Method::Bssrdf {
                 estimator: Estimator::Kernel(p),
                 profile,
+                policy,
             } => Method::Bssrdf {
                 estimator: Estimator::Kernel(p.with_samples(budget)),
                 profile,
+                policy,
             },
             m => m,
         }
@@ -62,13 +76,21 @@ impl Method {
     /// Monte Carlo); other methods are unchanged.
     pub fn with_averaging(self, averaging: Option<het_estimate::Averaging>) -> Self {
         match (self, averaging) {
-            (Method::Bssrdf { estimator, profile }, Some(a)) => Method::Bssrdf {
+            (
+                Method::Bssrdf {
+                    estimator,
+                    profile,
+                    policy,
+                },
+                Some(a),
+            ) => Method::Bssrdf {
                 estimator: match estimator {
                     Estimator::Sone(p) => Estimator::Sone(p.with_averaging(a)),
                     Estimator::Kernel(p) => Estimator::Kernel(p.with_averaging(a)),
                     e => e,
                 },
                 profile,
+                policy,
             },
             (m, _) => m,
         }
@@ -83,6 +105,7 @@ impl Method {
                 Method::Bssrdf {
                     estimator: Estimator::Sone(mut p),
                     profile,
+                    policy,
                 },
                 Some(b),
             ) => {
@@ -90,6 +113,7 @@ impl Method {
                 Method::Bssrdf {
                     estimator: Estimator::Sone(p),
                     profile,
+                    policy,
                 }
             }
             (m, _) => m,
@@ -125,7 +149,13 @@ impl Method {
     /// The method with its profile model overridden (BSSRDF methods only).
     pub fn with_profile(self, profile: Option<ProfileModel>) -> Self {
         match self {
-            Method::Bssrdf { estimator, .. } => Method::Bssrdf { estimator, profile },
+            Method::Bssrdf {
+                estimator, policy, ..
+            } => Method::Bssrdf {
+                estimator,
+                profile,
+                policy,
+            },
             m => m,
         }
     }

@@ -9,6 +9,7 @@ pub mod light_trace;
 pub mod lighting;
 mod method;
 pub mod path;
+pub mod plan;
 pub mod preparation;
 pub mod probe;
 mod shape_correction;
@@ -17,7 +18,7 @@ pub mod warnings;
 
 pub use counters::PathCounters;
 pub use light_trace::{LightTraceError, LightTraceOptions, LightTraced, LightTracer, Roles};
-pub use path::{LightStrategy, Method, PathIntegrator, PathOptions};
+pub use path::{Correction, Coverage, LightStrategy, Method, PathIntegrator, PathOptions, Policy};
 pub use preparation::PrepareObserver;
 
 /// Why a render could not start.

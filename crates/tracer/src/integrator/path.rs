@@ -59,17 +59,146 @@ pub enum Method {
     Bssrdf {
         /// How (x_i, x_o) become homogeneous coefficients.
         estimator: Estimator,
-        /// Profile model; `None` uses each material's own (or the dipole).
+        /// Profile model; `None` uses each material's own (the tabulated exact profile where
+        /// it applies, else photon beam diffusion).
         profile: Option<ProfileModel>,
+        /// Which translucent objects get the BSSRDF, and which get the shape correction.
+        policy: Policy,
     },
 }
 
+/// How a BSSRDF method applies to a scene's translucent objects.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Policy {
+    /// Which objects get the BSSRDF; the others are path traced.
+    pub coverage: Coverage,
+    /// Which of them get the shape correction.
+    pub correction: Correction,
+}
+
+/// Which BSSRDF objects get the shape correction (`render --shape-correction`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Correction {
+    /// Each material's own `shape_correction` where it sets one; else the objects too small
+    /// for a half-space profile ([`crate::integrator::warnings::is_optically_small`]). The
+    /// default of `render` and of `--method auto`.
+    Auto,
+    /// Each material's own `shape_correction`, off where it sets none: the library's default
+    /// ([`Method::bssrdf`]), so that a render is what its scene says.
+    #[default]
+    Materials,
+    /// Every BSSRDF object.
+    On,
+    /// None.
+    Off,
+}
+
+impl Correction {
+    /// The names of `--shape-correction` (the library's `Materials` is not one).
+    pub const NAMES: [&'static str; 3] = ["auto", "on", "off"];
+
+    /// `auto`, `materials`, `on` or `off`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Correction::Auto => "auto",
+            Correction::Materials => "materials",
+            Correction::On => "on",
+            Correction::Off => "off",
+        }
+    }
+
+    /// Whether an object whose material says `material` (its `shape_correction`, if set)
+    /// and which is `small` (optically small for a half-space profile) gets the correction.
+    pub fn applies(self, material: Option<bool>, small: bool) -> bool {
+        match self {
+            Correction::On => true,
+            Correction::Off => false,
+            Correction::Auto => material.unwrap_or(small),
+            Correction::Materials => material.unwrap_or(false),
+        }
+    }
+}
+
+impl std::str::FromStr for Correction {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "auto" => Ok(Correction::Auto),
+            "on" => Ok(Correction::On),
+            "off" => Ok(Correction::Off),
+            _ => Err(format!("unknown shape correction `{s}`: auto, on or off")),
+        }
+    }
+}
+
+/// Which translucent objects a BSSRDF method renders with its BSSRDF.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Coverage {
+    /// Every translucent object (`--method sone`, `kernel`, …: the estimators as such).
+    #[default]
+    Every,
+    /// The objects a half-space profile fits; the optically small ones
+    /// ([`crate::integrator::warnings::is_optically_small`]) are path traced, where the path
+    /// tracer can walk them (`--method auto`).
+    HalfSpaceOnly,
+}
+
 impl Method {
-    /// `pt`, or the estimator's name.
+    /// `pt`, `auto`, or the estimator's name.
     pub fn name(&self) -> &'static str {
         match self {
             Method::PathTraced => "pt",
+            Method::Bssrdf {
+                policy:
+                    Policy {
+                        coverage: Coverage::HalfSpaceOnly,
+                        ..
+                    },
+                ..
+            } => "auto",
             Method::Bssrdf { estimator, .. } => estimator.name(),
+        }
+    }
+
+    /// `auto`: `estimator` (Sone's with its defaults, for `--method auto`) where a half-space
+    /// profile fits, the path tracer inside optically small objects.
+    pub fn auto(estimator: Estimator) -> Self {
+        Method::Bssrdf {
+            estimator,
+            profile: None,
+            policy: Policy {
+                coverage: Coverage::HalfSpaceOnly,
+                correction: Correction::Auto,
+            },
+        }
+    }
+
+    /// A BSSRDF method with `estimator` on every translucent object.
+    pub fn bssrdf(estimator: Estimator, profile: Option<ProfileModel>) -> Self {
+        Method::Bssrdf {
+            estimator,
+            profile,
+            policy: Policy::default(),
+        }
+    }
+
+    /// The same method with the shape correction chosen by `correction` (BSSRDF methods
+    /// only).
+    pub fn with_correction(self, correction: Correction) -> Self {
+        match self {
+            Method::Bssrdf {
+                estimator,
+                profile,
+                policy,
+            } => Method::Bssrdf {
+                estimator,
+                profile,
+                policy: Policy {
+                    correction,
+                    ..policy
+                },
+            },
+            m => m,
         }
     }
 }
@@ -87,11 +216,29 @@ pub struct PathOptions {
 enum ObjectKind<'s> {
     Opaque,
     Translucent {
-        material: &'s Translucent,
+        material: MaterialOf<'s>,
         bssrdf: Option<Box<BssrdfObject>>,
         /// The medium has the same coefficients in every channel.
         grey: bool,
     },
+}
+
+/// A translucent object's material: the scene's, or, for a path-traced object whose medium is
+/// UV-mapped, a copy whose medium holds the object's body
+/// ([`crate::field::MediumField::with_interior`]), boxed so that the objects stay small.
+enum MaterialOf<'s> {
+    Scene(&'s Translucent),
+    Own(Box<Translucent>),
+}
+
+impl std::ops::Deref for MaterialOf<'_> {
+    type Target = Translucent;
+    fn deref(&self) -> &Translucent {
+        match self {
+            MaterialOf::Scene(t) => t,
+            MaterialOf::Own(t) => t,
+        }
+    }
 }
 
 /// Which colour channels a path carries.
@@ -386,13 +533,15 @@ impl<'s> PathIntegrator<'s> {
         if method == Method::PathTraced {
             scene.require_path_traceable()?;
         }
+        let plans = crate::integrator::plan::plan(scene, method);
         let mut objects = Vec::with_capacity(scene.objects().len());
         for (index, object) in scene.objects().iter().enumerate() {
-            objects.push(match &object.material {
-                Material::Translucent(t) => {
+            objects.push(match (&object.material, plans[index]) {
+                (Material::Translucent(t), Some(plan)) => {
                     let bssrdf = match method {
-                        Method::PathTraced => None,
-                        Method::Bssrdf { estimator, profile } => {
+                        Method::Bssrdf {
+                            estimator, profile, ..
+                        } if !plan.path_traced => {
                             let (lo, hi) = scene.geometry().object_bounds(index as u32);
                             let mut b = BssrdfObject::new(
                                 t,
@@ -406,7 +555,7 @@ impl<'s> PathIntegrator<'s> {
                             if estimator.reads_region_averages() {
                                 t.medium.build_area_tables();
                             }
-                            if t.shape_correction {
+                            if plan.corrected {
                                 b.correction = Some(
                                     ShapeCorrection::build(
                                         &b,
@@ -425,9 +574,21 @@ impl<'s> PathIntegrator<'s> {
                             }
                             Some(Box::new(b))
                         }
+                        _ => None,
+                    };
+                    // A path-traced UV-mapped medium is read inside the body at its nearest
+                    // surface point.
+                    let material = if bssrdf.is_none() && !t.medium.is_volumetric() {
+                        let mut own = t.clone();
+                        own.medium = own
+                            .medium
+                            .with_interior(scene.geometry().mesh(index as u32));
+                        MaterialOf::Own(Box::new(own))
+                    } else {
+                        MaterialOf::Scene(t)
                     };
                     ObjectKind::Translucent {
-                        material: t,
+                        material,
                         bssrdf,
                         grey: t.medium.is_grey(),
                     }
@@ -472,14 +633,22 @@ impl<'s> PathIntegrator<'s> {
         &self.warnings
     }
 
-    /// What preparing the render did that a user may want to know: one line per object whose
-    /// shape correction was measured (points, spacing, wall time).
+    /// What preparing the render did that a user may want to know: one line per object a
+    /// BSSRDF method path-traces (`--method auto`), and one per object whose shape correction
+    /// was measured (points, spacing, wall time).
     pub fn notes(&self) -> Vec<String> {
-        self.scene
-            .objects()
-            .iter()
-            .zip(&self.objects)
-            .filter_map(|(object, kind)| match kind {
+        let traced = self
+            .object_plans()
+            .into_iter()
+            .filter(|(_, p)| p.path_traced && matches!(self.method, Method::Bssrdf { .. }))
+            .map(|(name, _)| {
+                format!(
+                    "`{name}` is path traced: it is too small for a half-space profile \
+                     (`--method auto`; `--method sone` renders it with the BSSRDF)"
+                )
+            });
+        let corrections = self.scene.objects().iter().zip(&self.objects).filter_map(
+            |(object, kind)| match kind {
                 ObjectKind::Translucent {
                     bssrdf: Some(b), ..
                 } => b.correction.as_ref().map(|c| {
@@ -491,13 +660,24 @@ impl<'s> PathIntegrator<'s> {
                     )
                 }),
                 _ => None,
-            })
-            .collect()
+            },
+        );
+        traced.chain(corrections).collect()
     }
 
     /// The method rendered.
     pub fn method(&self) -> Method {
         self.method
+    }
+
+    /// How each translucent object is rendered, by name ([`crate::integrator::plan::plan`]):
+    /// what the sidecar records.
+    pub fn object_plans(&self) -> Vec<(String, crate::integrator::plan::ObjectPlan)> {
+        crate::integrator::plan::plan(self.scene, self.method)
+            .into_iter()
+            .zip(self.scene.objects())
+            .filter_map(|(p, o)| Some((o.name.clone(), p?)))
+            .collect()
     }
 
     /// Radiance arriving along `ray` (one sample).
@@ -1157,13 +1337,13 @@ impl<'s> PathIntegrator<'s> {
 
     /// The translucent material and BSSRDF data of `object`, when it is rendered with a
     /// BSSRDF.
-    pub(crate) fn bssrdf_object(&self, object: u32) -> Option<(&'s Translucent, &BssrdfObject)> {
+    pub(crate) fn bssrdf_object(&self, object: u32) -> Option<(&Translucent, &BssrdfObject)> {
         match self.objects.get(object as usize)? {
             ObjectKind::Translucent {
                 material,
                 bssrdf: Some(b),
                 ..
-            } => Some((*material, b.as_ref())),
+            } => Some((&**material, b.as_ref())),
             _ => None,
         }
     }

@@ -8,6 +8,7 @@
 use crate::field::Variation;
 use crate::geometry::Hit;
 use crate::integrator::Method;
+use crate::integrator::plan::{ObjectPlan, plan};
 use crate::light::Light;
 use crate::scene::Scene;
 
@@ -27,24 +28,23 @@ pub fn scene_warnings(scene: &Scene, method: Method) -> Vec<String> {
                 .to_string(),
         );
     }
-    match method {
-        Method::PathTraced => warnings.extend(unreachable_lights(scene)),
-        Method::Bssrdf { .. } => {
-            warnings.extend(hidden_cores(scene));
-            warnings.extend(small_objects(scene));
-            warnings.extend(depth_varying(scene));
-        }
-    }
+    let plans = plan(scene, method);
+    let traced = |i: u32| plans[i as usize].is_some_and(|p| p.path_traced);
+    let bssrdf = |i: u32| plans[i as usize].is_some_and(|p| !p.path_traced);
+    warnings.extend(unreachable_lights(scene, &traced));
+    warnings.extend(hidden_cores(scene, &bssrdf));
+    warnings.extend(small_objects(scene, &plans));
+    warnings.extend(depth_varying(scene, &bssrdf));
     warnings
 }
 
 /// One warning per delta light (directional, point) that cannot light the inside of a
-/// refractive (η > 1) translucent object in a path tracer, with that light's share of the
-/// power of every light `render` samples ([`Light::power`]).
-fn unreachable_lights(scene: &Scene) -> Vec<String> {
+/// refractive (η > 1) translucent object in a path tracer (those for which `traced` holds),
+/// with that light's share of the power of every light `render` samples ([`Light::power`]).
+fn unreachable_lights(scene: &Scene, traced: &dyn Fn(u32) -> bool) -> Vec<String> {
     let refractive: Vec<String> = scene
         .translucent_objects()
-        .filter(|(_, t)| t.eta != 1.0)
+        .filter(|(i, t)| t.eta != 1.0 && traced(*i))
         .map(|(i, t)| format!("`{}` (eta = {})", scene.objects()[i as usize].name, t.eta))
         .collect();
     if refractive.is_empty() {
@@ -88,12 +88,14 @@ fn unreachable_lights(scene: &Scene) -> Vec<String> {
     warnings
 }
 
-/// One warning per opaque object inside or crossing a translucent one: the BSSRDF methods
-/// treat the translucent object as homogeneous material throughout.
-fn hidden_cores(scene: &Scene) -> Vec<String> {
+/// One warning per opaque object inside or crossing a translucent one rendered by a BSSRDF
+/// (`bssrdf` holds for it): the BSSRDF methods treat the translucent object as homogeneous
+/// material throughout.
+fn hidden_cores(scene: &Scene, bssrdf: &dyn Fn(u32) -> bool) -> Vec<String> {
     scene
         .opaque_inside_media()
         .into_iter()
+        .filter(|(t, _)| bssrdf(*t))
         .map(|(t, o)| {
             format!(
                 "object `{}` lies inside or crosses the translucent object `{}`: BSSRDF methods \
@@ -133,6 +135,26 @@ pub(crate) fn light_reach(c: het_estimate::Coefficients, g: f64) -> (f64, bool) 
         .fold((0.0, true), |acc, x| if x.0 > acc.0 { x } else { acc })
 }
 
+/// Whether translucent object `object` is too small for a half-space profile: its bounding
+/// box's thinnest side is shorter than [`SMALL_OBJECT_DIFFUSION_LENGTHS`] times the longer of
+/// the diffusion length and the transport mean free path of its most translucent part
+/// (`light_reach` at the field's smallest coefficients). `--method auto` path-traces such
+/// objects, and the shape correction's `auto` corrects those a BSSRDF renders. False for an
+/// object that is not translucent.
+pub fn is_optically_small(scene: &Scene, object: u32) -> bool {
+    let Some(t) = scene
+        .objects()
+        .get(object as usize)
+        .and_then(|o| o.material.translucent())
+    else {
+        return false;
+    };
+    let (lo, hi) = scene.geometry().object_bounds(object);
+    let thinnest = (hi - lo).min_element();
+    let (longest, _) = light_reach(t.medium.field_bounds().min, t.g);
+    longest > 0.0 && thinnest.is_finite() && thinnest < SMALL_OBJECT_DIFFUSION_LENGTHS * longest
+}
+
 /// Camera samples per side of the grid that measures an object's share of the image.
 const SHARE_GRID: u32 = 128;
 
@@ -146,50 +168,53 @@ const SHARE_GRID: u32 = 128;
 /// slabs of 0.5 and 2 mfp render ×2.2 to ×6.7 and ×0.85 to ×1.47 too bright, a sphere of
 /// radius 1 mfp ×0.40 to ×0.95; at g = 0.8 sizes in transport mean free paths are 5× smaller
 /// and the errors grow (docs/physics.md#hazards).
-fn small_objects(scene: &Scene) -> Vec<String> {
+fn small_objects(scene: &Scene, plans: &[Option<ObjectPlan>]) -> Vec<String> {
     let mut warnings = Vec::new();
     for (i, t) in scene.translucent_objects() {
+        let Some(plan) = plans[i as usize].filter(|p| p.small && !p.path_traced) else {
+            continue;
+        };
         let (lo, hi) = scene.geometry().object_bounds(i);
-        let thinnest = (hi - lo).min_element();
+        let extent = hi - lo;
+        let thinnest = extent.min_element();
         let b = t.medium.field_bounds();
         let (longest, diffusive) = light_reach(b.min, t.g);
-        if longest > 0.0
-            && thinnest.is_finite()
-            && thinnest < SMALL_OBJECT_DIFFUSION_LENGTHS * longest
-        {
-            let share = 100.0 * image_share(scene, i);
-            let (unit, symbol) = if diffusive {
-                ("diffusion lengths", "1/σtr")
-            } else {
-                ("transport mean free paths", "1/σt'")
-            };
-            let value = if longest.is_finite() {
-                format!("{longest:.3}")
-            } else {
-                "∞".to_string()
-            };
-            let consequence = if t.shape_correction {
-                "the material's `shape_correction` scales the BSSRDF so that the object answers \
-                 uniform light as the volume does (measured by random walks in it), which brought \
-                 spheres, corners and the bunny within 15 % of the path tracer under uniform \
-                 light (docs/shapes.md); under other light it is a first-order correction"
-            } else {
-                "so light leaving through other faces, or never returning from a small curved \
-                 part, is not modelled, and those pixels can be several times too bright (thin \
-                 parts) or too dark (small bodies); `shape_correction = true` on the material \
-                 corrects most of it (docs/shapes.md)"
-            };
-            warnings.push(format!(
-                "translucent object `{}` ({share:.1} % of the image's pixels) is {thinnest:.3} \
-                 across its thinnest side, {:.2} {unit} of its most translucent part \
-                 ({symbol} = {value}, g = {}): BSSRDF profiles assume a half-space (the \
-                 tabulated profile at |g| <= 0.5: a slab of the local thickness on flat thin \
-                 parts); {consequence}; compare with `--method pt`",
-                scene.objects()[i as usize].name,
-                thinnest / longest,
-                t.g
-            ));
-        }
+        let share = 100.0 * image_share(scene, i);
+        let (unit, symbol) = if diffusive {
+            ("diffusion lengths", "1/σtr")
+        } else {
+            ("transport mean free paths", "1/σt'")
+        };
+        let value = if longest.is_finite() {
+            format!("{longest:.3}")
+        } else {
+            "∞".to_string()
+        };
+        // A thin part (a slab: its thinnest side well below the others) loses light through
+        // the far face, which a half-space keeps: too bright; a small compact body returns
+        // less light than a half-space: too dark (docs/shapes.md).
+        let middle = extent.x + extent.y + extent.z - extent.max_element() - thinnest;
+        let sign = if thinnest < 0.5 * middle {
+            "a thin part: a half-space profile renders it too bright (×0.85 to ×6.7 for slabs of 0.5 to 2 mfp)"
+        } else {
+            "a small body: a half-space profile renders it too dark (×0.40 to ×0.95 for a sphere of radius 1 mfp)"
+        };
+        let consequence = if plan.corrected {
+            "the shape correction scales its BSSRDF so that it answers uniform light as the \
+             volume does (measured by random walks in it: within 15 % of the path tracer under \
+             uniform light, docs/shapes.md); under other light it is a first-order correction"
+        } else {
+            "the shape correction is off for it (`render --shape-correction auto` or `on`, or \
+             the material's `shape_correction = true`, turns it on)"
+        };
+        warnings.push(format!(
+            "translucent object `{}` ({share:.1} % of the image's pixels) is {thinnest:.3} \
+             across its thinnest side, {:.2} {unit} of its most translucent part ({symbol} = \
+             {value}, g = {}): {sign}; {consequence}; `--method auto` path-traces such objects",
+            scene.objects()[i as usize].name,
+            thinnest / longest,
+            t.g
+        ));
     }
     warnings
 }
@@ -210,9 +235,10 @@ const OBLIQUE_SINE: f64 = 0.422_618_261_740_699_4;
 /// tracer over the heterogeneous bunny (`examples/scenes/bunny.toml`), 0.95 with the shape
 /// correction, whose walks go through the medium (0.89 when they went through the coefficients
 /// at the surface); 1.03–1.06 with a layer boundary 0.05–0.5 below a flat surface.
-fn depth_varying(scene: &Scene) -> Vec<String> {
+fn depth_varying(scene: &Scene, bssrdf: &dyn Fn(u32) -> bool) -> Vec<String> {
     let mut tallies: Vec<DepthTally<'_>> = scene
         .translucent_objects()
+        .filter(|(i, _)| bssrdf(*i))
         .map(|(object, t)| DepthTally {
             object,
             fields: t

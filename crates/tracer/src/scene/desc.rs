@@ -527,5 +527,10 @@ shape_desc!(
     MeshFileDesc {
         /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
+        /// A glTF shape without `material` only: the `shape_correction` of every translucent
+        /// material the file creates (as the material key; unset, the render decides).
+        shape_correction: Option<bool>,
+        /// A glTF shape without `material` only: their `shape_correction_seed`.
+        shape_correction_seed: Option<u64>,
     }
 );

@@ -628,10 +628,11 @@ impl Cx {
             }
             (g, a) => g.or(a).unwrap_or(0.0),
         };
-        if d.shape_correction_seed.is_some() && d.shape_correction != Some(true) {
+        if d.shape_correction_seed.is_some() && d.shape_correction == Some(false) {
             return Err(self.invalid(
                 &format!("{key}.shape_correction_seed"),
-                "a seed for the shape correction, which is off: add `shape_correction = true`",
+                "a seed for the shape correction, which `shape_correction = false` turns off: \
+                 remove one of the two",
             ));
         }
         // Validate the scalar values now with placeholder constant fields (so that unused
@@ -643,7 +644,7 @@ impl Cx {
             eta: d.eta,
             profile,
             thickness_aware: d.thickness_aware.unwrap_or(true),
-            shape_correction: d.shape_correction.unwrap_or(false),
+            shape_correction: d.shape_correction,
             correction_seed: d
                 .shape_correction_seed
                 .unwrap_or(Translucent::DEFAULT_CORRECTION_SEED),
@@ -964,6 +965,28 @@ impl Cx {
                 }
                 kind @ ("obj" | "gltf" | "ply") => {
                     let d: MeshFileDesc = self.de(v, &key)?;
+                    let correction = (d.shape_correction, d.shape_correction_seed);
+                    if (correction.0.is_some() || correction.1.is_some())
+                        && (kind != "gltf" || d.material.is_some())
+                    {
+                        let which = if correction.0.is_some() {
+                            "shape_correction"
+                        } else {
+                            "shape_correction_seed"
+                        };
+                        return Err(self.invalid(
+                            &k(which),
+                            "applies to a glTF shape that uses the file's materials (no \
+                             `material`); set it on the material instead",
+                        ));
+                    }
+                    if correction.0 == Some(false) && correction.1.is_some() {
+                        return Err(self.invalid(
+                            &k("shape_correction_seed"),
+                            "a seed for the shape correction, which `shape_correction = false` \
+                             turns off: remove one of the two",
+                        ));
+                    }
                     let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
                     self.check_readable(&k("path"), &path)?;
@@ -984,7 +1007,7 @@ impl Cx {
                         let mut images = HashMap::new();
                         for part in std::mem::take(&mut model.parts) {
                             let name = format!("{shape}/{}", part.material.name);
-                            let material = self.gltf_material(
+                            let mut material = self.gltf_material(
                                 &model,
                                 &part.material,
                                 &mut images,
@@ -992,6 +1015,14 @@ impl Cx {
                                 &key,
                                 scale,
                             )?;
+                            if let Material::Translucent(t) = &mut material {
+                                if let Some(on) = correction.0 {
+                                    t.shape_correction = Some(on);
+                                }
+                                if let Some(seed) = correction.1 {
+                                    t.correction_seed = seed;
+                                }
+                            }
                             self.add_shape(
                                 &mut out,
                                 &mut names,

@@ -125,9 +125,11 @@ pub struct Translucent {
     /// Whether a BSSRDF render scales the profile by the shape correction measured by random
     /// walks in the object when the render is prepared (`integrator/shape_correction.rs`,
     /// docs/shapes.md): small and curved bodies answer uniform light as the volume does. Its
-    /// preparation costs seconds to minutes (more with higher albedo and larger objects).
-    /// Scene key `shape_correction`; default false.
-    pub shape_correction: bool,
+    /// preparation costs seconds (more with higher albedo and larger objects). Scene key
+    /// `shape_correction`; `None` (no key) leaves the choice to the render
+    /// ([`crate::integrator::Correction`]: by default, the objects too small for a half-space
+    /// profile).
+    pub shape_correction: Option<bool>,
     /// Seed of the shape correction's random numbers (scene key `shape_correction_seed`;
     /// default [`Translucent::DEFAULT_CORRECTION_SEED`]). The correction is a Monte Carlo
     /// measurement made once per render; another seed shows its own spread.
@@ -182,7 +184,7 @@ impl Translucent {
             eta,
             profile: None,
             thickness_aware: true,
-            shape_correction: false,
+            shape_correction: None,
             correction_seed: Self::DEFAULT_CORRECTION_SEED,
             angular_coupling: true,
             unit_scale: 1.0,
@@ -389,24 +391,45 @@ impl Scene {
         Ok(())
     }
 
-    /// Errors when a translucent material used by an object has a field defined only on the
-    /// surface (a UV-mapped image): a volumetric render needs coefficients in the volume.
+    /// Errors when a translucent object's medium has a field defined only on the surface (a
+    /// UV-mapped image) and its mesh has no texture coordinates. With them, the path tracer
+    /// reads such a field inside the body at the texture coordinates of the nearest surface
+    /// point ([`crate::field::MediumField::with_interior`]); without them the field has no
+    /// value anywhere.
     pub fn require_volumetric(&self) -> Result<(), SceneError> {
-        for (_, t) in self.translucent_objects() {
+        for (i, t) in self.translucent_objects() {
+            if self.geometry().mesh(i).uvs.is_some() {
+                continue;
+            }
             for (which, f) in t.medium.named_fields() {
                 if !f.is_volumetric() {
                     return Err(self.invalid(
                         format!("{}.{which}", t.key),
                         t.line,
                         format!(
-                            "material `{}`: {which} is a UV-mapped image, defined only on the surface; a volumetric (path-traced) render needs a planar projection (`mapping = \"planar\"`)",
-                            t.name
+                            "material `{}`: {which} is a UV-mapped image and the mesh of `{}` has no texture coordinates, so it has no value inside the body for a volumetric (path-traced) render; give the mesh texture coordinates or use a planar projection (`mapping = \"planar\"`)",
+                            t.name,
+                            self.objects[i as usize].name
                         ),
                     ));
                 }
             }
         }
         Ok(())
+    }
+
+    /// Whether the path tracer can walk translucent object `object`: a closed mesh, and a
+    /// medium defined in space or read through texture coordinates the mesh has (the two
+    /// checks of [`Scene::require_path_traceable`], for one object).
+    pub fn can_path_trace(&self, object: u32) -> bool {
+        let Some(o) = self.objects.get(object as usize) else {
+            return false;
+        };
+        let Some(t) = o.material.translucent() else {
+            return false;
+        };
+        o.report.is_closed()
+            && (t.medium.is_volumetric() || self.geometry().mesh(object).uvs.is_some())
     }
 
     /// Both checks a volumetric path-traced render needs.

@@ -242,10 +242,7 @@ fn strategies_agree(what: &str, scene: &Scene, method: Method, spp: u32) {
 }
 
 fn sone(profile: ProfileModel) -> Method {
-    Method::Bssrdf {
-        estimator: "sone".parse().unwrap(),
-        profile: Some(profile),
-    }
+    Method::bssrdf("sone".parse().unwrap(), Some(profile))
 }
 
 #[test]

@@ -300,10 +300,7 @@ fn gltf_scene_warns_about_what_it_does_not_read_and_other_meshes_need_a_material
         tracer::scene::Scene::from_toml_str(&scene_text, dir.path(), "clearcoat.toml").unwrap();
     for method in [
         Method::PathTraced,
-        Method::Bssrdf {
-            estimator: het_estimate::Estimator::Sone(Default::default()),
-            profile: None,
-        },
+        Method::bssrdf(het_estimate::Estimator::Sone(Default::default()), None),
     ] {
         let w = scene_warnings(&scene, method);
         assert!(

@@ -619,8 +619,8 @@ fn the_default_profile_is_tabulated_where_it_applies() {
 }
 
 /// `shape_correction_seed` reaches the material (the correction's own Monte Carlo seed);
-/// without it the material has the default seed; given while the correction is off, it is an
-/// error naming the key.
+/// without it the material has the default seed; given while the material turns the correction
+/// off, it is an error naming the key.
 #[test]
 fn shape_correction_seed_is_read_and_needs_the_correction() {
     use tracer::scene::{Material, Translucent};
@@ -636,18 +636,21 @@ fn shape_correction_seed_is_read_and_needs_the_correction() {
         seed_of(&with(
             "shape_correction = true\nshape_correction_seed = 7\n"
         )),
-        (true, 7)
+        (Some(true), 7)
     );
     assert_eq!(
         seed_of(&with("shape_correction = true\n")),
-        (true, Translucent::DEFAULT_CORRECTION_SEED)
+        (Some(true), Translucent::DEFAULT_CORRECTION_SEED)
     );
-    for off in ["", "shape_correction = false\n"] {
-        let e = load_err(&with(&format!("{off}shape_correction_seed = 7\n")));
-        check(
-            &e,
-            "material[0].shape_correction_seed",
-            &["shape_correction = true"],
-        );
-    }
+    // Without the key the render decides (`--shape-correction auto` corrects small objects):
+    // a seed is meaningful.
+    assert_eq!(seed_of(&with("shape_correction_seed = 7\n")), (None, 7));
+    let e = load_err(&with(
+        "shape_correction = false\nshape_correction_seed = 7\n",
+    ));
+    check(
+        &e,
+        "material[0].shape_correction_seed",
+        &["shape_correction = false"],
+    );
 }
