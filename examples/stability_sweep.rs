@@ -281,7 +281,7 @@ below keeps a value finite where the formula has a removable singularity or leav
   cleanly to 0; HG's inverse CDF and CDF switch to the isotropic form for |g| < 1e-8.
 * `table.rs`: rows uniform in s = √(1 − α') (48), columns x = 0 and 127 radii geometric in \
   **[1e-4, 1e5]** (optical), **the x = 0 column is evaluated at x = 1e-6** (`X0_EVAL`) and \
-  `TableSampler::eval` at **max(r, 1e-6/σt')**; beyond x = 1e5 an exponential tail of scale 1e5 \
+  `RadiusSampler::eval` at **max(r, 1e-6/σt')**; beyond x = 1e5 an exponential tail of scale 1e5 \
   keeps the density positive everywhere; rows with no energy (α' = 0) borrow the nearest row's \
   shape; the interpolated total is clamped at ≥ 0; `invert_rho_eff` clamps its target to \
   [ρ_eff(0), ρ_eff(1)] (NaN → ρ_eff(0)); sampling clamps u to < 1 − ε/2 and the tail quantile \

@@ -10,7 +10,7 @@ use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::analytic::{CheckField, PlanePoint, StripeField};
 use het_estimate::pattern::{BinaryPattern, Check, Stripe};
-use het_estimate::{CoefficientField, Coefficients, Estimator, Named};
+use het_estimate::{CoefficientField, Coefficients, Estimator};
 use tracer::field::{Axis, Field, MediumField, PlanarProjection};
 use tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, TriangleMesh, primitives};
 use tracer::integrator::probe::{ProbeSampler, probe};

@@ -343,8 +343,12 @@ fn angular_coupling_as_read_matches_chandrasekhar_at_eta_one() {
     let centre = |j: usize| ((j as f64 + 0.5) / N_MU as f64).sqrt();
     let mut worst: f64 = 0.0;
     let mut spread: f64 = 0.0;
-    for (single, kinds) in [(true, &[0, 1][..]), (false, &[1][..])] {
-        let coupling = AngularCoupling::new(1.0, single, true).unwrap();
+    for (scattering, kinds) in [
+        (bssrdf_core::Scattering::All, &[0, 1][..]),
+        (bssrdf_core::Scattering::Multiple, &[1][..]),
+    ] {
+        let coupling = AngularCoupling::new(1.0, scattering);
+        let single = scattering.includes_single();
         for row in 0..N_ALBEDO {
             let alpha = albedo_of_row(row);
             if !(0.3..=0.999).contains(&alpha) {

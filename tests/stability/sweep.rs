@@ -244,7 +244,7 @@ impl Report {
 pub mod section {
     /// `Profile` methods.
     pub const PROFILE: u8 = 1;
-    /// `TableSampler` methods.
+    /// `RadiusSampler` methods.
     pub const TABLE: u8 = 2;
     /// Directional dipole.
     pub const DIRPOLE: u8 = 3;
@@ -330,7 +330,7 @@ fn timed<T>(seconds: &mut f64, f: impl FnOnce() -> T) -> T {
     v
 }
 
-/// Checks the five `RadialProfile` methods of `p` (a `Profile` or a `TableSampler`).
+/// Checks the five `RadialProfile` methods of `p` (a `Profile` or a `RadiusSampler`).
 #[allow(clippy::too_many_arguments)]
 fn check_radial(
     r: &mut Report,
@@ -351,11 +351,11 @@ fn check_radial(
             "Profile::radius_for_fraction",
         ],
         _ => [
-            "TableSampler::eval",
-            "TableSampler::total",
-            "TableSampler::sample_r",
-            "TableSampler::pdf_r",
-            "TableSampler::radius_for_fraction",
+            "RadiusSampler::eval",
+            "RadiusSampler::total",
+            "RadiusSampler::sample_r",
+            "RadiusSampler::pdf_r",
+            "RadiusSampler::radius_for_fraction",
         ],
     };
     let _ = kind;

@@ -6,7 +6,7 @@
 #[non_exhaustive]
 pub enum ParamError {
     /// A value was NaN or infinite.
-    #[error("{name} must be finite, got {value}")]
+    #[error("{name} must be finite, got {}", Num(*value))]
     NotFinite {
         /// Parameter name (`sigma_a`, `g`, …).
         name: &'static str,
@@ -14,7 +14,7 @@ pub enum ParamError {
         value: f64,
     },
     /// A value that must be non-negative was negative.
-    #[error("{name} must be >= 0, got {value}")]
+    #[error("{name} must be >= 0, got {}", Num(*value))]
     Negative {
         /// Parameter name.
         name: &'static str,
@@ -22,7 +22,7 @@ pub enum ParamError {
         value: f64,
     },
     /// A value lay outside its allowed range.
-    #[error("{name} must lie in {range}, got {value}")]
+    #[error("{name} must lie in {range}, got {}", Num(*value))]
     OutOfRange {
         /// Parameter name.
         name: &'static str,
@@ -35,6 +35,23 @@ pub enum ParamError {
     /// that parsing composes with `?` alongside the other parameter checks.
     #[error(transparent)]
     UnknownName(#[from] crate::model::UnknownName),
+}
+
+/// A number as error messages print it: as written when that is short (`0.5`, `-1`, `1.6`),
+/// in scientific notation (`{:e}`) when the plain form would run past 12 characters, so that
+/// `1e50` prints as `1e50` and not as 51 digits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let plain = self.0.to_string();
+        if plain.len() <= 12 {
+            f.write_str(&plain)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
 }
 
 /// Checks that `value` is finite and `>= 0`.
@@ -115,4 +132,26 @@ pub fn validate_sigmas(sigma_a: f64, sigma_s: f64) -> Result<(f64, f64), ParamEr
         check_sigma(name, v).map(|v| if v < SIGMA_EPSILON { 0.0 } else { v })
     };
     Ok((check("sigma_a", sigma_a)?, check("sigma_s", sigma_s)?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_print_short_numbers() {
+        let e = check_sigma("sigma_a", 1.000_000_000_000_000_5e20).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "sigma_a must lie in [0, 1e12], got 1.0000000000000005e20"
+        );
+        assert_eq!(
+            check_sigma("sigma_s", -0.5).unwrap_err().to_string(),
+            "sigma_s must be >= 0, got -0.5"
+        );
+        assert_eq!(Num(f64::NAN).to_string(), "NaN");
+        assert_eq!(Num(1.0 / 3.0).to_string(), "3.333333333333333e-1");
+        assert_eq!(Num(1e-30).to_string(), "1e-30");
+        assert_eq!(Num(1.6).to_string(), "1.6");
+    }
 }

@@ -33,9 +33,18 @@ pub struct FamilyOptions {
 }
 
 impl FamilyOptions {
-    /// Default options with the given diffuse Fresnel choice.
-    pub const fn with_diffuse_fresnel(diffuse_fresnel: DiffuseFresnel) -> Self {
-        Self { diffuse_fresnel }
+    /// The defaults (the exact diffuse Fresnel reflectance).
+    pub const fn new() -> Self {
+        Self {
+            diffuse_fresnel: DiffuseFresnel::Exact,
+        }
+    }
+
+    /// The same options with the diffuse Fresnel choice `diffuse_fresnel`
+    /// (`FamilyOptions::new().with_diffuse_fresnel(DiffuseFresnel::JensenFit)`).
+    pub const fn with_diffuse_fresnel(mut self, diffuse_fresnel: DiffuseFresnel) -> Self {
+        self.diffuse_fresnel = diffuse_fresnel;
+        self
     }
 }
 

@@ -34,7 +34,7 @@ fn dipole_spot_values_match_notes() {
         Scattering::Multiple,
         0.0,
         1.3,
-        FamilyOptions::with_diffuse_fresnel(DiffuseFresnel::JensenFit),
+        FamilyOptions::new().with_diffuse_fresnel(DiffuseFresnel::JensenFit),
     )
     .unwrap();
     assert!(

@@ -1,5 +1,5 @@
-//! Homogeneous BSSRDF profile models in `f64`.
-//!
+#![doc = include_str!("../README.md")]
+//! # The layer
 //! This crate is the bottom layer of het-bssrdf (like pbrt's `util/` directory): pure
 //! numerics, no scene types, no I/O. It knows how light leaves a *homogeneous*
 //! half-space; the `het-estimate` crate decides which homogeneous parameters stand in
@@ -33,31 +33,7 @@
 //! valid input (σa = 0, σs = 0, vacuum, σt from 1e-6 to 1e6, r = 0 … 1e9, |g| < 1, η ∈ [1, 3]);
 //! invalid input is a [`ParamError`].
 //!
-//! # Using the profiles (renderer side)
-//! ```
-//! use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Rgb, Scattering};
-//! // Once per material:
-//! let family = ProfileFamily::new(ProfileModel::Pbd, Scattering::Multiple, 0.0, 1.3)?;
-//! let table = ProfileTable::new(family);
-//! // Per (x_i, x_o) pair, with the estimated coefficients:
-//! let profile = family.profile(0.01, 1.0)?;
-//! let value = profile.eval(0.7); // 1/length²
-//! // Per shading point, radius sampling at x_o's coefficients:
-//! let sampler = table.sampler(0.01, 1.0)?;
-//! if let Some(r) = sampler.sample_r(0.3) {
-//!     let pdf = sampler.pdf_r(r);
-//!     assert!(pdf > 0.0 && value > 0.0);
-//! }
-//! let probe_len = sampler.radius_for_fraction(0.999);
-//! assert!(probe_len > 0.0);
-//! // All three colour channels at once (grey channels are evaluated once):
-//! let rgb = family.profile_rgb(Rgb::new(0.01, 0.02, 0.05), Rgb::splat(1.0))?;
-//! let rd: Rgb = rgb.eval_rgb(0.7);
-//! assert!(rd[0] > rd[2]); // less absorption, more light at a distance
-//! // Unknown names are parameter errors too, so set-up composes with `?`:
-//! let model: ProfileModel = "pbd".parse()?;
-//! # Ok::<(), bssrdf_core::ParamError>(())
-//! ```
+//! The renderer-side example (the README's, compiled as a doctest) is at the top of this page.
 //!
 //! The estimators that choose `(σa, σs)` for a heterogeneous object, probe-ray sampling of
 //! incident points, and a complete example of both traits a renderer implements are in the
@@ -72,7 +48,9 @@
 pub mod albedo_inversion;
 pub mod beam_diffusion;
 pub mod better_dipole;
+#[cfg(any(test, feature = "tabulate"))]
 pub mod chi_square;
+mod coefficients;
 pub mod dipole;
 mod dipole_pair;
 pub mod directional_dipole;
@@ -86,13 +64,16 @@ pub mod profile;
 mod quadrature;
 pub mod rgb;
 pub mod rgb_profile;
+pub mod separable;
 pub mod single_scattering;
 pub mod slab_profile;
 pub mod table;
 pub mod tabulated;
 
 pub use albedo_inversion::AlbedoInversion;
+pub use coefficients::Coefficients;
 pub use error::ParamError;
+pub use error::{SIGMA_EPSILON, SIGMA_MAX};
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
 pub use fresnel::{DiffuseFresnel, FresnelMoments};
 /// The vector types of the public API (`glam::DVec3`), re-exported so that callers use the
@@ -103,8 +84,9 @@ pub use model::{ProfileModel, Scattering, UnknownName};
 pub use profile::RadialProfile;
 pub use rgb::Rgb;
 pub use rgb_profile::RgbProfile;
+pub use separable::{Crossing, SeparableBssrdf};
 pub use slab_profile::SlabProfile;
-pub use table::{ProfileTable, TableSampler};
+pub use table::{ProfileTable, RadiusSampler};
 pub use tabulated::SlabFace;
 
 #[cfg(test)]

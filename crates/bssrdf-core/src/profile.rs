@@ -9,8 +9,13 @@ use std::f64::consts::PI;
 /// # Conventions
 /// * `eval(r)` is the **radiant exitance per unit area at distance `r` from the point of
 ///   incidence, per unit incident power** (units 1/length², docs/physics.md#conventions). No Fresnel
-///   transmission factors and no `1/π` are included: a BSSRDF built from it multiplies by
-///   those (e.g. JMLH01's `S_d = F_t R F_t / π`).
+///   transmission factors and no angular normalisation are included. The BSSRDF the tracer
+///   renders and validates against its path tracer is
+///   `S = R · (1 − F_r(cos θ_i))(1 − F_r(cos θ_o)) / (c π)` with `c = 1 − 2 C₁(1/η)`
+///   (pbrt-v4's normalised Fresnel lobe), times the tabulated profile's angular coupling:
+///   call [`crate::SeparableBssrdf`] rather than rebuilding it. JMLH01's `F_t R F_t / π`
+///   (no `c`) is darker by the factor c = 0.939 at η = 1.3 and 0.908 at η = 1.5 (the
+///   validated S is 6.5 % and 10 % brighter).
 /// * `total()` is `∫₀^∞ 2πr R(r) dr`, the total diffuse reflectance (dimensionless).
 /// * `pdf_r(r)` is a probability density **with respect to `r`** (1/length) on `[0, ∞)`, and
 ///   `sample_r(u)` draws from exactly that density (inverse-CDF, so it is a deterministic,
@@ -40,7 +45,7 @@ pub trait RadialProfile {
     ///
     /// Cost: a numerical CDF inversion (milliseconds) for every model without a closed-form
     /// CDF: per material only. The per-material table's version
-    /// ([`crate::table::TableSampler`]) costs 0.2 µs.
+    /// ([`crate::table::RadiusSampler`]) costs 0.2 µs.
     fn radius_for_fraction(&self, f: f64) -> f64;
 }
 

@@ -14,7 +14,7 @@
 //! * **Per pair of points:** [`ProfileFamily::profile_rgb`] plus [`RgbProfile::eval_rgb`]
 //!   costs 0.26 µs for three distinct dipole channels and 21 µs for photon beam diffusion (a
 //!   depth quadrature per channel). Where PBD is too slow for an inner loop, the table's
-//!   tabulated evaluation ([`crate::table::TableSampler`]'s `eval`) costs the same for every
+//!   tabulated evaluation ([`crate::table::RadiusSampler`]'s `eval`) costs the same for every
 //!   model; it is an approximation, within 1.5 % of the exact profile weighted by energy but
 //!   up to 35 % off at single radii in the far tail and near r = 0 (tested).
 //! * **Never per sample:** [`RadialProfile::total`] and [`RadialProfile::radius_for_fraction`]

@@ -15,7 +15,7 @@
 //!   everywhere and sampling is unbiased for any profile), and the model's exact total.
 //!
 //! # Sampler
-//! [`ProfileTable::sampler`] returns a [`TableSampler`] (no allocation) for `(σa, σs)`: it
+//! [`ProfileTable::sampler`] returns a [`RadiusSampler`] (no allocation) for `(σa, σs)`: it
 //! mixes the two albedo rows around `s` with weights `(1 − t, t)`; `sample_r` picks a row with
 //! those probabilities (by splitting `u`) and inverts that row's piecewise-linear CDF exactly
 //! (a quadratic per cell), so `pdf_r = σt'[(1−t)p_i(x) + t p_{i+1}(x)]` is *exactly* the
@@ -226,12 +226,12 @@ impl ProfileTable {
 
     /// The sampler for coefficients `(σa, σs)` (1/length; validated like
     /// [`ProfileFamily::profile`]). Cost: a few ns, no allocation.
-    pub fn sampler(&self, sigma_a: f64, sigma_s: f64) -> Result<TableSampler<'_>, ParamError> {
+    pub fn sampler(&self, sigma_a: f64, sigma_s: f64) -> Result<RadiusSampler<'_>, ParamError> {
         let (sigma_a, sigma_s) = validate_sigmas(sigma_a, sigma_s)?;
         let sigma_sp = (1.0 - self.family.g()) * sigma_s;
         let sigma_tp = sigma_a + sigma_sp;
         if sigma_sp < SIGMA_EPSILON || sigma_tp < SIGMA_EPSILON {
-            return Ok(TableSampler {
+            return Ok(RadiusSampler {
                 table: self,
                 row: 0,
                 t: 0.0,
@@ -244,7 +244,7 @@ impl ProfileTable {
         let pos = s * (ROWS - 1) as f64;
         let row = (pos.floor() as usize).min(ROWS - 2);
         let t = (pos - row as f64).clamp(0.0, 1.0);
-        Ok(TableSampler {
+        Ok(RadiusSampler {
             table: self,
             row,
             t,
@@ -422,7 +422,7 @@ impl ProfileTable {
 
 /// Radius sampler at one `(σa, σs)` drawn from a [`ProfileTable`]; see the module docs.
 #[derive(Debug, Clone, Copy)]
-pub struct TableSampler<'a> {
+pub struct RadiusSampler<'a> {
     table: &'a ProfileTable,
     row: usize,
     t: f64,
@@ -431,7 +431,7 @@ pub struct TableSampler<'a> {
     total: f64,
 }
 
-impl TableSampler<'_> {
+impl RadiusSampler<'_> {
     /// True when the coefficients give no scattering (zero profile).
     pub fn is_zero(&self) -> bool {
         self.scale == 0.0
@@ -455,7 +455,7 @@ impl TableSampler<'_> {
     }
 }
 
-impl RadialProfile for TableSampler<'_> {
+impl RadialProfile for RadiusSampler<'_> {
     fn eval(&self, r: f64) -> f64 {
         if self.is_zero() {
             return 0.0;

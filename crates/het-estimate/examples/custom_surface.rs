@@ -3,10 +3,9 @@
 //!
 //! Run: `cargo run -p het-estimate --example custom_surface`
 
-use glam::DVec3;
+use het_estimate::glam::DVec3;
 use het_estimate::{
-    CoefficientField, Coefficients, Estimator, FieldBounds, Named, SplitMix64, SurfacePoint,
-    SurfaceQuery,
+    CoefficientField, Coefficients, Estimator, FieldBounds, SplitMix64, SurfacePoint, SurfaceQuery,
 };
 
 /// A sphere of radius `r` at the origin (the medium is inside).

@@ -7,8 +7,8 @@ use crate::field::Coefficients;
 /// The homogeneous parameters estimated for one pair (x_i, x_o).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Estimate {
-    /// Averaged σa and σs per channel (1/length). Always finite and ≥ 0, and within the
-    /// field's bounds when it reports them.
+    /// Averaged σa and σs per channel (1/length). Always in `[0, 1e12]` (the profiles'
+    /// range, `bssrdf_core::SIGMA_MAX`), and within the field's bounds when it reports them.
     pub coefficients: Coefficients,
     /// How the estimate was obtained.
     pub diagnostics: Diagnostics,

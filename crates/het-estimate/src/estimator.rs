@@ -1,6 +1,8 @@
 //! The closed set of estimators, resolved once per material ([`Estimator::prepare`]) and then
 //! run per (x_i, x_o) pair ([`PreparedEstimator::estimate`]).
 
+use std::sync::Arc;
+
 use bssrdf_core::ParamError;
 
 use crate::estimate::{Estimate, Region};
@@ -10,8 +12,8 @@ use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::names::Named;
 use crate::point_lookup;
+use crate::random::UniformSource;
 use crate::region_average::Probe;
-use crate::sampler::UniformSource;
 use crate::segment::{self, SegmentParams};
 use crate::sone::{self, SoneParams};
 use crate::surface::SurfaceQuery;
@@ -84,8 +86,10 @@ impl Estimator {
     }
 
     /// Validates the parameters and resolves the per-material constants (⟨θ²⟩ for Sone:
-    /// the exact value costs ~1 µs; the kernel's table: a few ms the first time a process
-    /// sees a given η, then shared), so do this once per material, outside the pixel loop.
+    /// the exact value costs ~1 µs; the kernel's table: a few ms unless another live
+    /// prepared estimator already holds the table of the same η, which is then shared), so do
+    /// this once per material, outside the pixel loop. The prepared estimator owns what it
+    /// computed: dropping it frees the kernel's table (512 KiB) unless another holds it.
     ///
     /// `g` is the Henyey–Greenstein mean cosine of the material (|g| < 1) and `eta` its
     /// relative index of refraction n_medium/n_outside (in [1, 3]; the kernel's extrapolated
@@ -137,17 +141,19 @@ impl Estimator {
     }
 }
 
-/// An estimator with its per-material constants resolved. Cheap to copy and share between
-/// threads; [`PreparedEstimator::estimate`] takes `&self`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// An estimator with its per-material constants resolved. `Send + Sync`, cheap to clone (the
+/// kernel's table is shared by reference count); [`PreparedEstimator::estimate`] takes
+/// `&self`.
+#[derive(Debug, Clone, PartialEq)]
 pub struct PreparedEstimator {
     estimator: Estimator,
     theta2: f64,
     /// Factor on σs in Eq. (2) (Sone; see `WidthScattering`).
     sigma_s_scale: f64,
     g: f64,
-    /// The kernel estimator's table (shared per η), `None` for the others.
-    kernel: Option<&'static KernelTable>,
+    /// The kernel estimator's table (shared per η among live estimators), `None` for the
+    /// others.
+    kernel: Option<Arc<KernelTable>>,
 }
 
 impl PreparedEstimator {
@@ -169,8 +175,11 @@ impl PreparedEstimator {
     /// * `rng`: the caller's uniform stream; fixed budgets draw 2 numbers per averaging stage
     ///   (1 for `segment`), point lookups none.
     ///
-    /// Never allocates, never panics on valid input; the coefficients are always finite and
-    /// ≥ 0. If `field.bounds()` says the field is constant, the constant is returned without
+    /// Never allocates, never panics on valid input; the coefficients always lie in the range
+    /// the profiles accept, `[0, bssrdf_core::SIGMA_MAX]` (1e12 per unit length): larger
+    /// values (a field returning +∞, or 1e15) are clamped to it
+    /// ([`Coefficients::clamp_to_range`](crate::Coefficients::clamp_to_range)), so an
+    /// estimate is always a valid profile argument. If `field.bounds()` says the field is constant, the constant is returned without
     /// any lookup or projection ([`crate::Diagnostics::short_circuit`]); components that the
     /// bounds show to be constant are not averaged. Fields with their own averaging space
     /// ([`CoefficientField::averaged`]) are averaged there and each mean is mapped back with
@@ -196,7 +205,7 @@ impl PreparedEstimator {
             probe.diag.region = Region::Constant;
             probe.diag.constant_components = 6;
             return Estimate {
-                coefficients: probe.to_coefficients(c),
+                coefficients: probe.to_coefficients(c).clamp_to_range(),
                 diagnostics: probe.diag,
             };
         }
@@ -209,14 +218,14 @@ impl PreparedEstimator {
             Estimator::Sone(p) => {
                 sone::estimate(p, self.theta2, self.sigma_s_scale, &mut probe, &known, rng)
             }
-            Estimator::Kernel(p) => match self.kernel {
+            Estimator::Kernel(p) => match &self.kernel {
                 Some(table) => kernel::estimate(p, self.g, table, &mut probe, &known, rng),
                 // Unreachable: `prepare` gives every kernel estimator its table.
                 None => point_lookup::endpoints(&mut probe),
             },
         };
         Estimate {
-            coefficients: probe.to_coefficients(known.finish(raw)),
+            coefficients: probe.to_coefficients(known.finish(raw)).clamp_to_range(),
             diagnostics: probe.diag,
         }
     }

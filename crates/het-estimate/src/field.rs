@@ -1,52 +1,11 @@
 //! The coefficient-lookup trait and the per-channel coefficient pair.
 
-use bssrdf_core::Rgb;
-
 use crate::ellipse::PlanarEllipse;
 use crate::uv_chart::UvChart;
 
-/// Absorption and scattering coefficients per colour channel, in 1/length.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Coefficients {
-    /// σa per channel.
-    pub sigma_a: Rgb,
-    /// σs per channel.
-    pub sigma_s: Rgb,
-}
-
-impl Coefficients {
-    /// The same σa and σs in every channel.
-    pub const fn grey(sigma_a: f64, sigma_s: f64) -> Self {
-        Self {
-            sigma_a: Rgb::splat(sigma_a),
-            sigma_s: Rgb::splat(sigma_s),
-        }
-    }
-    /// Channel-wise minimum.
-    #[inline]
-    pub fn min(self, o: Self) -> Self {
-        Self {
-            sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::min),
-            sigma_s: self.sigma_s.zip_map(o.sigma_s, f64::min),
-        }
-    }
-    /// Channel-wise maximum.
-    #[inline]
-    pub fn max(self, o: Self) -> Self {
-        Self {
-            sigma_a: self.sigma_a.zip_map(o.sigma_a, f64::max),
-            sigma_s: self.sigma_s.zip_map(o.sigma_s, f64::max),
-        }
-    }
-    /// True when every value is finite and non-negative.
-    #[inline]
-    pub fn is_valid(&self) -> bool {
-        self.sigma_a.is_finite()
-            && self.sigma_s.is_finite()
-            && self.sigma_a.min_component() >= 0.0
-            && self.sigma_s.min_component() >= 0.0
-    }
-}
+/// Absorption and scattering coefficients per colour channel, in 1/length (defined in
+/// `bssrdf-core`, where the profiles take them).
+pub use bssrdf_core::Coefficients;
 
 /// Channel-wise bounds of a field over the whole object.
 #[derive(Debug, Clone, Copy, PartialEq)]

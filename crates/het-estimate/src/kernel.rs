@@ -55,8 +55,8 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::prefilter::{Averaging, Flatness};
+use crate::random::UniformSource;
 use crate::region_average::{CHUNK, Probe};
-use crate::sampler::UniformSource;
 use crate::sampling::{DiskPoints, PointSet};
 use crate::surface::SurfaceQuery;
 
@@ -129,6 +129,18 @@ impl KernelParams {
     /// The same parameters with `iterations` weighted averages.
     pub const fn with_iterations(mut self, iterations: u32) -> Self {
         self.iterations = iterations;
+        self
+    }
+
+    /// The same parameters with projection misses handled by `misses`.
+    pub const fn with_misses(mut self, misses: MissPolicy) -> Self {
+        self.misses = misses;
+        self
+    }
+
+    /// The same parameters with the flatness criterion `flatness`.
+    pub const fn with_flatness(mut self, flatness: Flatness) -> Self {
+        self.flatness = flatness;
         self
     }
 
@@ -558,7 +570,7 @@ fn weighted_means(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampler::SplitMix64;
+    use crate::random::SplitMix64;
     use bssrdf_core::chi_square::ChiSquareTest;
 
     /// The square-root forms of a^p equal `powf` to within a few ulps, from 0 to 1e6.
@@ -713,13 +725,13 @@ mod tests {
             (1e-6, 1e-6, -0.9),
         ] {
             for d in [1e-9, 1.0, 1e6] {
-                if let Some(m) = weighted_means(&samples, [true; 3], (a, s, g), d, table, 1.0) {
+                if let Some(m) = weighted_means(&samples, [true; 3], (a, s, g), d, &table, 1.0) {
                     let (ma, ms) = m[0];
                     assert!(ma.is_finite() && ms.is_finite(), "{a} {s} {g} {d}");
                     assert!((0.1..=0.3).contains(&ma), "{ma}");
                 }
             }
         }
-        assert!(weighted_means(&samples, [true; 3], (0.0, 0.0, 0.0), 1.0, table, 1.0).is_none());
+        assert!(weighted_means(&samples, [true; 3], (0.0, 0.0, 0.0), 1.0, &table, 1.0).is_none());
     }
 }

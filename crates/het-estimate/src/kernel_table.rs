@@ -26,7 +26,7 @@
 //!
 //! Lookups are trilinear in (κ, x_i, x_o): eight reads and no transcendental function.
 
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, Weak};
 
 use crate::green::scaled_green;
 
@@ -78,6 +78,9 @@ pub fn rho_node(k: usize) -> f64 {
 pub fn kappa_node(j: usize) -> f64 {
     KAPPA_MAX * j as f64 / (KAPPA_NODES - 1) as f64
 }
+
+/// The tables alive in the process ([`KernelTable::shared`]), by weak reference.
+static TABLES: Mutex<Vec<Weak<KernelTable>>> = Mutex::new(Vec::new());
 
 /// `h = ln W̃₂(ρ_i, ρ_o; κ, A)` for one boundary coefficient A (see the module docs).
 pub struct KernelTable {
@@ -135,21 +138,28 @@ impl KernelTable {
         Self { a, h }
     }
 
-    /// The shared table for boundary coefficient `a`: built on first use and kept for the
-    /// life of the process (one per distinct A, i.e. per distinct η among the materials;
-    /// 512 KiB each: f64, which reads faster than f32 and its conversions).
-    pub fn shared(a: f64) -> &'static KernelTable {
-        static TABLES: OnceLock<Mutex<Vec<&'static KernelTable>>> = OnceLock::new();
-        let mut tables = TABLES
-            .get_or_init(|| Mutex::new(Vec::new()))
-            .lock()
-            .unwrap_or_else(|e| e.into_inner());
-        if let Some(t) = tables.iter().find(|t| t.a == a) {
+    /// The table for boundary coefficient `a`, shared with every other live holder of the
+    /// same A (one per distinct η among the prepared materials; 512 KiB each: f64, which
+    /// reads faster than f32 and its conversions). The caller owns it: the table is freed when
+    /// the last holder (a `PreparedEstimator`) is dropped, so preparing materials for any
+    /// number of distinct η (an artist dragging a slider) keeps only the live ones in memory
+    /// (`examples/kernel_memory.rs` prints the resident set across 1,000 η). The registry
+    /// holds weak references only.
+    pub fn shared(a: f64) -> Arc<KernelTable> {
+        let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
+        tables.retain(|t| t.strong_count() > 0);
+        if let Some(t) = tables.iter().find_map(|t| t.upgrade().filter(|t| t.a == a)) {
             return t;
         }
-        let t: &'static KernelTable = Box::leak(Box::new(KernelTable::build(a)));
-        tables.push(t);
+        let t = Arc::new(KernelTable::build(a));
+        tables.push(Arc::downgrade(&t));
         t
+    }
+
+    /// How many tables are alive (held by some prepared estimator) in this process.
+    pub fn live_tables() -> usize {
+        let tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
+        tables.iter().filter(|t| t.strong_count() > 0).count()
     }
 
     /// The boundary coefficient A of this table.
@@ -346,10 +356,29 @@ mod tests {
         }
     }
 
+    /// Tables are owned by their holders: one distinct A at a time stays one table, however
+    /// many A are prepared in turn, and a dropped table is rebuilt on demand.
+    #[test]
+    fn tables_are_freed_with_their_last_holder() {
+        // A values no other test uses, so that parallel tests do not hold them.
+        let a0 = 7.123_456;
+        let held = KernelTable::shared(a0);
+        for k in 1..=5 {
+            let t = KernelTable::shared(a0 + k as f64 * 1e-3);
+            assert_eq!(Arc::strong_count(&t), 1, "only the caller holds it");
+        }
+        let again = KernelTable::shared(a0);
+        assert!(Arc::ptr_eq(&held, &again));
+        assert_eq!(Arc::strong_count(&held), 2);
+        drop((held, again));
+        let weak = Arc::downgrade(&KernelTable::shared(a0));
+        assert_eq!(weak.strong_count(), 0, "freed with its last holder");
+    }
+
     #[test]
     fn table_is_symmetric_and_finite() {
         let t = KernelTable::shared(1.0);
-        assert!(std::ptr::eq(t, KernelTable::shared(1.0)));
+        assert!(Arc::ptr_eq(&t, &KernelTable::shared(1.0)));
         for &(ri, ro, k) in &[
             (0.3, 7.0, 0.2),
             (0.0, 0.0, 0.0),

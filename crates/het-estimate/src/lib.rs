@@ -28,7 +28,8 @@
 //!   a generic loop over the samples (no allocation, no dynamic dispatch inside).
 //! * **Caller-provided randomness** ([`UniformSource`]) keeps renders deterministic per seed.
 //!   Region estimators use randomly shifted low-discrepancy points ([`sampling`]).
-//! * **Always a usable answer.** Coefficients are finite and ≥ 0; invalid field values are a
+//! * **Always a usable answer.** Coefficients lie in `[0, 1e12]` (`bssrdf_core::SIGMA_MAX`, the
+//!   range the profiles accept: larger values are clamped to it); invalid field values are a
 //!   caller bug (debug assertion) and are sanitised in release builds; misses, degenerate
 //!   chords and degenerate widths have explicit, documented limits; [`Diagnostics`] reports
 //!   what happened (samples, projections, misses, short-circuits, fallbacks, the width).
@@ -63,14 +64,17 @@ pub mod pattern;
 mod point_lookup;
 pub mod prefilter;
 pub mod probe;
+pub mod random;
 mod region_average;
-pub mod sampler;
 pub mod sampling;
 pub mod segment;
 pub mod sone;
 pub mod surface;
 pub mod uv_chart;
 
+/// The profile crate this one estimates parameters for, re-exported so that one dependency
+/// (`het-estimate`) is enough and both agree on its version.
+pub use bssrdf_core;
 pub use bssrdf_core::Rgb;
 pub use budget::{MissPolicy, SampleBudget};
 pub use ellipse::PlanarEllipse;
@@ -85,10 +89,8 @@ pub use local_surface::Curvature;
 pub use names::Named;
 pub use path_integral::{MeanSquareAngle, SemiMinorAxis};
 pub use prefilter::{Averaging, Flatness};
+pub use random::{SplitMix64, UniformSource};
 pub use region_average::CHUNK;
-#[cfg(feature = "fixtures")]
-pub use sampler::SplitMix64;
-pub use sampler::UniformSource;
 pub use segment::SegmentParams;
 pub use sone::{SoneParams, WidthScattering};
 pub use surface::{Projected, SurfacePoint, SurfaceQuery};

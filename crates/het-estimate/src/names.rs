@@ -31,9 +31,16 @@ pub(crate) fn check_non_negative(name: &'static str, value: f64) -> Result<f64, 
 }
 
 /// Implements `Display` (the name) and `FromStr` (exact name, error `UnknownName`) for types
-/// implementing [`Named`].
+/// implementing [`Named`], and an inherent `ALL` constant.
 macro_rules! named_display_fromstr {
     ($($t:ty),* $(,)?) => {$(
+        impl $t {
+            /// Every choice, in documentation order (the same list as [`Named::ALL`], without
+            /// the trait in scope).
+            ///
+            /// [`Named::ALL`]: crate::Named::ALL
+            pub const ALL: &'static [Self] = <Self as $crate::names::Named>::ALL;
+        }
         impl ::std::fmt::Display for $t {
             fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
                 f.write_str($crate::names::Named::name(*self))

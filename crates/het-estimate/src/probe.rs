@@ -52,7 +52,7 @@
 //!
 //! # Use
 //! ```
-//! use bssrdf_core::{ProfileFamily, ProfileModel, Scattering};
+//! use het_estimate::bssrdf_core::{self, ProfileFamily, ProfileModel, Scattering};
 //! use het_estimate::glam::DVec3;
 //! use het_estimate::probe::{ProbeChords, ProbeSampler, probe};
 //! use het_estimate::{Coefficients, FieldBounds, SplitMix64, SurfacePoint};
@@ -67,28 +67,30 @@
 //! struct Floor;
 //! impl ProbeChords for Floor {
 //!     type Point = Hit;
-//!     fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, mut f: impl FnMut(&Hit)) {
+//!     fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, f: &mut dyn FnMut(&Hit)) {
 //!         let t = -o.z / d.z;
 //!         if t >= 0.0 && t <= t_max { f(&Hit(o + t * d)) }
 //!     }
 //! }
 //!
-//! // Once per material:
-//! let family = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3)?;
-//! let c = Coefficients::grey(0.01, 1.0);
-//! let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
-//! // Per shading point x_o:
-//! let x_o = Hit(DVec3::ZERO);
-//! let mut rng = SplitMix64::new(7);
-//! let set = probe(&Floor, &x_o, c, &sampler, &mut rng);
-//! for h in set.iter() {
-//!     let r = (h.hit.position() - x_o.position()).length();
-//!     assert!(r < sampler.probe_radius(c) && h.weight > 0.0);
+//! fn main() -> Result<(), bssrdf_core::ParamError> {
+//!     // Once per material:
+//!     let family = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3)?;
+//!     let c = Coefficients::grey(0.01, 1.0);
+//!     let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+//!     // Per shading point x_o:
+//!     let x_o = Hit(DVec3::ZERO);
+//!     let mut rng = SplitMix64::new(7);
+//!     let set = probe(&Floor, &x_o, c, &sampler, &mut rng);
+//!     for h in set.iter() {
+//!         let r = (h.hit.position() - x_o.position()).length();
+//!         assert!(r < sampler.probe_radius(c) && h.weight > 0.0);
+//!     }
+//!     Ok(())
 //! }
-//! # Ok::<(), bssrdf_core::ParamError>(())
 //! ```
 
-use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, TableSampler};
+use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, RadiusSampler};
 use glam::DVec3;
 
 use crate::frame::orthonormal_basis;
@@ -112,12 +114,12 @@ pub trait ProbeChords {
     /// Calls `f` for every crossing of the segment `origin + t·dir`, `t ∈ [0, t_max]` (`dir` a
     /// unit vector), with the object being shaded, in increasing `t`. A crossing through a
     /// shared edge or vertex should be reported once.
-    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: impl FnMut(&Self::Point));
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: &mut dyn FnMut(&Self::Point));
 }
 
 impl<C: ProbeChords + ?Sized> ProbeChords for &C {
     type Point = C::Point;
-    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: impl FnMut(&Self::Point)) {
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: &mut dyn FnMut(&Self::Point)) {
         (**self).for_each_hit(origin, dir, t_max, f)
     }
 }
@@ -149,10 +151,10 @@ struct ChannelKey {
 }
 
 /// The table searches of one channel of [`ProbeSampler::channels`]: x_o's own probe radius
-/// ([`TableSampler::radius_for_fraction`]; `None` where the table refuses x_o's coefficients,
+/// ([`RadiusSampler::radius_for_fraction`]; `None` where the table refuses x_o's coefficients,
 /// and 0 or not finite where its profile reaches nowhere) and,
 /// when the probe radius exceeds half the cap, the masses of the radial density's components
-/// below half the cap ([`TableSampler::fraction_within`]; the second is 0 for a single
+/// below half the cap ([`RadiusSampler::fraction_within`]; the second is 0 for a single
 /// profile).
 #[derive(Clone, Copy)]
 struct ChannelSearches {
@@ -356,8 +358,8 @@ struct Truncation {
 /// widest profile the estimate can become (see the module docs).
 #[derive(Clone, Copy)]
 enum Radial<'a> {
-    One(TableSampler<'a>),
-    Mixture(TableSampler<'a>, TableSampler<'a>),
+    One(RadiusSampler<'a>),
+    Mixture(RadiusSampler<'a>, RadiusSampler<'a>),
 }
 
 impl Radial<'_> {
@@ -395,7 +397,7 @@ impl Radial<'_> {
     /// (`radius_for_fraction`) within that mass. (`sample_r` splits `u` between the table's
     /// two rows, so scaling its `u` would not truncate.)
     fn sample_r_below(&self, u: f64, cap: f64, masses: [f64; 2]) -> Option<f64> {
-        let below = |s: &TableSampler<'_>, v: f64, mass: f64| {
+        let below = |s: &RadiusSampler<'_>, v: f64, mass: f64| {
             let r = s.radius_for_fraction(v * mass);
             (r.is_finite() && r < cap).then_some(r)
         };
@@ -650,7 +652,7 @@ impl<'s> ProbeDensity<'s> {
             let half = (c.r_max * c.r_max - r * r).sqrt();
             let base = self.origin + r * (cos * vx + sin * vy) - half * vz;
             let mut kept = 0;
-            chords.for_each_hit(base, vz, 2.0 * half, |h| {
+            chords.for_each_hit(base, vz, 2.0 * half, &mut |h| {
                 if kept < MAX_PROBE_HITS && keep(h) {
                     kept += 1;
                 }
@@ -764,7 +766,7 @@ mod tests {
     struct Slab(f64);
     impl ProbeChords for Slab {
         type Point = P;
-        fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, mut f: impl FnMut(&P)) {
+        fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, f: &mut dyn FnMut(&P)) {
             let mut hits = [
                 (-o.z / d.z, DVec3::Z),
                 ((-self.0 - o.z) / d.z, DVec3::NEG_Z),
@@ -969,7 +971,7 @@ mod tests {
     struct UnitSphere;
     impl ProbeChords for UnitSphere {
         type Point = P;
-        fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, mut f: impl FnMut(&P)) {
+        fn for_each_hit(&self, o: DVec3, d: DVec3, t_max: f64, f: &mut dyn FnMut(&P)) {
             let c = DVec3::new(0.0, 0.0, -1.0);
             let oc = o - c;
             let b = oc.dot(d);

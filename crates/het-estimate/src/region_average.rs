@@ -9,7 +9,7 @@ use crate::estimate::Diagnostics;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::sanitise;
 use crate::local_surface::{Curvature, End, LocalSurface};
-use crate::sampler::UniformSource;
+use crate::random::UniformSource;
 use crate::sampling::PointSet;
 use crate::surface::{Projected, SurfacePoint, SurfaceQuery};
 use crate::uv_chart::UvChart;
@@ -753,7 +753,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampler::SplitMix64;
+    use crate::random::SplitMix64;
     use crate::sampling::SegmentPoints;
     use std::num::NonZeroU32;
 

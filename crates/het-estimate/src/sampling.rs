@@ -27,7 +27,7 @@ use std::f64::consts::FRAC_PI_4;
 
 use glam::DVec2;
 
-use crate::sampler::UniformSource;
+use crate::random::UniformSource;
 
 /// 1/ρ (ρ = plastic number) in 0.64 fixed point.
 const R2_ALPHA_1: u64 = 0xc13f_a9a9_02a6_328f;
@@ -221,7 +221,7 @@ pub fn sin_cos_turn(u: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampler::SplitMix64;
+    use crate::random::SplitMix64;
     use bssrdf_core::chi_square::ChiSquareTest;
     use std::f64::consts::PI;
 

@@ -7,8 +7,8 @@ use crate::budget::{MissPolicy, SampleBudget};
 use crate::estimate::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::Known;
+use crate::random::UniformSource;
 use crate::region_average::{Probe, average};
-use crate::sampler::UniformSource;
 use crate::sampling::SegmentPoints;
 use crate::surface::SurfaceQuery;
 use bssrdf_core::Rgb;
@@ -35,6 +35,12 @@ impl SegmentParams {
     /// The same parameters with `samples` points.
     pub const fn with_samples(mut self, samples: SampleBudget) -> Self {
         self.samples = samples;
+        self
+    }
+
+    /// The same parameters with projection misses handled by `misses`.
+    pub const fn with_misses(mut self, misses: MissPolicy) -> Self {
+        self.misses = misses;
         self
     }
 }

@@ -53,8 +53,8 @@ use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::prefilter::{Averaging, Flatness};
+use crate::random::UniformSource;
 use crate::region_average::{Accumulator, Channels, Probe, Reading, average_chunks};
-use crate::sampler::UniformSource;
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
 
@@ -177,6 +177,49 @@ impl SoneParams {
     pub const fn with_samples(mut self, samples: SampleBudget) -> Self {
         self.disk = samples;
         self.ellipse = samples;
+        self
+    }
+
+    /// The same parameters with `disk` samples in the disk stage ([`SoneParams::disk`]).
+    pub const fn with_disk(mut self, disk: SampleBudget) -> Self {
+        self.disk = disk;
+        self
+    }
+
+    /// The same parameters with `ellipse` samples in the ellipse stage
+    /// ([`SoneParams::ellipse`]).
+    pub const fn with_ellipse(mut self, ellipse: SampleBudget) -> Self {
+        self.ellipse = ellipse;
+        self
+    }
+
+    /// The same parameters with ⟨θ²⟩ computed as `mean_square_angle`.
+    pub const fn with_mean_square_angle(mut self, mean_square_angle: MeanSquareAngle) -> Self {
+        self.mean_square_angle = mean_square_angle;
+        self
+    }
+
+    /// The same parameters with the ellipse's semi-minor axis `semi_minor`.
+    pub const fn with_semi_minor(mut self, semi_minor: SemiMinorAxis) -> Self {
+        self.semi_minor = semi_minor;
+        self
+    }
+
+    /// The same parameters with the path width's scattering coefficient `width_scattering`.
+    pub const fn with_width_scattering(mut self, width_scattering: WidthScattering) -> Self {
+        self.width_scattering = width_scattering;
+        self
+    }
+
+    /// The same parameters with projection misses handled by `misses`.
+    pub const fn with_misses(mut self, misses: MissPolicy) -> Self {
+        self.misses = misses;
+        self
+    }
+
+    /// The same parameters with the flatness criterion `flatness`.
+    pub const fn with_flatness(mut self, flatness: Flatness) -> Self {
+        self.flatness = flatness;
         self
     }
 }

@@ -32,6 +32,7 @@ use super::angular_file::{ANGULAR_ETAS, AngularData, N_MU, index};
 use super::grid::N_ALBEDO;
 use super::profile::{row_position, table};
 use crate::fresnel::{dielectric, fresnel_moment};
+use crate::model::Scattering;
 
 /// The data file built into the crate (regenerate with `het-bssrdf tabulate --angular`).
 static DATA: &[u8] = include_bytes!("../../data/angular-coupling-v1.bin");
@@ -67,11 +68,10 @@ pub struct AngularCoupling {
 
 impl AngularCoupling {
     /// The coupling at relative index `eta` (clamped to [1, 1.6]; linear between the data's
-    /// planes, 0.1 apart) for the scattering orders selected; `None` when neither is.
-    pub fn new(eta: f64, single: bool, multiple: bool) -> Option<Self> {
-        if !single && !multiple {
-            return None;
-        }
+    /// planes, 0.1 apart) for the scattering orders `scattering` selects, as the tabulated
+    /// profile of a [`crate::ProfileFamily`] with the same [`Scattering`] counts them.
+    pub fn new(eta: f64, scattering: Scattering) -> Self {
+        let (single, multiple) = (scattering.includes_single(), scattering.includes_multiple());
         let step = ANGULAR_ETAS[1] - ANGULAR_ETAS[0];
         let last = ANGULAR_ETAS.len() - 1;
         let pe = if eta.is_finite() {
@@ -88,7 +88,7 @@ impl AngularCoupling {
             .zip(&hi)
             .map(|(a, b)| ((1.0 - f) * a + f * b) as f32)
             .collect();
-        Some(Self { t })
+        Self { t }
     }
 
     /// T at the data's plane `q` (`[row][j][k]`, f64).
@@ -287,8 +287,8 @@ mod tests {
             f64::INFINITY,
         ];
         for eta in [1.0, 1.05, 1.3, 1.6, 3.0, f64::NAN] {
-            for (single, multiple) in [(true, false), (false, true), (true, true)] {
-                let c = AngularCoupling::new(eta, single, multiple).unwrap();
+            for &scattering in Scattering::ALL {
+                let c = AngularCoupling::new(eta, scattering);
                 for &alpha in &values {
                     for &a in &values {
                         for &b in &values {
@@ -300,6 +300,5 @@ mod tests {
                 }
             }
         }
-        assert!(AngularCoupling::new(1.3, false, false).is_none());
     }
 }

@@ -140,6 +140,7 @@ fn chunk(eta: f64, plane: u64, seed: u64, start: u64, count: u64, ln_alpha: &[f6
     s
 }
 
+#[cfg(any(test, feature = "tabulate"))]
 /// Simulates plane `plane` (refractive index `ANGULAR_ETAS[plane]`) with `photons` photons per
 /// incidence bin on `threads` threads; bit-identical for any `threads ≥ 1`.
 pub fn simulate_plane(plane: usize, seed: u64, photons: u64, threads: usize) -> AngularPlane {
@@ -173,6 +174,7 @@ pub fn simulate_plane(plane: usize, seed: u64, photons: u64, threads: usize) -> 
     }
 }
 
+#[cfg(any(test, feature = "tabulate"))]
 /// Simulates every plane (see the module docs), reporting each finished plane to `progress`.
 pub fn tabulate_angular(
     seed: u64,

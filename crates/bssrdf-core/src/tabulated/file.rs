@@ -314,6 +314,7 @@ impl<'a> Reader<'a> {
     }
 }
 
+#[cfg(any(test, feature = "tabulate"))]
 /// Simulates every plane with `photons` photons each (see [`super::simulate`]) and returns the
 /// table; bit-identical for a given seed and photon count whatever `threads` is.
 pub fn tabulate(

@@ -294,6 +294,7 @@ impl SlabData {
     }
 }
 
+#[cfg(any(test, feature = "tabulate"))]
 /// Simulates one plane: `photons` photons through a slab of optical thickness `thickness` at
 /// `eta`, `key` part of the random key; bit-identical for any `threads ≥ 1`.
 pub fn simulate_slab_plane(
@@ -314,6 +315,7 @@ pub fn simulate_slab_plane(
     SlabPlane::from_tally(thickness, eta, &total)
 }
 
+#[cfg(any(test, feature = "tabulate"))]
 /// Simulates every plane of the slab table with `photons` photons each; `progress(i)` after
 /// plane `i`. Bit-identical for a given seed and photon count whatever `threads` is. Paths
 /// longer than [`super::simulate::MAX_EVENTS`] scattering events are dropped (counted per plane).

@@ -1,5 +1,8 @@
 //! The separable BSSRDF both BSSRDF renderers evaluate (the camera-traced one in
-//! [`super::path`], the light-traced one in [`super::light_trace`]):
+//! [`super::path`], the light-traced one in [`super::light_trace`]): `bssrdf-core`'s public
+//! [`SeparableBssrdf`], whose parts ([`SeparableBssrdf::entry_lobe`],
+//! [`SeparableBssrdf::coupling`], [`SeparableBssrdf::combine`]) the renderers call where their
+//! sampling splits S:
 //!
 //! S(x_i, ω_i; x_o, ω_o) = (1 − F_r(cos θ_o)) · R(|x_i − x_o|; σ̄a, σ̄s) · S_w(ω_i),
 //! S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
@@ -35,10 +38,7 @@
 //! half-space profile. Every choice is symmetric in the two points, so reciprocity holds as
 //! above.
 
-use std::f64::consts::PI;
-
-use bssrdf_core::tabulated::AngularCoupling;
-use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SlabFace};
+use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SeparableBssrdf, SlabFace};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
 
@@ -57,10 +57,9 @@ pub(crate) struct BssrdfObject {
     pub sampler: ProbeSampler,
     /// How a pair becomes homogeneous coefficients.
     pub estimator: PreparedEstimator,
-    /// c = 1 − 2·C1(1/η), the normalisation of S_w.
-    sw_norm: f64,
-    /// Relative index of refraction η.
-    eta: f64,
+    /// S itself: the Fresnel factors, their normalisation c and the angular coupling
+    /// (`bssrdf_core::separable`).
+    bssrdf: SeparableBssrdf,
     /// The longest side of the object's bounding box: the extent the probe radii are drawn
     /// within ([`super::probe::probe_within`]).
     pub extent: f64,
@@ -71,10 +70,6 @@ pub(crate) struct BssrdfObject {
     /// The shape correction c (module docs of [`super::shape_correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
     pub correction: Option<super::shape_correction::ShapeCorrection>,
-    /// The tabulated profile's angular coupling T(α, μ_i, μ_o)
-    /// ([`bssrdf_core::tabulated::angular`]): with the tabulated model, unless the material
-    /// turns it off (`angular_coupling = false`).
-    coupling: Option<AngularCoupling>,
 }
 
 /// The profile weight of one pair, with what the angular coupling needs to finish it
@@ -105,23 +100,16 @@ impl BssrdfObject {
         let thickness_aware = material.thickness_aware
             && family.model() == ProfileModel::Tabulated
             && family.g().abs() <= SLAB_MAX_G;
-        let coupling = if material.angular_coupling && family.model() == ProfileModel::Tabulated {
-            AngularCoupling::new(
-                material.eta,
-                scattering.includes_single(),
-                scattering.includes_multiple(),
-            )
-        } else {
-            None
-        };
+        // The tabulated profile's angular coupling, unless the material turns it off
+        // (`angular_coupling = false`).
+        let bssrdf =
+            SeparableBssrdf::from_family(family).with_angular_coupling(material.angular_coupling);
         Ok(Self {
-            coupling,
+            bssrdf,
             thickness_aware,
             sampler: ProbeSampler::new(family, &material.medium),
             family,
             estimator,
-            sw_norm: 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / material.eta),
-            eta: material.eta,
             extent,
             correction: None,
         })
@@ -129,7 +117,7 @@ impl BssrdfObject {
 
     /// Relative index of refraction η.
     pub fn eta(&self) -> f64 {
-        self.eta
+        self.bssrdf.eta()
     }
 
     /// One probe set around `x_o` over `chords` (the object, or the shape correction's
@@ -160,17 +148,10 @@ impl BssrdfObject {
             .probe_points_into(points, chords, x_o, coeffs, self.extent, rng)
     }
 
-    /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
-    /// (unitless; 1 for η = 1).
-    #[inline]
-    pub fn transmission(&self, cos: f64) -> f64 {
-        1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta)
-    }
-
     /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π).
     #[inline]
     pub fn entry_lobe(&self, cos: f64) -> f64 {
-        self.transmission(cos) / (self.sw_norm * PI)
+        self.bssrdf.entry_lobe(cos)
     }
 
     /// R(|x_i − x_o|) (1/length², per channel) at the coefficients the estimator gives for
@@ -210,19 +191,10 @@ impl BssrdfObject {
     /// Symmetric in the two cosines, bit for bit.
     #[inline]
     pub fn coupling(&self, w: &PairWeight, cos_i: f64, cos_o: f64) -> Rgb {
-        let Some(t) = self.coupling.as_ref().filter(|_| w.reflection) else {
+        if !w.reflection {
             return Rgb::splat(1.0);
-        };
-        // The reduced albedo per channel, as the profile reads its rows; a channel that does
-        // not scatter (its profile is 0) gets NaN, hence T = 1.
-        let alpha = std::array::from_fn(|ch| {
-            self.family
-                .reduced_albedo(w.coeffs.sigma_a[ch], w.coeffs.sigma_s[ch])
-                .ok()
-                .flatten()
-                .unwrap_or(f64::NAN)
-        });
-        Rgb(t.factors(alpha, cos_i, cos_o))
+        }
+        self.bssrdf.coupling(&w.coeffs, cos_i, cos_o)
     }
 
     /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium
@@ -278,9 +250,10 @@ impl BssrdfObject {
             return Rgb::ZERO;
         };
         let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
-        let fresnel = self.transmission(cos_i) * self.transmission(cos_o);
         let w = self.profile(surface, medium, x_i, x_o, rng, counters);
-        let s = w.rd * (fresnel / (self.sw_norm * PI)) * self.coupling(&w, cos_i, cos_o);
+        let s = self
+            .bssrdf
+            .combine(w.rd, self.coupling(&w, cos_i, cos_o), cos_i, cos_o);
         match (
             self.correction_along(x_i, w_i, n_i),
             self.correction_along(x_o, w_o, n_o),

@@ -66,7 +66,7 @@ pub type ProbePoints = lib::ProbePoints<Hit>;
 impl ProbeChords for ObjectSurface<'_> {
     type Point = Hit;
     #[inline]
-    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: impl FnMut(&Hit)) {
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: &mut dyn FnMut(&Hit)) {
         self.geometry.for_each_object_hit(
             self.object,
             &Ray::with_range(origin, dir, 0.0, t_max),

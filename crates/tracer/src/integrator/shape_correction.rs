@@ -920,7 +920,7 @@ struct TangentPlane {
 
 impl ProbeChords for TangentPlane {
     type Point = Hit;
-    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, mut f: impl FnMut(&Hit)) {
+    fn for_each_hit(&self, origin: DVec3, dir: DVec3, t_max: f64, f: &mut dyn FnMut(&Hit)) {
         let dn = dir.dot(self.n);
         if dn == 0.0 {
             return;

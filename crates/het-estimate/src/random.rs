@@ -1,4 +1,5 @@
-//! The caller-provided source of uniform random numbers.
+//! Random numbers: the caller-provided source of uniform numbers the estimators draw from, and
+//! a small seeded generator for examples, tests and renderers without one of their own.
 
 /// A stream of uniform numbers in `[0, 1)`, provided by the caller so that renders stay
 /// deterministic for a given seed whatever the thread count.
@@ -13,16 +14,15 @@ impl<U: UniformSource + ?Sized> UniformSource for &mut U {
     }
 }
 
-/// SplitMix64 (SLF14: Steele, Lea & Flood 2014): a
-/// tiny seeded [`UniformSource`] for tests, examples and benchmarks. Renderers pass their own
-/// per-pixel stream instead. Behind the `fixtures` feature.
-#[cfg(any(test, feature = "fixtures"))]
-#[derive(Debug, Clone)]
+/// SplitMix64 (SLF14: Steele, Lea & Flood 2014): a tiny seeded [`UniformSource`] for
+/// examples, tests and benchmarks, and for renderers without a stream of their own (a
+/// renderer usually passes its own per-pixel stream, which keeps its renders deterministic
+/// per seed). Not cryptographic.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SplitMix64 {
     state: u64,
 }
 
-#[cfg(any(test, feature = "fixtures"))]
 impl SplitMix64 {
     /// A stream determined by `seed`.
     pub const fn new(seed: u64) -> Self {
@@ -40,7 +40,6 @@ impl SplitMix64 {
     }
 }
 
-#[cfg(any(test, feature = "fixtures"))]
 impl UniformSource for SplitMix64 {
     /// 53 random bits scaled into `[0, 1)`.
     #[inline]
