@@ -105,11 +105,19 @@ pub fn warn_counters(c: &PathCounters) {
     }
 }
 
-/// Refuses, before anything is allocated, a render of the scene's `width × height` that would
-/// not fit in memory; the error names the scene's keys and the figure.
-pub fn check_image_memory(width: u32, height: u32, scene: &Path) -> anyhow::Result<()> {
-    tracer::memory::check_render(width, height)
-        .with_context(|| format!("{}: render.width, render.height", scene.display()))
+/// Refuses, before anything is allocated, a render of the scene's `width × height` by
+/// `method` that would not fit in the memory this process may still allocate (its films, and
+/// the summed-area tables its preparation builds); the error names the scene's keys and the
+/// figure.
+pub fn check_image_memory(
+    scene: &tracer::scene::Scene,
+    method: tracer::integrator::Method,
+    file: &Path,
+) -> anyhow::Result<()> {
+    let (width, height) = scene.camera().resolution();
+    let tables = tracer::memory::area_table_bytes(scene, method);
+    tracer::memory::check_render(width, height, tables)
+        .with_context(|| format!("{}: render.width, render.height", file.display()))
 }
 
 /// Triangle count above which a render says how many triangles its shapes became.

@@ -40,7 +40,12 @@ const BEAM_ONLY: &[&str] = &[
 ];
 
 /// Flags of scene studies: they do not apply to the beam experiment.
-const SCENE_ONLY: &[&str] = &["reference_spp", "max_spp", "max_depth"];
+const SCENE_ONLY: &[&str] = &[
+    "reference_spp",
+    "max_spp",
+    "max_depth",
+    "allow_outside_assets",
+];
 
 /// Arguments of `het-bssrdf converge`.
 #[derive(Debug, clap::Args)]
@@ -100,6 +105,10 @@ pub struct Args {
     /// Seed of the runs (the reference uses a different one).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
+    /// Scene: let glTF files read buffers and images outside their own folder (refused by
+    /// default: a downloaded glTF file is untrusted input).
+    #[arg(long)]
+    allow_outside_assets: bool,
     /// Output directory (created if missing).
     #[arg(short, long)]
     out: Option<PathBuf>,
@@ -227,7 +236,10 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .scene
         .as_ref()
         .expect("clap requires a scene without --beam");
-    let scene = Scene::load(file)?;
+    let scene = Scene::load_with(
+        file,
+        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+    )?;
     let mut base = RenderJob::from_scene(&scene, Method::PathTraced);
     if given.has("scattering") {
         base.scattering = args.setup.scattering;

@@ -95,6 +95,11 @@ pub struct Args {
     /// each pass that ends at least this many seconds after the previous checkpoint.
     #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     checkpoint: Option<Duration>,
+    /// Let glTF files read buffers and images outside their own folder (refused by default:
+    /// a downloaded glTF file is untrusted input; a shape's `allow_outside_assets = true`
+    /// allows it for that shape).
+    #[arg(long)]
+    allow_outside_assets: bool,
     /// Trace paths from the `camera` (default) or from the `light`s. A light-traced render
     /// traces spp × width × height light paths; it takes no --time, --tile or --checkpoint.
     #[arg(long, value_enum, default_value_t = Trace::Camera)]
@@ -103,7 +108,10 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = Scene::load(&args.scene)?;
+    let scene = Scene::load_with(
+        &args.scene,
+        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+    )?;
     let scene = match args.invert {
         Some(at) => scene.with_invert(at),
         None => scene,
@@ -168,7 +176,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}{tile}.exr", method.name())));
     check_writable(&out)?;
     let (width, height) = scene.camera().resolution();
-    check_image_memory(width, height, &args.scene)?;
+    check_image_memory(&scene, method, &args.scene)?;
     note_triangles(&scene);
     if args.trace == Trace::Light {
         if args.time.is_some() || args.tile.is_some() || args.checkpoint.is_some() {

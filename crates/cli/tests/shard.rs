@@ -484,3 +484,40 @@ fn a_flipped_bit_in_a_shards_pixels_is_refused() {
         &["merge", "s-0.exr", "s-1.exr", "s-2.exr", "-o", "m.exr"],
     );
 }
+
+/// Issue 39, case 3: a glTF model's external buffer edited between two tiles was not in the
+/// scene hash, so the shards merged into a wrong image (relative L2 0.52 against the right
+/// one). The buffer is now hashed with the scene.
+#[test]
+fn a_gltf_buffer_edited_between_tiles_is_refused() {
+    let s = Scratch::new();
+    s.write("tetra.bin", common::tetra_bin());
+    s.write("m.gltf", common::gltf(common::NODES, 12, 72, "tetra.bin"));
+    s.write("t.toml", common::with_gltf("m.gltf"));
+    let tile = |i: &str| {
+        ok(
+            &s,
+            &[
+                "render",
+                "t.toml",
+                "--method",
+                "pt",
+                "--tile",
+                &format!("{i}/2"),
+                "-o",
+                &format!("t-{i}.exr"),
+            ],
+        )
+    };
+    tile("0");
+    // The same file name and length, another vertex: the tetrahedron's apex moves.
+    let mut bin = common::tetra_bin();
+    bin[44..48].copy_from_slice(&2f32.to_le_bytes());
+    s.write("tetra.bin", bin);
+    tile("1");
+    s.assert_rejected(
+        &["merge", "t-0.exr", "t-1.exr", "-o", "t.exr"],
+        1,
+        &["t-1.exr", "t-0.exr", "scene (hash of its files)"],
+    );
+}

@@ -376,7 +376,7 @@ pub enum OutputError {
 /// Work that would need more memory than the machine has available, refused before anything
 /// is allocated.
 #[derive(Debug, thiserror::Error)]
-#[error("{what} would need about {} of memory, more than the {} available", human_bytes(*bytes), human_bytes(*available))]
+#[error("{what} would need about {} of memory, more than the {} available (limit: {limit})", human_bytes(*bytes), human_bytes(*available))]
 pub struct TooLarge {
     /// What is too large, with its size (`"a 20000x20000 render"`).
     pub what: String,
@@ -384,6 +384,8 @@ pub struct TooLarge {
     pub bytes: f64,
     /// The memory available, in bytes.
     pub available: f64,
+    /// Which limit gives `available` (see [`crate::memory::headroom`]).
+    pub limit: &'static str,
 }
 
 /// A byte count in words: `9.6 GB`, `512 MB`, `12 kB` (decimal units).

@@ -575,6 +575,38 @@ pub(crate) enum ExrReadError {
     Decode(String),
 }
 
+/// The size (width, height) and channel count of the first layer of the EXR at `path`, from
+/// its header alone.
+pub(crate) fn exr_size(path: &Path) -> Result<(u32, u32, usize), ExrReadError> {
+    #[cfg(feature = "exr")]
+    {
+        let file = fs::File::open(path).map_err(ExrReadError::Io)?;
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
+            .map_err(|e| ExrReadError::Decode(e.to_string()))?;
+        let header = meta
+            .headers
+            .first()
+            .ok_or_else(|| ExrReadError::Decode("no layer".into()))?;
+        let size = header.layer_size;
+        let dim = |v: usize| {
+            u32::try_from(v)
+                .map_err(|_| ExrReadError::Decode(format!("image side {v} is too large")))
+        };
+        Ok((
+            dim(size.width())?,
+            dim(size.height())?,
+            header.channels.list.len(),
+        ))
+    }
+    #[cfg(not(feature = "exr"))]
+    {
+        let _ = path;
+        Err(ExrReadError::Decode(
+            "EXR support needs the `exr` feature of het-bssrdf-tracer".into(),
+        ))
+    }
+}
+
 /// Reads the first valid layer of an EXR as RGB `f32` (row-major, row 0 at the top).
 pub(crate) fn decode_exr_rgb(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>), ExrReadError> {
     #[cfg(feature = "exr")]

@@ -34,6 +34,42 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Run {
     }
 }
 
+/// Runs `het-bssrdf args…` in `dir` like [`run_in`], but kills it and panics if it has not
+/// ended after `seconds` (for inputs that used to hang or grow without bound).
+#[track_caller]
+pub fn run_within(dir: &Path, args: &[&str], seconds: u64) -> Run {
+    use std::process::Stdio;
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run het-bssrdf");
+    let start = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            let out = child.wait_with_output().expect("output");
+            return Run {
+                code: out.status.code(),
+                stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+            };
+        }
+        if start.elapsed() > Duration::from_secs(seconds) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "het-bssrdf {} did not end within {seconds} s",
+                args.join(" ")
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 /// Every path under `dir` (files and directories, hidden ones included: the atomic writers'
 /// temporary files start with a dot), relative to `dir`, sorted, directories marked `/`.
 pub fn listing(dir: &Path) -> Vec<String> {
@@ -279,4 +315,53 @@ pub fn gradient(w: u32, h: u32) -> Film {
         }
     }
     f
+}
+
+/// A closed tetrahedron: 4 `f32` positions (48 bytes) then 12 `u16` indices (24 bytes).
+pub fn tetra_bin() -> Vec<u8> {
+    let mut b = Vec::new();
+    for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]] {
+        for c in p {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3] {
+        b.extend_from_slice(&i.to_le_bytes());
+    }
+    b
+}
+
+/// The glTF document with the given nodes, index count, buffer length and buffer URI.
+pub fn gltf(nodes: &str, index_count: u32, byte_length: u32, uri: &str) -> String {
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": {nodes},
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+  "buffers": [{{"uri": "{uri}", "byteLength": {byte_length}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 24}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+      "min": [0, 0, 0], "max": [1, 1, 1]}},
+    {{"bufferView": 1, "componentType": 5123, "count": {index_count}, "type": "SCALAR"}}
+  ]
+}}"#
+    )
+}
+
+/// The nodes of [`gltf`]'s usual document: one node holding the mesh.
+pub const NODES: &str = r#"[{"mesh": 0}]"#;
+
+/// [`MINIMAL`] with its box replaced by a glTF shape named `tet` reading `path`.
+pub fn with_gltf(path: &str) -> String {
+    edit(
+        MINIMAL,
+        "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
+        &format!("type = \"gltf\"\nname = \"tet\"\nmaterial = \"m\"\npath = \"{path}\""),
+    )
 }

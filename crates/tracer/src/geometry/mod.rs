@@ -25,6 +25,7 @@
 mod bvh;
 #[cfg(feature = "gltf")]
 pub mod gltf;
+pub mod gltf_assets;
 #[cfg(feature = "gltf")]
 pub mod gltf_material;
 pub mod mesh;

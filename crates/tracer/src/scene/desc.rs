@@ -527,5 +527,8 @@ shape_desc!(
     MeshFileDesc {
         /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
+        /// glTF only: let the file's buffer and image URIs name files outside its own folder
+        /// (default false; see [`crate::geometry::gltf_assets`]).
+        allow_outside_assets: Option<bool>,
     }
 );
