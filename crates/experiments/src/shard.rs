@@ -209,7 +209,8 @@ struct Part {
     /// The EXR header's metadata pairs.
     header: Vec<(String, String)>,
     shard: Shard,
-    film: Film,
+    /// The image's width and height.
+    size: (u32, u32),
 }
 
 /// What [`merge`] made.
@@ -248,8 +249,9 @@ fn shard_err(path: &Path, message: impl Into<String>) -> MergeError {
     }
 }
 
-/// Reads one shard's EXR, its header and its sidecar, and checks that they agree.
-fn read_part(path: &Path) -> Result<Part, MergeError> {
+/// Reads one shard's EXR, its header and its sidecar, and checks that they agree; returns the
+/// image apart.
+fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
     let (_, json_path) = sidecar_paths(path);
     let text = std::fs::read_to_string(&json_path).map_err(|source| OutputError::Io {
         path: json_path.clone(),
@@ -341,13 +343,16 @@ fn read_part(path: &Path) -> Result<Part, MergeError> {
             ),
         ));
     }
-    Ok(Part {
-        path: path.to_path_buf(),
-        sidecar,
-        header,
-        shard,
+    Ok((
+        Part {
+            path: path.to_path_buf(),
+            sidecar,
+            header,
+            shard,
+            size: (film.width, film.height),
+        },
         film,
-    })
+    ))
 }
 
 /// The value of `name` in an EXR header's metadata pairs.
@@ -600,23 +605,47 @@ pub fn merge(
     if inputs.is_empty() {
         return Err(MergeError::Inconsistent("no shards given".into()));
     }
-    let parts = inputs
-        .iter()
-        .map(|p| read_part(p))
-        .collect::<Result<Vec<_>, _>>()?;
+    // Each shard's rows are copied as it is read, so that one shard's image is held at a time.
+    let mut parts: Vec<Part> = Vec::with_capacity(inputs.len());
+    let mut film: Option<Film> = None;
+    for path in inputs {
+        let (part, image) = read_part(path)?;
+        let merged = match &mut film {
+            Some(f) => f,
+            None => {
+                let (w, h) = part.size;
+                tracer::memory::check(
+                    || format!("merging {w}x{h} shards"),
+                    f64::from(w) * f64::from(h) * tracer::memory::RENDER_BYTES_PER_PIXEL,
+                )
+                .map_err(|e| shard_err(&part.path, e.to_string()))?;
+                film.insert(Film::new(w, h))
+            }
+        };
+        if (merged.width, merged.height) != part.size {
+            return Err(MergeError::Inconsistent(format!(
+                "`{}` and `{}` are shards of different renders: image size {}x{} vs {}x{}",
+                part.path.display(),
+                parts[0].path.display(),
+                part.size.0,
+                part.size.1,
+                merged.width,
+                merged.height
+            )));
+        }
+        let w = merged.width as usize;
+        for y in (0..merged.height).filter(|&y| part.shard.holds_row(y)) {
+            let row = y as usize * w..(y as usize + 1) * w;
+            merged.pixels[row.clone()].copy_from_slice(&image.pixels[row]);
+        }
+        parts.push(part);
+    }
+    let film = film.expect("at least one shard was read");
     check_consistent(&parts, exposure.is_some())?;
     let first = &parts[0];
-    let (width, height) = (first.film.width, first.film.height);
     let count = first.shard.count();
     let mut by_index: Vec<&Part> = parts.iter().collect();
     by_index.sort_by_key(|p| p.shard.index());
-    let mut film = Film::new(width, height);
-    let w = width as usize;
-    for y in 0..height {
-        let src = &by_index[(y % count) as usize].film;
-        let row = y as usize * w..(y as usize + 1) * w;
-        film.pixels[row.clone()].copy_from_slice(&src.pixels[row]);
-    }
     let spp = |p: &Part| {
         p.sidecar["spp"]
             .as_u64()

@@ -38,9 +38,15 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Run {
 /// ended after `seconds` (for inputs that used to hang or grow without bound).
 #[track_caller]
 pub fn run_within(dir: &Path, args: &[&str], seconds: u64) -> Run {
+    run_program_within(dir, env!("CARGO_BIN_EXE_het-bssrdf"), args, seconds)
+}
+
+/// Runs `program args…` in `dir`, killed (and the test failed) after `seconds`.
+#[track_caller]
+pub fn run_program_within(dir: &Path, program: &str, args: &[&str], seconds: u64) -> Run {
     use std::process::Stdio;
     use std::time::{Duration, Instant};
-    let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+    let mut child = Command::new(program)
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::null())
@@ -364,4 +370,98 @@ pub fn with_gltf(path: &str) -> String {
         "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
         &format!("type = \"gltf\"\nname = \"tet\"\nmaterial = \"m\"\npath = \"{path}\""),
     )
+}
+
+/// A `w × h` 8-bit greyscale PNG of zeros, made without holding its pixels: the zlib stream is
+/// one fixed-Huffman deflate block (a literal 0, then matches of 258 bytes at distance 1), so
+/// a 20000² image (400 MB decoded) is a file of about 2.5 MB.
+pub fn black_grey_png(w: u32, h: u32) -> Vec<u8> {
+    /// Deflate's bit order: values LSB first, Huffman codes MSB first.
+    struct Bits {
+        out: Vec<u8>,
+        acc: u32,
+        n: u32,
+    }
+    impl Bits {
+        fn bit(&mut self, b: u32) {
+            self.acc |= (b & 1) << self.n;
+            self.n += 1;
+            if self.n == 8 {
+                self.out.push(self.acc as u8);
+                self.acc = 0;
+                self.n = 0;
+            }
+        }
+        fn code(&mut self, code: u32, len: u32) {
+            for i in (0..len).rev() {
+                self.bit(code >> i);
+            }
+        }
+    }
+    let total = u64::from(h) * (u64::from(w) + 1); // a filter byte (0) per row
+    let mut bits = Bits {
+        out: vec![0x78, 0x01],
+        acc: 0,
+        n: 0,
+    };
+    bits.bit(1); // BFINAL
+    bits.bit(1); // BTYPE = 01 (fixed Huffman), LSB first
+    bits.bit(0);
+    bits.code(0x30, 8); // literal 0
+    let rest = total - 1;
+    for _ in 0..rest / 258 {
+        bits.code(0xC5, 8); // length 258 (symbol 285)
+        bits.code(0, 5); // distance 1
+    }
+    for _ in 0..rest % 258 {
+        bits.code(0x30, 8);
+    }
+    bits.code(0, 7); // end of block (symbol 256)
+    while bits.n != 0 {
+        bits.bit(0);
+    }
+    let mut zlib = bits.out;
+    // Adler-32 of `total` zero bytes: a stays 1, b adds 1 per byte.
+    let adler = (((total % 65521) as u32) << 16) | 1;
+    zlib.extend_from_slice(&adler.to_be_bytes());
+    let crc = |bytes: &[u8]| {
+        let mut c = 0xFFFF_FFFFu32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    };
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut chunk = |kind: &[u8], data: &[u8]| {
+        png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        png.extend_from_slice(&body);
+        png.extend_from_slice(&crc(&body).to_be_bytes());
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&w.to_be_bytes());
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]); // 8-bit grey, deflate, no interlace
+    chunk(b"IHDR", &ihdr);
+    chunk(b"IDAT", &zlib);
+    chunk(b"IEND", &[]);
+    png
+}
+
+/// Runs `het-bssrdf args…` in `dir` under the shell limits `limits` (e.g. `ulimit -v
+/// 1000000`), within `seconds`.
+#[track_caller]
+pub fn run_limited(dir: &Path, limits: &str, args: &[&str], seconds: u64) -> Run {
+    let script = format!("{limits} && exec \"$0\" \"$@\"");
+    let mut sh_args = vec!["-c", &script, env!("CARGO_BIN_EXE_het-bssrdf")];
+    sh_args.extend_from_slice(args);
+    run_program_within(dir, "sh", &sh_args, seconds)
 }
