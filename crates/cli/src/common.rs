@@ -1,10 +1,12 @@
 //! Helpers shared by the subcommands: method names, output paths, summaries.
 
+use crate::diag::say;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
 use tracer::integrator::PathCounters;
+use tracer::output::OutputLock;
 
 /// Parses a duration in seconds (> 0).
 pub fn parse_seconds(s: &str) -> Result<Duration, String> {
@@ -55,10 +57,27 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     experiments::run::check_render_outputs(path).context("invalid --out")
 }
 
+/// Claims the output set of a run (the EXR `exr` and the PNG and JSON beside it) before its
+/// work starts: every path writable ([`check_writable`]), none of them one of the run's
+/// `inputs` (a scene's texture, a shard being merged), the set locked against other runs
+/// ([`OutputLock`]), and the temporaries a killed run left for it removed. Keep the lock until
+/// the last file is written.
+pub fn claim_outputs(exr: &Path, inputs: &[&Path]) -> anyhow::Result<OutputLock> {
+    check_writable(exr)?;
+    let (png, json) = experiments::run::sidecar_paths(exr);
+    let set = [exr, png.as_path(), json.as_path()];
+    tracer::output::check_not_inputs(set, inputs).context("invalid --out")?;
+    let lock = OutputLock::acquire(exr).context("invalid --out")?;
+    for path in set {
+        tracer::output::remove_stale_temporaries(path);
+    }
+    Ok(lock)
+}
+
 /// One line per rare event that happened, so that no cap or fallback is silent.
 pub fn warn_counters(c: &PathCounters) {
     if c.capped > 0 {
-        eprintln!(
+        say!(
             "warning: {} of {} paths ({:.3} %) hit the collision cap of {} collisions and were cut \
              (their remaining light is lost); --max-collisions sets the cap",
             c.capped,
@@ -68,19 +87,19 @@ pub fn warn_counters(c: &PathCounters) {
         );
     }
     if c.leaks > 0 {
-        eprintln!(
+        say!(
             "warning: {} rays inside a closed object found no boundary (paths ended)",
             c.leaks
         );
     }
     if c.profile_failures > 0 {
-        eprintln!(
+        say!(
             "warning: {} profile evaluations rejected their estimated coefficients (those channels contributed 0)",
             c.profile_failures
         );
     }
     if c.estimator_fallbacks > 0 {
-        eprintln!(
+        say!(
             "note: {} estimates fell back to the endpoint average (every projection missed)",
             c.estimator_fallbacks
         );
@@ -94,7 +113,7 @@ pub fn warn_counters(c: &PathCounters) {
         } else {
             String::new()
         };
-        eprintln!(
+        say!(
             "averaging: {} of {} estimates prefiltered (sone: closed-form footprints; kernel: \
              points read in the surface's plane); sampled: {} where the surface was too curved \
              for a flat footprint{charts}",
@@ -128,7 +147,7 @@ const MANY_TRIANGLES: usize = 1_000_000;
 pub fn note_triangles(scene: &tracer::scene::Scene) {
     let n = scene.geometry().triangle_count();
     if n >= MANY_TRIANGLES {
-        eprintln!(
+        say!(
             "note: the scene's {} objects are {:.1} million triangles",
             scene.geometry().object_count(),
             n as f64 / 1e6

@@ -3,6 +3,7 @@
 //! `convergence.csv`, `convergence.png` (+ `.svg`), `summary.json` with the speed-up of each
 //! BSSRDF method over path tracing, and the largest run of every method as an image.
 
+use crate::diag::say;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -154,9 +155,11 @@ fn print_summary(summary: &[MethodSummary]) {
             }
             _ => String::new(),
         };
-        eprintln!(
+        say!(
             "{:>24}: converged rel. L2 {:.4} after {:.3} s; {pt}{aware}",
-            s.method, s.converged_error, s.time_to_converge
+            s.method,
+            s.converged_error,
+            s.time_to_converge
         );
     }
 }
@@ -222,7 +225,7 @@ fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
     if usable {
         dir
     } else {
-        eprintln!(
+        say!(
             "warning: the reference cache `{}` cannot be written; caching in `{}` instead",
             dir.display(),
             out.display()
@@ -257,7 +260,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
                 .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
             let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
             if !cache.is_file() {
-                eprintln!(
+                say!(
                     "rendering the path-traced reference at {spp} spp into {}",
                     cache.display()
                 );
@@ -338,13 +341,13 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     print_summary(&summary);
     for (name, outcome) in &finals {
         if outcome.prepare_seconds >= 0.5 {
-            eprintln!(
+            say!(
                 "note: preparing `{name}` took {:.1} s, once, not counted in its times above",
                 outcome.prepare_seconds
             );
         }
     }
-    eprintln!(
+    say!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()
     );
@@ -370,7 +373,7 @@ impl RunLog {
         self.runs.push(run.clone());
         let text = experiments::converge::csv(&self.runs);
         if let Err(e) = tracer::output::write_atomic(&self.path, text.as_bytes()) {
-            eprintln!("warning: {e}: the runs so far are not saved");
+            say!("warning: {e}: the runs so far are not saved");
         }
     }
 }
@@ -472,7 +475,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         )?;
     }
     print_summary(&summary);
-    eprintln!(
+    say!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()
     );

@@ -372,6 +372,22 @@ pub enum OutputError {
         /// The cargo feature to enable.
         feature: &'static str,
     },
+    /// Another process holds the lock of the output set (see [`crate::output::OutputLock`]).
+    #[error("cannot write `{}`: another het-bssrdf run ({holder}) is writing it and the files beside it; wait for it to end or choose another output", path.display())]
+    Busy {
+        /// The requested output path.
+        path: PathBuf,
+        /// Who holds the lock, as it wrote in the lock file (`pid 1234 on node7`).
+        holder: String,
+    },
+    /// The output would replace a file the run reads.
+    #[error("cannot write `{}`: it is `{}`, an input of this run, which it would replace; choose another output", path.display(), input.display())]
+    IsInput {
+        /// The requested output path.
+        path: PathBuf,
+        /// The input it resolves to.
+        input: PathBuf,
+    },
 }
 /// Work that would need more memory than the machine has available, refused before anything
 /// is allocated.

@@ -4,7 +4,8 @@
 #![allow(dead_code)] // each test crate uses a different subset
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
 
 use bssrdf_core::Rgb;
 use tracer::film::Film;
@@ -44,8 +45,6 @@ pub fn run_within(dir: &Path, args: &[&str], seconds: u64) -> Run {
 /// Runs `program args…` in `dir`, killed (and the test failed) after `seconds`.
 #[track_caller]
 pub fn run_program_within(dir: &Path, program: &str, args: &[&str], seconds: u64) -> Run {
-    use std::process::Stdio;
-    use std::time::{Duration, Instant};
     let mut child = Command::new(program)
         .args(args)
         .current_dir(dir)
@@ -464,4 +463,92 @@ pub fn run_limited(dir: &Path, limits: &str, args: &[&str], seconds: u64) -> Run
     let mut sh_args = vec!["-c", &script, env!("CARGO_BIN_EXE_het-bssrdf")];
     sh_args.extend_from_slice(args);
     run_program_within(dir, "sh", &sh_args, seconds)
+}
+
+/// A running `het-bssrdf`, killed if the test fails before waiting for it.
+pub struct Running(Option<Child>);
+
+impl Running {
+    pub fn id(&self) -> u32 {
+        self.0.as_ref().expect("running").id()
+    }
+    pub fn wait_with_output(mut self) -> std::io::Result<std::process::Output> {
+        self.0.take().expect("running").wait_with_output()
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        if let Some(c) = &mut self.0 {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+/// Starts `het-bssrdf args…` in `dir` without waiting.
+pub fn spawn(dir: &Path, args: &[&str]) -> Running {
+    Running(Some(
+        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(args)
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn het-bssrdf"),
+    ))
+}
+
+/// Sends `signal` (`INT`, `TERM`) to the child.
+pub fn signal(child: &Running, signal: &str) {
+    let ok = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .expect("run kill")
+        .success();
+    assert!(ok, "kill -{signal} failed");
+}
+
+/// Waits for `cond` for at most 60 s.
+#[track_caller]
+pub fn wait_for(what: &str, cond: impl Fn() -> bool) {
+    let start = Instant::now();
+    while !cond() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Runs `het-bssrdf args…` in `dir`, sends it `sig` 1.5 s after it started, and returns its
+/// exit code and stderr.
+pub fn interrupted_after_a_while(dir: &Path, args: &[&str], sig: &str) -> (Option<i32>, String) {
+    let child = spawn(dir, args);
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, sig);
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The JSON sidecar at `path`.
+pub fn sidecar(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).expect("read sidecar")).expect("sidecar JSON")
+}
+
+/// No temporary (`.….tmp`) or probe file left in `dir`.
+#[track_caller]
+pub fn assert_no_temporaries(dir: &Path) {
+    let files = listing(dir);
+    assert!(
+        !files
+            .iter()
+            .any(|f| f.ends_with(".tmp") || f.contains(".het-bssrdf-probe")),
+        "temporary files left: {files:?}"
+    );
 }
