@@ -188,7 +188,16 @@ fn cgroup_dir_headroom(dir: &Path, max_file: &str, used_file: &str) -> Option<f6
 /// Refuses `what` when `bytes` exceeds the memory this process may still allocate
 /// ([`headroom`]).
 pub fn check(what: impl FnOnce() -> String, bytes: f64) -> Result<(), TooLarge> {
-    let room = headroom();
+    check_within(headroom(), what, bytes)
+}
+
+/// [`check`] against a headroom read before (for many checks in a row: reading the limits
+/// takes several file reads).
+pub fn check_within(
+    room: Headroom,
+    what: impl FnOnce() -> String,
+    bytes: f64,
+) -> Result<(), TooLarge> {
     if bytes.is_finite() && bytes <= room.bytes {
         Ok(())
     } else {

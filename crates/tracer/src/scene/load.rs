@@ -160,9 +160,15 @@ impl Cx {
     }
 
     /// Refuses, before they are generated, primitives whose `triangles` so far would not fit
-    /// in memory (see [`crate::memory`]).
-    fn check_tessellation(&self, triangles: f64, key: &str) -> Result<(), SceneError> {
-        crate::memory::check(
+    /// in `room` (see [`crate::memory`]).
+    fn check_tessellation(
+        &self,
+        room: crate::memory::Headroom,
+        triangles: f64,
+        key: &str,
+    ) -> Result<(), SceneError> {
+        crate::memory::check_within(
+            room,
             || {
                 format!(
                     "the scene's primitives ({:.1} million triangles)",
@@ -911,10 +917,12 @@ impl Cx {
         let mut out: Vec<ShapePlan> = Vec::new();
         let mut names = HashSet::new();
         let shapes = self.elements(t, "shape")?;
-        // The primitives' triangles, counted before any is generated.
+        // The primitives' triangles, counted before any is generated; the limits are read
+        // once (a check per shape read them 100,000 times for as many boxes).
+        let room = crate::memory::headroom();
         let mut tessellated = 0.0;
         for (key, v) in &shapes {
-            tessellated += match self.type_of(v, key, KINDS)? {
+            let added = match self.type_of(v, key, KINDS)? {
                 "sphere" => {
                     let d: SphereDesc = self.de(v, key)?;
                     20.0 * 4f64.powi(d.subdivisions.unwrap_or(5).min(9) as i32)
@@ -923,9 +931,10 @@ impl Cx {
                     let d: HalfSpaceDesc = self.de(v, key)?;
                     2.0 * f64::from(d.subdivisions.unwrap_or(32).min(1024)).powi(2) + 10.0
                 }
-                _ => 0.0,
+                _ => continue,
             };
-            self.check_tessellation(tessellated, &format!("{key}.subdivisions"))?;
+            tessellated += added;
+            self.check_tessellation(room, tessellated, &format!("{key}.subdivisions"))?;
         }
         for (i, (key, v)) in shapes.into_iter().enumerate() {
             let k = |sub: &str| format!("{key}.{sub}");
