@@ -155,7 +155,8 @@ fn a_second_run_to_one_output_set_is_refused() {
     });
     let mut second = ENDLESS.to_vec();
     second.extend_from_slice(&["--seed", "2"]);
-    let r = s.run(&second);
+    // Refused at once (a second writer, not refused, would render for ever).
+    let r = common::run_within(s.path(), &second, 60);
     assert_eq!(r.code, Some(1), "{}", r.stderr);
     assert!(
         r.stderr.contains("another het-bssrdf run") && r.stderr.contains("out.exr"),
