@@ -68,8 +68,16 @@ pub fn claim_outputs(exr: &Path, inputs: &[&Path]) -> anyhow::Result<OutputLock>
     let set = [exr, png.as_path(), json.as_path()];
     tracer::output::check_not_inputs(set, inputs).context("invalid --out")?;
     let lock = OutputLock::acquire(exr).context("invalid --out")?;
-    for path in set {
-        tracer::output::remove_stale_temporaries(path);
+    if lock.is_held() {
+        for path in set {
+            tracer::output::remove_stale_temporaries(path);
+        }
+    } else {
+        say!(
+            "note: the file system of `{}` cannot lock it: another run writing the same files \
+             would not be detected",
+            exr.display()
+        );
     }
     Ok(lock)
 }

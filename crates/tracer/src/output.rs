@@ -126,6 +126,9 @@ pub struct OutputLock {
     /// Held open: closing it releases the lock.
     _file: fs::File,
     path: PathBuf,
+    /// False when the file system does not support locks (some network file systems): the set
+    /// is then written unlocked.
+    held: bool,
 }
 
 impl OutputLock {
@@ -156,6 +159,15 @@ impl OutputLock {
             // SAFETY: flock on a descriptor this function owns.
             if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
                 let e = std::io::Error::last_os_error();
+                let unsupported = [libc::ENOLCK, libc::EOPNOTSUPP, libc::ENOSYS];
+                if e.raw_os_error().is_some_and(|c| unsupported.contains(&c)) {
+                    locks().push(lock_path.clone());
+                    return Ok(OutputLock {
+                        _file: file,
+                        path: lock_path,
+                        held: false,
+                    });
+                }
                 if e.raw_os_error() == Some(libc::EWOULDBLOCK) {
                     let holder = fs::read_to_string(&lock_path)
                         .ok()
@@ -187,8 +199,15 @@ impl OutputLock {
             return Ok(OutputLock {
                 _file: file,
                 path: lock_path,
+                held: true,
             });
         }
+    }
+
+    /// False when the file system refused to lock (`ENOLCK`, `EOPNOTSUPP`): the set is written
+    /// as before locks, and another run writing it would not be seen.
+    pub fn is_held(&self) -> bool {
+        self.held
     }
 }
 

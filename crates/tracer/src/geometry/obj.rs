@@ -11,9 +11,8 @@ use crate::error::MeshError;
 /// Loads every object and group of an OBJ file into one mesh (faces triangulated, one index
 /// per vertex; materials are ignored, and `mtllib` files are not opened). Normals are kept
 /// only when every part has them; texture coordinates when any part has them (see
-/// [`TriangleMesh::append`]). The file is read as a stream of lines through a
-/// [`TextGuard`](super::obj_lines::TextGuard): a binary file (a NUL byte, a line over 16 MiB)
-/// is refused after one buffer, not read whole. The mesh is not validated here: call
+/// [`TriangleMesh::append`]). The file is read as a stream of lines through a guard: a
+/// binary file (a NUL byte, a line over 16 MiB) is refused after one buffer, not read whole. The mesh is not validated here: call
 /// [`TriangleMesh::prepare`].
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
     let file = path.display().to_string();
