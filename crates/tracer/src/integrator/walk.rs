@@ -18,12 +18,13 @@
 //! it) guards against pathological inputs,
 //! and every capped path is counted ([`PathCounters::capped`]) rather than dropped silently.
 
+use bssrdf_core::Rgb;
 use glam::DVec3;
 
 use crate::geometry::{Geometry, Hit, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::rng::Rng;
-use crate::volume::{ChannelMedium, Interaction, TrackingCounters, sample_hg, sample_interaction};
+use crate::volume::{FreeFlight, Interaction, TrackingCounters, sample_hg};
 
 /// Collisions allowed in one walk before it is stopped and counted as capped, by default.
 pub const MAX_COLLISIONS: u64 = 100_000_000;
@@ -142,12 +143,13 @@ pub enum WalkEnd {
 }
 
 /// One object's medium as the walk sees it.
-pub struct WalkMedium<'a, M: ChannelMedium> {
+pub struct WalkMedium<'a, M: FreeFlight> {
     /// The scene geometry.
     pub geometry: &'a Geometry,
     /// The object's index.
     pub object: u32,
-    /// Coefficients of the traced channel.
+    /// The free-flight sampler: one channel ([`crate::volume::ChannelView`]) or every channel
+    /// with a hero ([`crate::spectral::HeroTracking`]).
     pub medium: &'a M,
     /// HG mean cosine.
     pub g: f64,
@@ -155,7 +157,7 @@ pub struct WalkMedium<'a, M: ChannelMedium> {
     pub interface: Interface,
 }
 
-impl<M: ChannelMedium> WalkMedium<'_, M> {
+impl<M: FreeFlight> WalkMedium<'_, M> {
     /// Walks from `start`, a point inside the medium (the entry hit's `spawn_origin(dir)`, or
     /// a point just off a surface inside it), along the unit direction `dir`, until the path
     /// leaves, meets another object's surface, is absorbed or is capped. `last_scatter` is the
@@ -168,11 +170,40 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
         &self,
         start: DVec3,
         dir: DVec3,
-        mut last_scatter: Option<(DVec3, f64)>,
+        last_scatter: Option<(DVec3, f64)>,
         order: &mut u32,
         rng: &mut Rng,
         counters: &mut PathCounters,
         mut on_scatter: impl FnMut(DVec3, DVec3, u32, &mut Rng),
+    ) -> WalkEnd {
+        let mut weight = Rgb::ONE;
+        self.walk_carrying(
+            start,
+            dir,
+            last_scatter,
+            order,
+            &mut weight,
+            rng,
+            counters,
+            |p, d, k, _, rng| on_scatter(p, d, k, rng),
+        )
+    }
+
+    /// [`WalkMedium::walk`] carrying the per-channel path weight `weight`, which every flight
+    /// multiplies ([`FreeFlight`]: unchanged for one channel, the density ratios to the hero
+    /// for hero tracking, up to a common factor); `on_scatter` also receives the weight at the
+    /// scattering vertex.
+    #[allow(clippy::too_many_arguments)]
+    pub fn walk_carrying(
+        &self,
+        start: DVec3,
+        dir: DVec3,
+        mut last_scatter: Option<(DVec3, f64)>,
+        order: &mut u32,
+        weight: &mut Rgb,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+        mut on_scatter: impl FnMut(DVec3, DVec3, u32, Rgb, &mut Rng),
     ) -> WalkEnd {
         let mut origin = start;
         let mut d = dir;
@@ -184,7 +215,10 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
                 counters.leaks += 1;
                 break WalkEnd::Leaked;
             };
-            match sample_interaction(self.medium, origin, d, boundary.t, rng, &mut tracking) {
+            match self
+                .medium
+                .sample_flight(origin, d, boundary.t, rng, &mut tracking, weight)
+            {
                 Interaction::Absorb { .. } => break WalkEnd::Absorbed,
                 Interaction::Scatter { t } => {
                     collisions += 1;
@@ -194,7 +228,7 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
                     }
                     let p = origin + t * d;
                     *order += 1;
-                    on_scatter(p, d, *order, rng);
+                    on_scatter(p, d, *order, *weight, rng);
                     let nd = sample_hg(d, self.g, rng);
                     last_scatter = Some((p, bssrdf_core::hg::phase(d.dot(nd), self.g)));
                     origin = p;
