@@ -210,15 +210,25 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
         let mut collisions = 0u64;
         let cap = collision_cap();
         let mut tracking = TrackingCounters::default();
+        let (lo, hi) = self.geometry.object_bounds(self.object);
         let end = loop {
-            let Some(boundary) = self.geometry.intersect(&Ray::new(origin, d)) else {
-                counters.leaks += 1;
-                break WalkEnd::Leaked;
+            // The flight first, up to where the ray leaves the object's bounding box; the scene
+            // only when the flight reaches a surface (see [`Self::flight`]).
+            let (interaction, boundary) = match self.flight(
+                origin,
+                d,
+                box_exit(origin, d, lo, hi),
+                rng,
+                &mut tracking,
+                weight,
+            ) {
+                Some(found) => found,
+                None => {
+                    counters.leaks += 1;
+                    break WalkEnd::Leaked;
+                }
             };
-            match self
-                .medium
-                .sample_flight(origin, d, boundary.t, rng, &mut tracking, weight)
-            {
+            match interaction {
                 Interaction::Absorb { .. } => break WalkEnd::Absorbed,
                 Interaction::Scatter { t } => {
                     collisions += 1;
@@ -234,14 +244,15 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
                     origin = p;
                     d = nd;
                 }
-                Interaction::Pass if boundary.object != self.object => {
+                Interaction::Pass if boundary.is_some_and(|b| b.object != self.object) => {
                     break WalkEnd::Surface {
-                        hit: boundary,
+                        hit: boundary.expect("a pass has its surface"),
                         dir: d,
                         last_scatter,
                     };
                 }
                 Interaction::Pass => {
+                    let boundary = boundary.expect("a pass has its surface");
                     if boundary.ng.dot(d) <= 0.0 {
                         // Seen from outside although we are inside: the origin sat numerically
                         // on the far side of a face. Step over the face and go on.
@@ -270,6 +281,65 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
         counters.add_tracking(&tracking);
         end
     }
+
+    /// One flight from `origin` along `d`: the next real interaction before the first surface
+    /// of the scene, with that surface when the flight reaches it (`Pass`); `None` when no
+    /// surface is found (the ray has leaked out of the closed object).
+    ///
+    /// The flight is sampled first, up to `t_box` (where the ray leaves the object's bounding
+    /// box, beyond which no surface that ends the walk can lie), and the scene is asked only
+    /// whether anything lies on the segment up to the sampled collision: inside a medium
+    /// most flights end in a collision far from any surface, and an occlusion query on a
+    /// short segment costs less than the closest hit of the whole ray. When a surface is on
+    /// the segment (or the flight reached `t_box`), the flight is sampled again up to the
+    /// closest hit with the same random numbers: its tentative collisions are the same up to
+    /// that surface, where it passes, and it leaves `rng` and `weight` exactly as sampling
+    /// up to the surface from the start does. The outcome is therefore the same sample as
+    /// delta tracking against the closest hit, random number for random number.
+    fn flight(
+        &self,
+        origin: DVec3,
+        d: DVec3,
+        t_box: f64,
+        rng: &mut Rng,
+        tracking: &mut TrackingCounters,
+        weight: &mut Rgb,
+    ) -> Option<(Interaction, Option<Hit>)> {
+        if t_box > 0.0 {
+            let (saved_rng, saved_weight, saved_tracking) = (rng.clone(), *weight, *tracking);
+            let sampled = self
+                .medium
+                .sample_flight(origin, d, t_box, rng, tracking, weight);
+            match sampled {
+                Interaction::Scatter { t } | Interaction::Absorb { t }
+                    if !self.geometry.occluded(&Ray::with_range(origin, d, 0.0, t)) =>
+                {
+                    return Some((sampled, None));
+                }
+                _ => {
+                    *rng = saved_rng;
+                    *weight = saved_weight;
+                    *tracking = saved_tracking;
+                }
+            }
+        }
+        let boundary = self.geometry.intersect(&Ray::new(origin, d))?;
+        let sampled = self
+            .medium
+            .sample_flight(origin, d, boundary.t, rng, tracking, weight);
+        Some((sampled, Some(boundary)))
+    }
+}
+
+/// The distance along `origin + t·d` at which the ray leaves the box `[lo, hi]` (slab test;
+/// 0 or less when `origin` is outside it).
+#[inline]
+fn box_exit(origin: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    let inv = d.recip();
+    let (t0, t1) = ((lo - origin) * inv, (hi - origin) * inv);
+    let far = t0.max(t1).min_element();
+    let near = t0.min(t1).max_element();
+    if near > 0.0 || far.is_nan() { 0.0 } else { far }
 }
 
 #[cfg(test)]
