@@ -21,9 +21,9 @@
 //! `r_u` get identical updates in the medium). The path tracer divides β by the mean of r_u
 //! over the channels: f_c / ((1/3) Σ_k p_k), the one-sample balance heuristic over the three
 //! channels as sampling techniques (Vea97 §9.2.4) — the hero being chosen uniformly. Only ratios
-//! between the channels of q matter, so [`sample_hero`] keeps its largest channel at 1 and the
-//! product over hundreds of collisions neither overflows nor underflows in the channel that
-//! counts. The path tracer's use, and what next-event estimation does: `integrator/path.rs`
+//! between the channels of q matter, so [`sample_hero`] rescales it when its largest channel
+//! leaves [1e-100, 1e100], and the product over any number of collisions neither overflows nor
+//! underflows in the channel that counts. The path tracer's use, and what next-event estimation does: `integrator/path.rs`
 //! and `docs/physics.md#spectral-mis`.
 //!
 //! Units: distances in scene units, coefficients in 1/scene unit; `dir` is a unit vector.
@@ -114,16 +114,20 @@ impl<M: SpectralMedium> FreeFlight for HeroTracking<M> {
     }
 }
 
-/// Rescales `weight` so that its largest channel is 1 (only ratios between channels matter);
-/// an infinite channel becomes 1 and the finite ones 0, a weight with no positive channel is
-/// left as it is.
+/// Rescales `weight` so that its largest channel is 1 when that channel has left
+/// [1e-100, 1e100] (only ratios between channels matter, and the hero's channel, multiplied by
+/// 1 at every step, stays near 1 otherwise); an infinite channel becomes 1 and the finite ones
+/// 0, a weight with no positive channel is left as it is.
 #[inline]
 fn normalise(weight: &mut Rgb) {
     let max = weight.max_component();
+    if (1e-100..=1e100).contains(&max) {
+        return;
+    }
     if max.is_infinite() {
         *weight = weight.map(|w| if w.is_infinite() { 1.0 } else { 0.0 });
     } else if max > 0.0 {
-        *weight = *weight * (1.0 / max);
+        *weight *= 1.0 / max;
     }
 }
 
@@ -143,8 +147,8 @@ fn fold_majorant(weight: &mut Rgb, majorant: Rgb, hero: usize, t: f64) {
 
 /// The next real interaction along `origin + t·dir`, `t ∈ (0, t_max)`, by delta tracking with
 /// the majorant of channel `hero`, multiplying `weight` by each channel's density ratio to the
-/// hero's (see the module docs) and leaving its largest channel at 1. The hero's own channel
-/// is multiplied by exactly 1 at every step, so it stays positive. `t_max` may be infinite only
+/// hero's (see the module docs), rescaled when its largest channel leaves [1e-100, 1e100].
+/// The hero's own channel is multiplied by 1 at every step, so it stays positive. `t_max` may be infinite only
 /// where the hero surely collides.
 #[allow(clippy::too_many_arguments)]
 pub fn sample_hero<M: SpectralMedium + ?Sized>(
