@@ -121,7 +121,8 @@ pub fn plane_albedos(albedos: &[f64], g: f64, eta: f64) -> Vec<f64> {
 
 /// The totals of one anisotropic medium's half-space (one g ≠ 0 and η) at every albedo: the
 /// plane albedo ([`plane_albedo`]) on the half-space table's albedo rows, interpolated as
-/// the table's totals are (cubic in log √(1 − α)), and the exact single scattering, which is
+/// the table's totals are (docs/tabulated-profile.md, "Totals between rows"), and the exact
+/// single scattering, which is
 /// linear in the albedo. What the tabulated profile's totals are at g ≠ 0
 /// (`crate::family`): similarity theory gives the shape, these the amount.
 #[derive(Debug, Clone, PartialEq)]
@@ -180,7 +181,8 @@ impl AnisotropicTotals {
     }
 
     /// The plane albedo, every order, at single-scattering albedo `albedo` ∈ [0, 1]
-    /// (interpolated between the rows as the table's totals are: [`totals_between_rows`]).
+    /// (interpolated between the rows as the table's totals are: docs/tabulated-profile.md,
+    /// "Totals between rows").
     pub fn all(&self, albedo: f64) -> f64 {
         let (s, m) = totals_between_rows(albedo, N_ALBEDO, self.rows.single, |r| self.rows.all[r]);
         (s + m).clamp(0.0, 1.0)

@@ -271,7 +271,7 @@ impl Bands {
 ///
 /// A footprint thinner than [`THIN_ASPECT`] (minor over major semi-axis, b/a, including a
 /// segment, b = 0) is replaced by its b → 0 limit, the segment along its major axis with the
-/// semicircle law ([`segment_check_fraction`]): in unit-disk coordinates the cells' images
+/// semicircle law, cut at the cells' edges: in unit-disk coordinates the cells' images
 /// grow as a/b, and the polygon areas below lose every digit (at b/a ≤ 3·10⁻⁹ they returned
 /// 0.83, 0 or 1 where 0.444 was right). The limit's own error is of order (b/a)², and
 /// `tests/prefilter.rs` checks both against brute force from b/a = 10⁻¹² to 1.

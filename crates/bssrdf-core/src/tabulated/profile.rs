@@ -18,7 +18,7 @@ static DATA: &[u8] = include_bytes!("../../data/halfspace-profile-v1.bin");
 pub const POOL_REL_SE: f64 = 0.1;
 
 /// The built-in table, parsed once, with sparse bins pooled and the radial node values set to
-/// conserve each bin's mass ([`conserve_bin_masses`]; `density` then holds node values, not
+/// conserve each bin's mass (docs/tabulated-profile.md; `density` then holds node values, not
 /// bin means).
 pub fn table() -> &'static TableData {
     static TABLE: OnceLock<TableData> = OnceLock::new();
@@ -66,7 +66,8 @@ impl TabulatedTerm {
     /// [`ETA_MAX`]] (clamped), counting single and/or multiple scattering.
     ///
     /// Albedo: the radial shape is linear between the two rows around α (in log √(1 − α)),
-    /// and the totals follow [`totals_between_rows`]: the linear rule had put the
+    /// and the totals follow the rule of docs/tabulated-profile.md, "Totals between rows"
+    /// (`totals_between_rows`): the linear rule had put the
     /// multiple-scattering total 2.6 % high at α = 0.5 and 20 % at α = 0.2 against
     /// Chandrasekhar's (`tests/tabulated.rs`).
     pub fn new(sigma_t: f64, alpha: f64, eta: f64, single: bool, multiple: bool) -> Self {
