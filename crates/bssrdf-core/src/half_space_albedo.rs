@@ -122,9 +122,8 @@ pub fn plane_albedos(albedos: &[f64], g: f64, eta: f64) -> Vec<f64> {
 /// The totals of one anisotropic medium's half-space (one g ≠ 0 and η) at every albedo: the
 /// plane albedo ([`plane_albedo`]) on the half-space table's albedo rows, interpolated as
 /// the table's totals are (docs/tabulated-profile.md, "Totals between rows"), and the exact
-/// single scattering, which is
-/// linear in the albedo. What the tabulated profile's totals are at g ≠ 0
-/// (`crate::family`): similarity theory gives the shape, these the amount.
+/// single scattering, which is linear in the albedo. What the tabulated profile's totals are
+/// at g ≠ 0 (`crate::family`): similarity theory gives the shape, these the amount.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnisotropicTotals {
     g: f64,
