@@ -271,7 +271,7 @@ impl ProfileFamily {
     /// The real medium's multiple-scattering total over the similar isotropic medium's (the
     /// factor [`ProfileFamily::profile`] scales the table's multiple scattering by at g ≠ 0;
     /// 1 at g = 0, for other models and for media that do not scatter), for validated
-    /// coefficients. The slab profile scales its reflection by it.
+    /// coefficients. The slab profile scales both its faces by it.
     pub(crate) fn multiple_scale(&self, sigma_a: f64, sigma_s: f64) -> f64 {
         let (
             Some(totals),

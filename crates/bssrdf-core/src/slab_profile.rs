@@ -13,8 +13,8 @@ use crate::tabulated::{SlabFace, SlabTerm};
 /// thickness and the family's `g` and `η` (1/length², exitance per unit area per unit power
 /// entering; conventions of [`RadialProfile`]). Multiple scattering from the slab table
 /// (similarity theory for g ≠ 0: reduced coefficients, thickness in reduced mean free paths,
-/// and the reflection scaled as the half-space profile's multiple scattering is, so that the
-/// thick limit is that profile; see [`ProfileFamily::profile`]); single scattering, when the
+/// and both faces scaled as the half-space profile's multiple scattering is, so that the thick
+/// limit is that profile; see [`ProfileFamily::profile`]); single scattering, when the
 /// family selects it, is the half-space profile's single-scattering term on the entry face
 /// and absent from the opposite face (an approximation: a thin slab reflects less single
 /// scattering and transmits some). `Copy`.
@@ -83,7 +83,7 @@ impl ProfileFamily {
             .filter(|_| self.scattering().includes_multiple())
             .map(|alpha_p| {
                 SlabTerm::new(sigma_tp, alpha_p, self.eta(), thickness)
-                    .with_reflection_scale(self.multiple_scale(sigma_a, sigma_s))
+                    .with_scale(self.multiple_scale(sigma_a, sigma_s))
             });
         let single = self.tabulated_single(sigma_a, sigma_s);
         Ok(Some(SlabProfile { multiple, single }))

@@ -119,8 +119,8 @@ pub struct SlabTerm {
     half_space: (f64, TabulatedTerm),
     /// Per face (reflection, transmission): the factor that brings the corners' total
     /// (linear between albedo rows) to the face's total with the rows' totals interpolated
-    /// cubically, as the half-space table's ([`TabulatedTerm::new`]); the reflection's also
-    /// carries [`SlabTerm::with_reflection_scale`].
+    /// cubically, as the half-space table's ([`TabulatedTerm::new`]); both also carry
+    /// [`SlabTerm::with_scale`].
     scale: [f64; 2],
 }
 
@@ -207,12 +207,13 @@ impl SlabTerm {
         }
     }
 
-    /// The same slab with its reflection (the slab part and the half-space blend alike)
+    /// The same slab with both faces (the slab part and the half-space blend alike)
     /// multiplied by `k` (≥ 0): how the family gives an anisotropic medium its own
     /// multiple-scattering total (`crate::slab_profile`).
-    pub fn with_reflection_scale(mut self, k: f64) -> Self {
+    pub fn with_scale(mut self, k: f64) -> Self {
         if k.is_finite() && k >= 0.0 {
             self.scale[0] *= k;
+            self.scale[1] *= k;
             let hs = &self.half_space.1;
             self.half_space.1 = hs.scaled_to(k * crate::profile::RadialProfile::total(hs));
         }
