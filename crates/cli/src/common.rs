@@ -124,7 +124,10 @@ pub fn warn_counters(c: &PathCounters) {
         say!(
             "averaging: of {} estimates, {} read a region in closed form, {} sampled a region on \
              the surface's local quadric (no rays), {} projected a region by rays{charts}",
-            c.estimates, c.prefiltered, c.lifted, c.prefilter_fallbacks
+            c.estimates,
+            c.prefiltered,
+            c.lifted,
+            c.prefilter_fallbacks
         );
     }
 }

@@ -461,9 +461,15 @@ impl ShapeCorrection {
                     steps
                         .step(|| {
                             sums.as_ref()?;
-                            Some(body_response(bssrdf, &surface, walk_medium, x, *coeffs, key(i), |x_i| {
-                                corr.at(x_i.p, x_i.ns).incident_mean(&weights)
-                            }))
+                            Some(body_response(
+                                bssrdf,
+                                &surface,
+                                walk_medium,
+                                x,
+                                *coeffs,
+                                key(i),
+                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
+                            ))
                         })
                         .flatten()
                 })
@@ -737,7 +743,9 @@ fn point_sums(
             let c = match field {
                 Some(field) => {
                     let mut own = Rng::from_keys(rng.next_u64(), &[]);
-                    let est = bssrdf.estimator.estimate(&plane, field, &hit.hit, x_o, &mut own);
+                    let est = bssrdf
+                        .estimator
+                        .estimate(&plane, field, &hit.hit, x_o, &mut own);
                     counters.record_estimate(&est.diagnostics);
                     est.coefficients
                 }
@@ -892,7 +900,11 @@ fn body_response(
                         .profile(surface, field, &hit.hit, x_o, &mut rng, &mut counters)
                         .rd
                 }
-                None => bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters).0,
+                None => {
+                    bssrdf
+                        .weigh(surface, coeffs, &hit.hit, x_o, &mut counters)
+                        .0
+                }
             };
             sum += r * g(&hit.hit) * hit.weight;
         }
@@ -969,8 +981,7 @@ impl het_estimate::SurfaceQuery for TangentPlane {
             return None;
         }
         let t = (self.p0 - origin).dot(self.n) / dn;
-        t.is_finite()
-            .then(|| self.hit(t.abs(), origin + t * dir))
+        t.is_finite().then(|| self.hit(t.abs(), origin + t * dir))
     }
     fn curvature(&self, _: &Hit) -> Option<het_estimate::Curvature> {
         Some(het_estimate::Curvature::ZERO)
