@@ -6,7 +6,8 @@
 //! A pixel counts when the camera rays through four points of it (the centres of its
 //! quarters) all hit `OBJECT` first. The ratio is Σ test / Σ reference over those pixels,
 //! summed over the three channels; its standard error is the spread of the same ratio over
-//! eight interleaved pixel groups (pixel (x, y) in group (x + y) mod 8), divided by √8.
+//! eight interleaved pixel groups (pixel (x, y) in group (x + y) mod 8), divided by √8. The
+//! same ratio per channel follows (a hue shift shows as channels that disagree).
 //!
 //! With `--faces` the same ratio is also printed per facing (the axis nearest the shading
 //! normal at the pixel's centre: +x, −x, …) and, for a translucent object whose σa varies,
@@ -38,6 +39,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or_else(|| format!("no object named `{object}` in the scene"))? as u32;
     let camera = scene.camera().with_resolution(test.width, test.height)?;
     let mut groups = [(0.0f64, 0.0f64); 8];
+    // Per channel, per group: (test, reference).
+    let mut channel_groups = [[(0.0f64, 0.0f64); 8]; 3];
     let mut pixels = 0usize;
     let medium = scene.objects()[id as usize]
         .material
@@ -73,6 +76,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let g = &mut groups[((x + y) % 8) as usize];
             g.0 += tv;
             g.1 += rv;
+            for (c, cg) in channel_groups.iter_mut().enumerate() {
+                let g = &mut cg[((x + y) % 8) as usize];
+                g.0 += test.pixels[i][c];
+                g.1 += reference.pixels[i][c];
+            }
             pixels += 1;
             if faces {
                 let ray = camera.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
@@ -108,6 +116,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         t / r,
         sd / 8f64.sqrt()
     );
+    let per_channel: Vec<String> = channel_groups
+        .iter()
+        .zip(["R", "G", "B"])
+        .map(|(cg, name)| {
+            let (t, r) = cg.iter().fold((0.0, 0.0), |(t, r), g| (t + g.0, r + g.1));
+            let ratios = cg.map(|(t, r)| t / r);
+            let m = ratios.iter().sum::<f64>() / 8.0;
+            let sd = (ratios.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / 7.0).sqrt();
+            format!("{name} {:.4} ± {:.4}", t / r, sd / 8f64.sqrt())
+        })
+        .collect();
+    println!("  per channel: {}", per_channel.join(", "));
     if faces {
         let names = ["+x", "-x", "+y", "-y", "+z", "-z"];
         for (name, halves) in names.iter().zip(&by_face) {

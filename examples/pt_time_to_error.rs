@@ -13,29 +13,16 @@
 //! (user + system of the process, from `/proc/self/stat` on Linux) is printed beside it, since
 //! on a shared machine the wall time includes waiting for the cores.
 //!
-//! Each pixel's spread has ν = RUNS − 1 degrees of freedom, so the median over pixels of the
-//! estimated standard errors sits below the true one by √(median χ²_ν / ν) (Wilson–Hilferty:
-//! median χ²_ν ≈ ν(1 − 2/(9ν))³; 0.978 for 16 runs). The printed median is divided by that
-//! factor, which is exact when every pixel has the same relative error and close otherwise.
+//! The median is corrected for its bias with few runs (`experiments::time_to_error`).
 
 use bssrdf_core::Scattering;
 use experiments::run::{RenderJob, render_scene};
 use experiments::scenes::CHECKER_SLAB;
+use experiments::time_to_error::{ErrorSpread, cpu_seconds};
 use het_bssrdf::{bssrdf_core, tracer};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;
-
-/// User + system CPU seconds of this process so far (Linux; `None` elsewhere).
-fn cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which is in parentheses and may contain spaces).
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    // utime and stime are fields 14 and 15 of the whole line: 12 and 13 after the name.
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0) // USER_HZ is 100 on Linux
-}
 
 fn main() {
     let args: Vec<u32> = std::env::args()
@@ -65,23 +52,9 @@ fn main() {
         images.push(out.film.pixels);
     }
     let cpu = cpu0.zip(cpu_seconds()).map(|(a, b)| b - a);
-    let k = f64::from(runs);
-    let mut rel = Vec::with_capacity(images[0].len() * 3);
-    for p in 0..images[0].len() {
-        for c in 0..3 {
-            let v: Vec<f64> = images.iter().map(|im| im[p][c]).collect();
-            let mean = v.iter().sum::<f64>() / k;
-            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0);
-            if mean > 0.0 {
-                rel.push((var / k).sqrt() / mean);
-            }
-        }
-    }
-    rel.sort_by(f64::total_cmp);
-    let nu = k - 1.0;
-    let chi_median_ratio = (1.0 - 2.0 / (9.0 * nu)).powi(3);
-    let median = rel[rel.len() / 2] / chi_median_ratio.sqrt();
-    let factor = (median / 0.01).powi(2);
+    let spread = ErrorSpread::of(&images);
+    let median = spread.median_relative;
+    let factor = spread.time_factor(0.01);
     println!(
         "checker slab, all scattering orders, 128 x 128: {runs} runs x {spp} spp = {} spp",
         runs * spp

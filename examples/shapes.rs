@@ -4,8 +4,11 @@
 //! the same ratio on a half-space, with standard errors over seeds; and the fraction of BSSRDF
 //! shading points whose probes found nothing.
 //!
-//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8] [-- --oblique] [-- --half-space]
+//!     cargo run --release --example shapes [-- --quick] [-- --g 0.8] [-- --oblique] [-- --half-space] [-- --scattering all]
 //!
+//! `--scattering all` counts every scattering order in both renderers (the default is
+//! multiple scattering, two or more events). `--only NONE` (a label no shape has) keeps the
+//! half-space alone.
 //! `--oblique` replaces the shapes by the half-space seen at μ = 0.58 and 0.3 from its normal.
 //! `--half-space` turns the materials' `thickness_aware` off: the tabulated profile is the
 //! half-space one everywhere, as before the slab profile (docs/shapes.md).
@@ -20,9 +23,11 @@ mod shapes;
 
 use std::path::PathBuf;
 
-use bssrdf_core::ProfileModel;
+use bssrdf_core::{ProfileModel, Scattering};
 use het_bssrdf::{bssrdf_core, tracer};
-use shapes::{Medium, Shape, bssrdf, mean_se, measure, outside_light, ratio, shape_scene_with};
+use shapes::{
+    Medium, Shape, bssrdf, mean_se, measure_orders, outside_light, ratio, shape_scene_with,
+};
 use tracer::integrator::Method;
 
 /// Samples per pixel and seeds: per shape (pixel counts differ) and per method.
@@ -55,6 +60,15 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .map(|s| s.parse::<f64>().expect("--g takes a number"))
         .unwrap_or(0.0);
+    let scattering: Scattering = args
+        .iter()
+        .position(|a| a == "--scattering")
+        .and_then(|i| args.get(i + 1))
+        .map(|s| {
+            s.parse()
+                .expect("--scattering takes multiple, single or all")
+        })
+        .unwrap_or(Scattering::Multiple);
     let bunny = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/bunny.obj");
     let columns: Vec<Medium> = Medium::COLUMNS.iter().map(|m| Medium { g, ..*m }).collect();
     let models: Vec<ProfileModel> = if args.iter().any(|a| a == "--tabulated-only") {
@@ -86,9 +100,10 @@ fn main() {
             let outside = outside_light(&scene, m.eta, 32);
             let t0 = std::time::Instant::now();
             let seed0 = 1000 * ci as u64;
-            let pt = measure(
+            let pt = measure_orders(
                 &scene,
                 Method::PathTraced,
+                scattering,
                 outside,
                 spp_pt,
                 seed0..seed0 + seeds,
@@ -97,7 +112,14 @@ fn main() {
             let mut per_model = Vec::new();
             let mut miss = Vec::new();
             for &model in &models {
-                let b = measure(&scene, bssrdf(model), outside, spp_b, seed0..seed0 + seeds);
+                let b = measure_orders(
+                    &scene,
+                    bssrdf(model),
+                    scattering,
+                    outside,
+                    spp_b,
+                    seed0..seed0 + seeds,
+                );
                 per_model.push(mean_se(b.iter().map(|s| s.through)));
                 miss.push(mean_se(b.iter().map(|s| s.miss_fraction)));
             }

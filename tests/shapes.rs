@@ -5,16 +5,18 @@
 //! `examples/shapes.rs` prints the whole table with more samples).
 //!
 //! Each case is the double ratio q = (BSSRDF/PT on the shape) / (BSSRDF/PT on the
-//! half-space), with its standard error over 4 fixed seeds. The accepted tolerance is stated
-//! per case:
-//! * `Within15` — the half-space profile is good enough here: |q − 1| < 0.15 (+ 4 SE).
-//! * `Band(q0)` — still outside 15 % (small and curved bodies lose or gain light;
-//!   docs/shapes.md). `q0` is the value `examples/shapes.rs` measured (8 seeds,
-//!   4–16× these samples), so this is a regression guard, not a reference: q must stay within
-//!   ±10 % (+ 4 SE) of it, so that a change that makes the case worse — or better, which
-//!   should then move the case to `Within15` or a new band — fails.
+//! half-space), with its standard error over 4 fixed seeds.
+//! * The `shapes_*` tests validate: the half-space profile is good enough for each of their
+//!   cases, |q − 1| < 0.15 (+ 3 SE; the SE must be below 3 % of q, and is 0.5–2.7 % at these
+//!   samples, so the window is about ±17–23 %).
+//! * The `regression_guard_*` tests do not: they hold the cases that are still outside 15 %
+//!   (small and curved bodies lose or gain light; docs/shapes.md) to the value q0 that
+//!   `examples/shapes.rs` measured (8 seeds, 4–16× these samples), ±10 % (+ 3 SE), so that a
+//!   change that makes such a case worse, or better, fails and gets looked at. They are
+//!   regression guards of today's numbers, not evidence for any claim.
 //!
-//! The half-space ratio itself (the tabulated profile's own error) must be within 5 %.
+//! The half-space ratio itself (the tabulated profile's own error) must be within 5 %; the
+//! profile's own error on anisotropic half-spaces is `anisotropic_half_spaces_match_the_path_tracer`'s.
 //!
 //! The `shapes_corrected_*` cases turn the material's `shape_correction` on
 //! (docs/shapes.md, "The shape correction").
@@ -31,10 +33,11 @@ use crate::common::shapes::{
 /// Accepted tolerance of one case.
 #[derive(Debug, Clone, Copy)]
 enum Tolerance {
-    /// |q − 1| < 0.15.
+    /// |q − 1| < 0.15: validation.
     Within15,
-    /// Measured q0 (outside 15 %): q within ±10 % of it.
-    Band(f64),
+    /// A measured q0 (outside 15 %): q within ±10 % of it. A regression guard, not validation;
+    /// only the `regression_guard_*` tests use it.
+    RegressionGuard(f64),
 }
 
 const SEEDS: u64 = 4;
@@ -83,10 +86,11 @@ fn check_with(medium: Medium, cases: &[(Shape, Tolerance)], seed0: u64, correcte
     for (k, &(shape, tol)) in cases.iter().enumerate() {
         let (pt, b) = pair(shape, medium, seed0 + 100 * (k as u64 + 1), corrected);
         let (q, se) = ratio(ratio(b, pt), hs);
+        eprintln!("{} {}: q = {q:.3} ± {se:.3}", medium.label(), shape.label());
         assert!(se < 0.03 * q, "test too weak: {} {q} ± {se}", shape.label());
         let ok = match tol {
-            Tolerance::Within15 => (q - 1.0).abs() < 0.15 + 4.0 * se,
-            Tolerance::Band(q0) => (q - q0).abs() < 0.1 * q0 + 4.0 * se,
+            Tolerance::Within15 => (q - 1.0).abs() < 0.15 + 3.0 * se,
+            Tolerance::RegressionGuard(q0) => (q - q0).abs() < 0.1 * q0 + 3.0 * se,
         };
         if !ok {
             failures.push(format!("{}: q = {q:.3} ± {se:.3}, {tol:?}", shape.label()));
@@ -95,7 +99,7 @@ fn check_with(medium: Medium, cases: &[(Shape, Tolerance)], seed0: u64, correcte
     assert!(failures.is_empty(), "{}: {failures:#?}", medium.label());
 }
 
-use Tolerance::{Band, Within15};
+use Tolerance::{RegressionGuard, Within15};
 
 #[test]
 fn shapes_index_matched_albedo_0_9() {
@@ -106,7 +110,6 @@ fn shapes_index_matched_albedo_0_9() {
             (Shape::Slab(2.0), Within15),
             (Shape::Sphere(1.0), Within15),
             (Shape::Sphere(10.0), Within15),
-            (Shape::BoxCorner, Band(0.81)),
         ],
         10_000,
     );
@@ -131,13 +134,7 @@ fn shapes_index_matched_albedo_0_99() {
 fn shapes_refractive_albedo_0_9() {
     check(
         Medium::new(0.9, 1.3),
-        &[
-            (Shape::Slab(0.5), Within15),
-            (Shape::Slab(2.0), Within15),
-            (Shape::Sphere(1.0), Band(0.47)),
-            (Shape::Sphere(10.0), Band(0.81)),
-            (Shape::BoxCorner, Band(0.64)),
-        ],
+        &[(Shape::Slab(0.5), Within15), (Shape::Slab(2.0), Within15)],
         30_000,
     );
 }
@@ -146,14 +143,37 @@ fn shapes_refractive_albedo_0_9() {
 fn shapes_refractive_albedo_0_99() {
     check(
         Medium::new(0.99, 1.3),
-        &[
-            (Shape::Slab(0.5), Within15),
-            (Shape::Slab(2.0), Within15),
-            (Shape::Sphere(1.0), Band(0.53)),
-            (Shape::Sphere(10.0), Band(0.82)),
-            (Shape::BoxCorner, Band(0.81)),
-        ],
+        &[(Shape::Slab(0.5), Within15), (Shape::Slab(2.0), Within15)],
         40_000,
+    );
+}
+
+/// Regression guards, not validation (module docs): the cases of the four g = 0 columns that
+/// are still outside 15 % without the shape correction.
+#[test]
+fn regression_guard_shapes_outside_15_percent() {
+    check(
+        Medium::new(0.9, 1.0),
+        &[(Shape::BoxCorner, RegressionGuard(0.81))],
+        10_500,
+    );
+    check(
+        Medium::new(0.9, 1.3),
+        &[
+            (Shape::Sphere(1.0), RegressionGuard(0.47)),
+            (Shape::Sphere(10.0), RegressionGuard(0.81)),
+            (Shape::BoxCorner, RegressionGuard(0.64)),
+        ],
+        30_500,
+    );
+    check(
+        Medium::new(0.99, 1.3),
+        &[
+            (Shape::Sphere(1.0), RegressionGuard(0.53)),
+            (Shape::Sphere(10.0), RegressionGuard(0.82)),
+            (Shape::BoxCorner, RegressionGuard(0.81)),
+        ],
+        40_500,
     );
 }
 
@@ -281,4 +301,54 @@ fn angular_coupling_makes_an_oblique_half_space_exact() {
         (q_off - 1.0).abs() > 0.04 + 3.0 * se_off,
         "without the coupling the test cannot fail: BSSRDF/PT {q_off:.3} ± {se_off:.3}"
     );
+}
+
+/// What "multiple" means at g ≠ 0, and the totals the tabulated profile takes for it
+/// (issue 38; docs/tabulated-profile.md, "Anisotropic scattering"): homogeneous half-spaces
+/// under a uniform sky, seen along the normal, BSSRDF/PT within 3 % (+ 3 SE) for multiple
+/// scattering alone and for all orders. Under a uniform sky the angular coupling's
+/// normalisation makes the BSSRDF image the profile's total, so this checks the totals
+/// against the path tracer's Henyey–Greenstein transport. Before, the tabulated profile's
+/// multiple scattering was the similar isotropic medium's (0.72 of the path tracer's at g 0.6,
+/// η 1, ϖ 0.9), and its total the similar medium's (1.13× at g 0.6, η 1.3, ϖ 0.9).
+#[test]
+fn anisotropic_half_spaces_match_the_path_tracer() {
+    use bssrdf_core::Scattering;
+
+    use crate::common::shapes::measure_orders;
+    let bunny = std::path::Path::new("unused");
+    let mut failures = Vec::new();
+    // (g, η, ϖ, orders, path tracer's samples per pixel: more where its noise is larger)
+    for (k, (g, eta, albedo, scattering, spp_pt)) in [
+        (0.6, 1.0, 0.9, Scattering::Multiple, 1024),
+        (0.6, 1.3, 0.9, Scattering::All, 4096),
+        (0.3, 1.3, 0.99, Scattering::Multiple, 1024),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let medium = Medium {
+            g,
+            ..Medium::new(albedo, eta)
+        };
+        let scene = shape_scene_with(Shape::HalfSpace, medium, bunny, true, false);
+        let outside = outside_light(&scene, eta, 16);
+        let seeds = 110_000 + 10 * k as u64..110_004 + 10 * k as u64;
+        let through = |method, spp| {
+            let s = measure_orders(&scene, method, scattering, outside, spp, seeds.clone());
+            mean_se(s.iter().map(|s| s.through))
+        };
+        let pt = through(Method::PathTraced, spp_pt);
+        let b = through(bssrdf(ProfileModel::Tabulated), 256);
+        let (q, se) = ratio(b, pt);
+        eprintln!(
+            "{} {scattering}: BSSRDF/PT {q:.4} ± {se:.4}",
+            medium.label()
+        );
+        assert!(se < 0.01, "test too weak: {} ± {se}", medium.label());
+        if (q - 1.0).abs() >= 0.03 + 3.0 * se {
+            failures.push(format!("{} {scattering}: {q:.4} ± {se:.4}", medium.label()));
+        }
+    }
+    assert!(failures.is_empty(), "BSSRDF/PT: {failures:#?}");
 }

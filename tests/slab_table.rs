@@ -5,12 +5,14 @@
 //! (a separate simulation), and the profile built on it.
 
 use bssrdf_core::fresnel::dielectric;
-use bssrdf_core::tabulated::grid::{N_ALBEDO, N_BINS, albedo_of_row, annulus_area, centre};
+use bssrdf_core::tabulated::grid::{N_ALBEDO, N_BINS, albedo_of_row, centre};
 use bssrdf_core::tabulated::profile::table;
 use bssrdf_core::tabulated::slab::{
     SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, SlabFace, SlabTerm, slab_albedo_of_row, slab_table,
 };
 use bssrdf_core::tabulated::slab_file::{SlabData, SlabPlane, simulate_slab_plane};
+
+use crate::common::radial::radial_integral;
 
 const DATA: &[u8] = include_bytes!("../crates/bssrdf-core/data/slab-profile-v1.bin");
 
@@ -194,19 +196,56 @@ fn the_profile_is_the_table_at_its_planes_and_integrates_to_its_totals() {
                         (got - want).abs() <= 1e-9 * want.max(1e-300),
                         "{d} {eta} {row}"
                     );
-                    // The binned integral of the (pooled) density: the totals also count
-                    // exits beyond the last bin, which a slab never reaches.
-                    let binned: f64 = (0..N_BINS)
-                        .map(|j| p.density[SlabPlane::index(f, row, j)] as f64 * annulus_area(j))
-                        .sum();
+                    // The profile integrates to its total (which also counts exits beyond
+                    // the last bin, which a slab never reaches).
+                    let integral = radial_integral(|r| term.eval(face, r), 1.0);
                     assert!(
-                        (binned - want).abs() <= 1e-3 * want + 1e-9,
-                        "{d} {eta} {row} {f}: {binned} vs {want}"
+                        (integral - want).abs() <= 1e-3 * want + 1e-9,
+                        "{d} {eta} {row} {f}: ∫ {integral} vs {want}"
                     );
                 }
             }
         }
     }
+}
+
+/// Between the planes and rows the profile still integrates to its totals: the reflection
+/// within 0.1 %, the transmission within 0.2 % (it is interpolated in radius per thickness
+/// plane and row, then mixed; between η planes log–log interpolation of the mixed bins loses
+/// up to 0.12 % of the transmission of slabs thicker than about 5 mean free paths).
+#[test]
+fn the_profile_integrates_to_its_totals_between_the_planes() {
+    let mut worst = [0.0f64; 2];
+    for d in [0.1, 0.6, 1.5, 3.0, 7.0, 12.0, 20.0] {
+        for eta in [1.0, 1.22, 1.47] {
+            for alpha in [0.2, 0.5, 0.77, 0.95, 0.999] {
+                let term = SlabTerm::new(2.0, alpha, eta, d / 2.0);
+                for (f, face) in [SlabFace::Reflection, SlabFace::Transmission]
+                    .into_iter()
+                    .enumerate()
+                {
+                    // Transmissions below 10⁻³ of the entering light (thick slabs of low
+                    // albedo) are left out: their bins are sparse counts, and between η
+                    // planes clamping their mixture at 0 adds up to 0.7 % of almost nothing
+                    // (measured at 1–3·10⁻⁴; exact at the planes).
+                    let total = term.total(face);
+                    if total < 1e-3 {
+                        continue;
+                    }
+                    let q = radial_integral(|r| term.eval(face, r), 2.0) / total;
+                    worst[f] = worst[f].max((q - 1.0).abs());
+                    assert!(
+                        (q - 1.0).abs() < [1e-3, 2e-3][f],
+                        "d {d} η {eta} α {alpha} {face:?}: ∫ = {q:.5} × total"
+                    );
+                }
+            }
+        }
+    }
+    eprintln!(
+        "slab ∫ / total: reflection within {:.1e}, transmission within {:.1e}",
+        worst[0], worst[1]
+    );
 }
 
 #[test]

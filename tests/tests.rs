@@ -11,6 +11,7 @@ mod readme;
 mod reciprocity;
 mod shapes;
 mod slab_table;
+mod spectral;
 mod stability;
 mod stiff;
 mod tabulated;

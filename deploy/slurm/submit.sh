@@ -16,7 +16,7 @@ n=$1 scene=$2 out=$3
 shift 3
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$(dirname "${out}")"
-array=$(SCENE="${scene}" OUT="${out}" RENDER_ARGS="$*" \
+array=$(SCENE="${scene}" OUT="${out}" SHARDS="${n}" RENDER_ARGS="$*" \
     sbatch --parsable --array="0-$((n - 1))" --export=ALL "${here}/render-shard.sbatch")
 array=${array%%;*}
 merge=$(OUT="${out}" SHARDS="${n}" \

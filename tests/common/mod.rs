@@ -4,4 +4,5 @@
 pub mod chandrasekhar;
 pub mod half_space;
 pub mod harness;
+pub mod radial;
 pub mod shapes;

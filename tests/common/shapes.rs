@@ -269,11 +269,23 @@ pub fn measure(
     spp: u32,
     seeds: std::ops::Range<u64>,
 ) -> Vec<Sample> {
+    measure_orders(scene, method, Scattering::Multiple, outside, spp, seeds)
+}
+
+/// [`measure`] counting the scattering orders `scattering`.
+pub fn measure_orders(
+    scene: &Scene,
+    method: Method,
+    scattering: Scattering,
+    outside: f64,
+    spp: u32,
+    seeds: std::ops::Range<u64>,
+) -> Vec<Sample> {
     let integrator = PathIntegrator::new(
         scene,
         method,
         PathOptions {
-            scattering: Scattering::Multiple,
+            scattering,
             max_depth: 8,
         },
     )

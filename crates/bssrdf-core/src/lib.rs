@@ -57,6 +57,7 @@ pub mod directional_dipole;
 pub mod error;
 pub mod family;
 pub mod fresnel;
+pub mod half_space_albedo;
 pub mod hg;
 pub mod medium;
 pub mod model;

@@ -89,6 +89,12 @@ pub(crate) fn gl8() -> &'static Rule<8> {
     R.get_or_init(legendre::<8>)
 }
 
+/// 12-point Gauss–Legendre on [-1, 1].
+pub(crate) fn gl12() -> &'static Rule<12> {
+    static R: OnceLock<Rule<12>> = OnceLock::new();
+    R.get_or_init(legendre::<12>)
+}
+
 /// 32-point Gauss–Legendre on [-1, 1].
 pub(crate) fn gl32() -> &'static Rule<32> {
     static R: OnceLock<Rule<32>> = OnceLock::new();
@@ -115,6 +121,17 @@ pub(crate) fn integrate<const N: usize>(
         s += rule.w[k] * f(m + h * rule.x[k]);
     }
     s * h
+}
+
+/// The nodes and weights of a Gauss–Legendre `rule` mapped to `[a, b]`.
+pub(crate) fn integrate_nodes<const N: usize>(
+    rule: &Rule<N>,
+    a: f64,
+    b: f64,
+) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let h = 0.5 * (b - a);
+    let m = 0.5 * (a + b);
+    (0..N).map(move |k| (m + h * rule.x[k], h * rule.w[k]))
 }
 
 #[cfg(test)]

@@ -4,22 +4,24 @@
 //! object is around a pair of points.
 
 use crate::error::{ParamError, validate_sigmas};
-use crate::family::ProfileFamily;
+use crate::family::{Profile, ProfileFamily};
 use crate::model::ProfileModel;
 use crate::profile::RadialProfile;
-use crate::tabulated::{SlabFace, SlabTerm, TabulatedTerm};
+use crate::tabulated::{SlabFace, SlabTerm};
 
 /// Reflection R_slab(r) and transmission T_slab(ρ) of a homogeneous slab at one `(σa, σs)`,
 /// thickness and the family's `g` and `η` (1/length², exitance per unit area per unit power
 /// entering; conventions of [`RadialProfile`]). Multiple scattering from the slab table
-/// (similarity theory for g ≠ 0: reduced coefficients, thickness in reduced mean free paths);
-/// single scattering, when the family selects it, is the half-space table's single-scattering
-/// term on the entry face and absent from the opposite face (an approximation: a thin slab
-/// reflects less single scattering and transmits some). `Copy`.
+/// (similarity theory for g ≠ 0: reduced coefficients, thickness in reduced mean free paths,
+/// and both faces scaled as the half-space profile's multiple scattering is, so that the thick
+/// limit is that profile; see [`ProfileFamily::profile`]); single scattering, when the
+/// family selects it, is the half-space profile's single-scattering term on the entry face
+/// and absent from the opposite face (an approximation: a thin slab reflects less single
+/// scattering and transmits some). `Copy`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SlabProfile {
     multiple: Option<SlabTerm>,
-    single: Option<TabulatedTerm>,
+    single: Option<Profile>,
 }
 
 impl SlabProfile {
@@ -79,11 +81,11 @@ impl ProfileFamily {
         let multiple = reduced
             .albedo
             .filter(|_| self.scattering().includes_multiple())
-            .map(|alpha_p| SlabTerm::new(sigma_tp, alpha_p, self.eta(), thickness));
-        let single = reduced
-            .albedo
-            .filter(|_| self.scattering().includes_single())
-            .map(|alpha_p| TabulatedTerm::new(sigma_tp, alpha_p, self.eta(), true, false));
+            .map(|alpha_p| {
+                SlabTerm::new(sigma_tp, alpha_p, self.eta(), thickness)
+                    .with_scale(self.multiple_scale(sigma_a, sigma_s))
+            });
+        let single = self.tabulated_single(sigma_a, sigma_s);
         Ok(Some(SlabProfile { multiple, single }))
     }
 }

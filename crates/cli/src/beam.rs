@@ -3,6 +3,7 @@
 //! diffuse exitance map over [−E, E]² (grey EXR, row 0 at y = +E), a false-colour log-scale
 //! PNG with a colour bar, and a JSON sidecar.
 
+use crate::diag::say;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -272,7 +273,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     )
     .context("--resolution")?;
     set_collision_cap(args.max_collisions);
-    interrupt::install()?;
+    interrupt::install(interrupt::Mode::Finish)?;
     let method = args.region.apply(
         args.method.with_estimator_samples(
             args.estimator_samples
@@ -306,7 +307,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
             out.display()
         );
     }
-    eprintln!(
+    say!(
         "{}: {} samples in {:.2} s; wrote {}",
         map.method,
         map.samples,
@@ -316,7 +317,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     if let Some(x) = map.exits {
         let (a, se) = x.reflectance(Scattering::All);
         let rate = map.samples as f64 / map.seconds.max(1e-9) / rayon::current_num_threads() as f64;
-        eprintln!("  total reflectance {a:.5} ± {se:.5}; {rate:.3e} photons/s/core");
+        say!("  total reflectance {a:.5} ± {se:.5}; {rate:.3e} photons/s/core");
     }
     warn_counters(&map.counters);
     Ok(())

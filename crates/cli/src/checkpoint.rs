@@ -2,6 +2,7 @@
 //! a completed pass at least `SECONDS` after the last checkpoint, writes the image so far (the
 //! EXR, PNG and JSON set; the sidecar says `"checkpoint": true` and the samples taken).
 
+use crate::diag::say;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -56,7 +57,7 @@ impl RenderObserver<PathCounters> for Checkpoints<'_> {
         }
         if let Err(e) = (self.write)(partial) {
             self.progress
-                .suspend(|| eprintln!("warning: checkpoint not written: {e:#}"));
+                .suspend(|| say!("warning: checkpoint not written: {e:#}"));
         }
         *last = Instant::now();
     }

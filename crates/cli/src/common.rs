@@ -1,10 +1,12 @@
 //! Helpers shared by the subcommands: method names, output paths, summaries.
 
+use crate::diag::say;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use anyhow::Context;
 use tracer::integrator::PathCounters;
+use tracer::output::OutputLock;
 
 /// Parses a duration in seconds (> 0).
 pub fn parse_seconds(s: &str) -> Result<Duration, String> {
@@ -55,10 +57,35 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     experiments::run::check_render_outputs(path).context("invalid --out")
 }
 
+/// Claims the output set of a run (the EXR `exr` and the PNG and JSON beside it) before its
+/// work starts: every path writable ([`check_writable`]), none of them one of the run's
+/// `inputs` (a scene's texture, a shard being merged), the set locked against other runs
+/// ([`OutputLock`]), and the temporaries a killed run left for it removed. Keep the lock until
+/// the last file is written.
+pub fn claim_outputs(exr: &Path, inputs: &[&Path]) -> anyhow::Result<OutputLock> {
+    check_writable(exr)?;
+    let (png, json) = experiments::run::sidecar_paths(exr);
+    let set = [exr, png.as_path(), json.as_path()];
+    tracer::output::check_not_inputs(set, inputs).context("invalid --out")?;
+    let lock = OutputLock::acquire(exr).context("invalid --out")?;
+    if lock.is_held() {
+        for path in set {
+            tracer::output::remove_stale_temporaries(path);
+        }
+    } else {
+        say!(
+            "note: the file system of `{}` cannot lock it: another run writing the same files \
+             would not be detected",
+            exr.display()
+        );
+    }
+    Ok(lock)
+}
+
 /// One line per rare event that happened, so that no cap or fallback is silent.
 pub fn warn_counters(c: &PathCounters) {
     if c.capped > 0 {
-        eprintln!(
+        say!(
             "warning: {} of {} paths ({:.3} %) hit the collision cap of {} collisions and were cut \
              (their remaining light is lost); --max-collisions sets the cap",
             c.capped,
@@ -68,19 +95,19 @@ pub fn warn_counters(c: &PathCounters) {
         );
     }
     if c.leaks > 0 {
-        eprintln!(
+        say!(
             "warning: {} rays inside a closed object found no boundary (paths ended)",
             c.leaks
         );
     }
     if c.profile_failures > 0 {
-        eprintln!(
+        say!(
             "warning: {} profile evaluations rejected their estimated coefficients (those channels contributed 0)",
             c.profile_failures
         );
     }
     if c.estimator_fallbacks > 0 {
-        eprintln!(
+        say!(
             "note: {} estimates fell back to the endpoint average (every projection missed)",
             c.estimator_fallbacks
         );
@@ -94,19 +121,30 @@ pub fn warn_counters(c: &PathCounters) {
         } else {
             String::new()
         };
-        eprintln!(
+        say!(
             "averaging: of {} estimates, {} read a region in closed form, {} sampled a region on \
              the surface's local quadric (no rays), {} projected a region by rays{charts}",
-            c.estimates, c.prefiltered, c.lifted, c.prefilter_fallbacks
+            c.estimates,
+            c.prefiltered,
+            c.lifted,
+            c.prefilter_fallbacks
         );
     }
 }
 
-/// Refuses, before anything is allocated, a render of the scene's `width × height` that would
-/// not fit in memory; the error names the scene's keys and the figure.
-pub fn check_image_memory(width: u32, height: u32, scene: &Path) -> anyhow::Result<()> {
-    tracer::memory::check_render(width, height)
-        .with_context(|| format!("{}: render.width, render.height", scene.display()))
+/// Refuses, before anything is allocated, a render of the scene's `width × height` by
+/// `method` that would not fit in the memory this process may still allocate (its films, and
+/// the summed-area tables its preparation builds); the error names the scene's keys and the
+/// figure.
+pub fn check_image_memory(
+    scene: &tracer::scene::Scene,
+    method: tracer::integrator::Method,
+    file: &Path,
+) -> anyhow::Result<()> {
+    let (width, height) = scene.camera().resolution();
+    let tables = tracer::memory::area_table_bytes(scene, method);
+    tracer::memory::check_render(width, height, tables)
+        .with_context(|| format!("{}: render.width, render.height", file.display()))
 }
 
 /// Triangle count above which a render says how many triangles its shapes became.
@@ -117,7 +155,7 @@ const MANY_TRIANGLES: usize = 1_000_000;
 pub fn note_triangles(scene: &tracer::scene::Scene) {
     let n = scene.geometry().triangle_count();
     if n >= MANY_TRIANGLES {
-        eprintln!(
+        say!(
             "note: the scene's {} objects are {:.1} million triangles",
             scene.geometry().object_count(),
             n as f64 / 1e6

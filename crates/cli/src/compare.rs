@@ -1,6 +1,7 @@
 //! `het-bssrdf compare`: error metrics of a test image against a reference (relative L2, RMSE,
 //! mean |log10(T/R)|), and a false-colour image of log10(T/R).
 
+use crate::diag::say;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -144,6 +145,6 @@ fn finish(args: &Args, test: &Film, reference: &Film, m: Metrics) -> anyhow::Res
         println!("mean_abs_log10 {:.6e}", m.mean_abs_log10);
         println!("values {} (log metric over {})", m.values, m.log_values);
     }
-    eprintln!("wrote {}", diff.display());
+    say!("wrote {}", diff.display());
     Ok(())
 }

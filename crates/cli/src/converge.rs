@@ -3,6 +3,7 @@
 //! `convergence.csv`, `convergence.png` (+ `.svg`), `summary.json` with the speed-up of each
 //! BSSRDF method over path tracing, and the largest run of every method as an image.
 
+use crate::diag::say;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -40,7 +41,12 @@ const BEAM_ONLY: &[&str] = &[
 ];
 
 /// Flags of scene studies: they do not apply to the beam experiment.
-const SCENE_ONLY: &[&str] = &["reference_spp", "max_spp", "max_depth"];
+const SCENE_ONLY: &[&str] = &[
+    "reference_spp",
+    "max_spp",
+    "max_depth",
+    "allow_outside_assets",
+];
 
 /// Arguments of `het-bssrdf converge`.
 #[derive(Debug, clap::Args)]
@@ -100,6 +106,10 @@ pub struct Args {
     /// Seed of the runs (the reference uses a different one).
     #[arg(long, default_value_t = 1, allow_hyphen_values = true)]
     seed: u64,
+    /// Scene: let glTF files read buffers and images outside their own folder (refused by
+    /// default: a downloaded glTF file is untrusted input).
+    #[arg(long)]
+    allow_outside_assets: bool,
     /// Output directory (created if missing).
     #[arg(short, long)]
     out: Option<PathBuf>,
@@ -145,9 +155,11 @@ fn print_summary(summary: &[MethodSummary]) {
             }
             _ => String::new(),
         };
-        eprintln!(
+        say!(
             "{:>24}: converged rel. L2 {:.4} after {:.3} s; {pt}{aware}",
-            s.method, s.converged_error, s.time_to_converge
+            s.method,
+            s.converged_error,
+            s.time_to_converge
         );
     }
 }
@@ -213,7 +225,7 @@ fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
     if usable {
         dir
     } else {
-        eprintln!(
+        say!(
             "warning: the reference cache `{}` cannot be written; caching in `{}` instead",
             dir.display(),
             out.display()
@@ -227,7 +239,10 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .scene
         .as_ref()
         .expect("clap requires a scene without --beam");
-    let scene = Scene::load(file)?;
+    let scene = Scene::load_with(
+        file,
+        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+    )?;
     let mut base = RenderJob::from_scene(&scene, Method::PathTraced);
     if given.has("scattering") {
         base.scattering = args.setup.scattering;
@@ -245,7 +260,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
                 .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
             let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
             if !cache.is_file() {
-                eprintln!(
+                say!(
                     "rendering the path-traced reference at {spp} spp into {}",
                     cache.display()
                 );
@@ -326,13 +341,13 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     print_summary(&summary);
     for (name, outcome) in &finals {
         if outcome.prepare_seconds >= 0.5 {
-            eprintln!(
+            say!(
                 "note: preparing `{name}` took {:.1} s, once, not counted in its times above",
                 outcome.prepare_seconds
             );
         }
     }
-    eprintln!(
+    say!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()
     );
@@ -358,7 +373,7 @@ impl RunLog {
         self.runs.push(run.clone());
         let text = experiments::converge::csv(&self.runs);
         if let Err(e) = tracer::output::write_atomic(&self.path, text.as_bytes()) {
-            eprintln!("warning: {e}: the runs so far are not saved");
+            say!("warning: {e}: the runs so far are not saved");
         }
     }
 }
@@ -460,7 +475,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         )?;
     }
     print_summary(&summary);
-    eprintln!(
+    say!(
         "wrote {}/convergence.csv, convergence.png, summary.json",
         out.display()
     );

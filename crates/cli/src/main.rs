@@ -3,7 +3,8 @@
 //!
 //! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
 //! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap);
-//! 130 or 143 when `render` or `beam` was interrupted by SIGINT or SIGTERM (see `interrupt`).
+//! 128 + the signal (130, 143, 129) when `render`, `beam` or `merge` was interrupted by SIGINT,
+//! SIGTERM or SIGHUP (see `interrupt`).
 //!
 //! Numeric flags accept values starting with `-`, so that `--photons -5` is reported as an
 //! invalid value of `--photons` rather than as an unknown argument `-5`.
@@ -14,6 +15,7 @@ mod choices;
 mod common;
 mod compare;
 mod converge;
+mod diag;
 mod flags;
 mod interrupt;
 mod merge;
@@ -23,6 +25,8 @@ mod reproduce;
 mod tabulate;
 
 use std::process::ExitCode;
+
+use diag::say;
 
 use anyhow::Context;
 use clap::{CommandFactory, FromArgMatches, Subcommand};
@@ -91,6 +95,7 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
 }
 
 fn main() -> ExitCode {
+    interrupt::ignore_file_size_signal();
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let given = flags::Given::from_matches(matches.subcommand().map(|(_, m)| m));
@@ -99,7 +104,7 @@ fn main() -> ExitCode {
         Err(err) => {
             // The libraries' errors do not repeat their sources in their messages (they return
             // them from `source()`), so the cause chain prints each cause once.
-            eprintln!("error: {err:#}");
+            say!("error: {err:#}");
             ExitCode::from(interrupt::exit_status().unwrap_or(1))
         }
     }

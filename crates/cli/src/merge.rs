@@ -2,9 +2,11 @@
 //! image (EXR, PNG preview and JSON sidecar); see `experiments::shard` for the partition, the
 //! checks and what a merge guarantees.
 
-use std::path::PathBuf;
+use crate::diag::say;
+use std::path::{Path, PathBuf};
 
-use crate::common::{check_writable, parse_exr_out};
+use crate::common::{claim_outputs, parse_exr_out};
+use crate::interrupt;
 
 /// Arguments of `het-bssrdf merge`.
 #[derive(Debug, clap::Args)]
@@ -22,7 +24,19 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    check_writable(&args.out)?;
+    let sidecars: Vec<PathBuf> = args
+        .shards
+        .iter()
+        .map(|p| experiments::run::sidecar_paths(p).1)
+        .collect();
+    let inputs: Vec<&Path> = args
+        .shards
+        .iter()
+        .chain(&sidecars)
+        .map(PathBuf::as_path)
+        .collect();
+    let _lock = claim_outputs(&args.out, &inputs)?;
+    interrupt::install(interrupt::Mode::Quit)?;
     let summary = experiments::shard::merge(&args.shards, &args.out, args.exposure)?;
     let (png, json) = &summary.sidecars;
     let spp = if summary.spp.0 == summary.spp.1 {
@@ -33,7 +47,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             summary.spp.0, summary.spp.1
         )
     };
-    eprintln!(
+    say!(
         "merged {} shards ({spp}{}); wrote {}, {}, {}",
         summary.count,
         if summary.time_budget {

@@ -1,6 +1,7 @@
 //! `het-bssrdf render`: render a scene file with one method (the path-traced reference or a
 //! BSSRDF estimator) to EXR, with a PNG preview and a JSON sidecar beside it.
 
+use crate::diag::say;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -17,8 +18,8 @@ use tracer::scene::Scene;
 
 use crate::checkpoint::Checkpoints;
 use crate::common::{
-    check_image_memory, check_writable, note_triangles, parse_exr_out, parse_positive,
-    parse_seconds, set_collision_cap, warn_counters,
+    check_image_memory, check_writable, claim_outputs, note_triangles, parse_exr_out,
+    parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
 use crate::flags::{RegionFlags, check_method_flags};
 use crate::interrupt;
@@ -104,6 +105,11 @@ pub struct Args {
     /// each pass that ends at least this many seconds after the previous checkpoint.
     #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     checkpoint: Option<Duration>,
+    /// Let glTF files read buffers and images outside their own folder (refused by default:
+    /// a downloaded glTF file is untrusted input; a shape's `allow_outside_assets = true`
+    /// allows it for that shape).
+    #[arg(long)]
+    allow_outside_assets: bool,
     /// Trace paths from the `camera` (default) or from the `light`s. A light-traced render
     /// traces spp × width × height light paths; it takes no --time, --tile or --checkpoint.
     #[arg(long, value_enum, default_value_t = Trace::Camera)]
@@ -112,7 +118,10 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = Scene::load(&args.scene)?;
+    let scene = Scene::load_with(
+        &args.scene,
+        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+    )?;
     let scene = match args.invert {
         Some(at) => scene.with_invert(at),
         None => scene,
@@ -181,9 +190,31 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}{tile}.exr", method.name())));
-    check_writable(&out)?;
+    let mut inputs: Vec<&std::path::Path> = vec![args.scene.as_path()];
+    inputs.extend(scene.input_files().iter().map(PathBuf::as_path));
+    let _lock = claim_outputs(&out, &inputs)?;
+    // A finished render already at `out` is replaced only by another finished one: the images
+    // of this run's passes so far (checkpoints, an interrupted render) go beside it.
+    let partial_out = holds_finished_render(&out).then(|| partial_path(&out));
+    if let Some(p) = &partial_out {
+        check_writable(p)?;
+        let (png, json) = sidecar_paths(p);
+        for path in [p.as_path(), &png, &json] {
+            tracer::output::remove_stale_temporaries(path);
+        }
+        if args.checkpoint.is_some() {
+            say!(
+                "note: `{}` holds a finished render, kept until this one finishes; checkpoints go \
+                 to `{}`",
+                out.display(),
+                p.display()
+            );
+        }
+    }
+    let partial_to = partial_out.as_deref().unwrap_or(&out);
+    let wrote_partial = std::sync::atomic::AtomicBool::new(false);
     let (width, height) = scene.camera().resolution();
-    check_image_memory(width, height, &args.scene)?;
+    check_image_memory(&scene, method, &args.scene)?;
     note_triangles(&scene);
     if args.trace == Trace::Light {
         if args.time.is_some() || args.tile.is_some() || args.checkpoint.is_some() {
@@ -192,7 +223,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return run_light_traced(&scene, &job, &out, args.exposure);
     }
     set_collision_cap(args.max_collisions);
-    interrupt::install()?;
+    interrupt::install(interrupt::Mode::Finish)?;
     let rays_before = scene.geometry().rays_traced();
     let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {
         let mut film = Film::new(partial.width, partial.height);
@@ -205,7 +236,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             *partial.counters,
             method.name().to_string(),
         );
-        write_render(&outcome, &scene, &job, &out, args.exposure)?;
+        write_render(&outcome, &scene, &job, partial_to, args.exposure)?;
+        wrote_partial.store(true, std::sync::atomic::Ordering::Relaxed);
         Ok(())
     };
     let observer = Checkpoints::new(
@@ -221,23 +253,40 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let outcome = render_scene_observed(&scene, &job, &observer);
     observer.finish();
     let outcome = outcome.with_context(|| format!("cannot render `{}`", args.scene.display()))?;
-    let (png, json) = sidecar_paths(&out);
     if outcome.interrupted {
         let signal = interrupt::received().map_or("interrupt", interrupt::name);
         if outcome.spp == 0 {
             bail!("{signal} before the first pass completed; nothing written");
         }
-        write_render(&outcome, &scene, &job, &out, args.exposure)?;
+        write_render(&outcome, &scene, &job, partial_to, args.exposure)?;
+        let (png, json) = sidecar_paths(partial_to);
+        let kept = match &partial_out {
+            Some(_) => format!(
+                "; the finished render at `{}` was kept, not replaced",
+                out.display()
+            ),
+            None => String::new(),
+        };
         bail!(
-            "{signal}: wrote the {} spp completed ({}, {}, {}; the sidecar says \"interrupted\": true)",
+            "{signal}: wrote the {} spp completed ({}, {}, {}; the sidecar says \"interrupted\": true){kept}",
             outcome.spp,
-            out.display(),
+            partial_to.display(),
             png.display(),
             json.display()
         );
     }
     write_render(&outcome, &scene, &job, &out, args.exposure)?;
-    eprintln!(
+    if let Some(p) = &partial_out
+        && wrote_partial.load(std::sync::atomic::Ordering::Relaxed)
+    {
+        // This run's checkpoints, superseded by its finished render.
+        let (png, json) = sidecar_paths(p);
+        for path in [p.as_path(), &png, &json] {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+    let (png, json) = sidecar_paths(&out);
+    say!(
         "{}: {} spp in {:.2} s ({:.2} Mrays/s); wrote {}, {}, {}",
         outcome.method,
         outcome.spp,
@@ -260,7 +309,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .collect();
     let px = rendered.len().max(1) as f64;
     let mean: [f64; 3] = std::array::from_fn(|c| rendered.iter().map(|p| p[c]).sum::<f64>() / px);
-    eprintln!(
+    say!(
         "mean pixel value (R, G, B){}: {:.6}, {:.6}, {:.6}",
         if shard.is_whole() {
             ""
@@ -272,13 +321,38 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mean[2]
     );
     for w in &outcome.warnings {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     for n in &outcome.notes {
-        eprintln!("note: {n}");
+        say!("note: {n}");
     }
     warn_counters(&outcome.counters);
     Ok(())
+}
+
+/// True when `out` holds a finished render: its EXR exists and its sidecar says neither
+/// `interrupted` nor `checkpoint`.
+fn holds_finished_render(out: &std::path::Path) -> bool {
+    let (_, json) = sidecar_paths(out);
+    let Ok(text) = std::fs::read_to_string(json) else {
+        return false;
+    };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
+    out.is_file()
+        && v["interrupted"] == serde_json::Value::Bool(false)
+        && v["checkpoint"] == serde_json::Value::Bool(false)
+}
+
+/// Where the partial images of a render to `out` go when `out` holds a finished one:
+/// `<stem>.partial.exr` beside it (with its PNG and JSON).
+fn partial_path(out: &std::path::Path) -> PathBuf {
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}.partial.exr"))
 }
 
 /// `render --trace light`: the light tracer ([`tracer::integrator::LightTracer`]) with
@@ -320,7 +394,7 @@ fn run_light_traced(
     write_render(&outcome, scene, job, out, exposure)?;
     let (png, json) = sidecar_paths(out);
     let mean = outcome.film.mean();
-    eprintln!(
+    say!(
         "{}: {paths} light paths in {:.2} s ({:.2} Mrays/s); wrote {}, {}, {}",
         outcome.method,
         outcome.seconds,
@@ -329,12 +403,14 @@ fn run_light_traced(
         png.display(),
         json.display()
     );
-    eprintln!(
+    say!(
         "mean pixel value (R, G, B): {:.6}, {:.6}, {:.6}",
-        mean[0], mean[1], mean[2]
+        mean[0],
+        mean[1],
+        mean[2]
     );
     for w in &outcome.warnings {
-        eprintln!("warning: {w}");
+        say!("warning: {w}");
     }
     warn_counters(&outcome.counters);
     Ok(())

@@ -1,5 +1,6 @@
 //! `het-bssrdf reproduce`: the paper's experiments end to end, summarised in `report.md`.
 
+use crate::diag::say;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -55,7 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     })?;
     experiments::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
         .context("invalid --out")?;
-    eprintln!(
+    say!(
         "reproduce ({} scale): expected time {}; writing into {}",
         scale.name,
         scale.expected,
@@ -69,12 +70,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if !bar.is_hidden() {
             return;
         }
-        eprintln!("[{:>5.0} s] {msg}", start.elapsed().as_secs_f64());
+        say!("[{:>5.0} s] {msg}", start.elapsed().as_secs_f64());
     };
     let report = reproduce(&args.out, &scale, args.seed, args.resume, &mut step)
         .with_context(|| format!("reproduce into `{}` failed", args.out.display()))?;
     bar.finish_and_clear();
-    eprintln!(
+    say!(
         "done in {:.0} s; report: {}",
         start.elapsed().as_secs_f64(),
         report.display()

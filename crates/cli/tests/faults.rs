@@ -5,99 +5,12 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-use common::{MINIMAL, Scratch, edit, gradient, listing, with_texture};
-
-/// A running `het-bssrdf`, killed if the test fails before waiting for it.
-struct Running(Option<Child>);
-
-impl Running {
-    fn id(&self) -> u32 {
-        self.0.as_ref().expect("running").id()
-    }
-    fn wait_with_output(mut self) -> std::io::Result<std::process::Output> {
-        self.0.take().expect("running").wait_with_output()
-    }
-}
-
-impl Drop for Running {
-    fn drop(&mut self) {
-        if let Some(c) = &mut self.0 {
-            let _ = c.kill();
-            let _ = c.wait();
-        }
-    }
-}
-
-/// Starts `het-bssrdf args…` in `dir` without waiting.
-fn spawn(dir: &Path, args: &[&str]) -> Running {
-    Running(Some(
-        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
-            .args(args)
-            .current_dir(dir)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("spawn het-bssrdf"),
-    ))
-}
-
-/// Sends `signal` (`INT`, `TERM`) to the child.
-fn signal(child: &Running, signal: &str) {
-    let ok = Command::new("kill")
-        .args([format!("-{signal}"), child.id().to_string()])
-        .status()
-        .expect("run kill")
-        .success();
-    assert!(ok, "kill -{signal} failed");
-}
-
-/// Waits for `cond` for at most 60 s.
-#[track_caller]
-fn wait_for(what: &str, cond: impl Fn() -> bool) {
-    let start = Instant::now();
-    while !cond() {
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "timed out waiting for {what}"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-/// Runs `het-bssrdf args…` in `dir`, sends it `sig` 1.5 s after it started, and returns its
-/// exit code and stderr.
-fn interrupted_after_a_while(dir: &Path, args: &[&str], sig: &str) -> (Option<i32>, String) {
-    let child = spawn(dir, args);
-    std::thread::sleep(Duration::from_millis(1500));
-    signal(&child, sig);
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// The JSON sidecar at `path`.
-fn sidecar(path: &Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(path).expect("read sidecar")).expect("sidecar JSON")
-}
-
-/// No temporary (`.….tmp`) or probe file left in `dir`.
-#[track_caller]
-fn assert_no_temporaries(dir: &Path) {
-    let files = listing(dir);
-    assert!(
-        !files
-            .iter()
-            .any(|f| f.ends_with(".tmp") || f.contains(".het-bssrdf-probe")),
-        "temporary files left: {files:?}"
-    );
-}
+use common::{
+    MINIMAL, Scratch, assert_no_temporaries, edit, gradient, interrupted_after_a_while, sidecar,
+    signal, spawn, wait_for, with_texture,
+};
 
 /// A render whose budget (10⁸ spp of 8 × 8 pixels) cannot finish during the test.
 const ENDLESS: &[&str] = &[

@@ -7,92 +7,27 @@
 mod common;
 
 use std::path::Path;
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
 
-use common::{CUBE_OBJ, MINIMAL, Scratch, edit, with_obj};
-
-/// A closed tetrahedron: 4 `f32` positions (48 bytes) then 12 `u16` indices (24 bytes).
-fn tetra_bin() -> Vec<u8> {
-    let mut b = Vec::new();
-    for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]] {
-        for c in p {
-            b.extend_from_slice(&c.to_le_bytes());
-        }
-    }
-    for i in [0u16, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3] {
-        b.extend_from_slice(&i.to_le_bytes());
-    }
-    b
-}
-
-/// The glTF document with the given nodes, index count, buffer length and buffer URI.
-fn gltf(nodes: &str, index_count: u32, byte_length: u32, uri: &str) -> String {
-    format!(
-        r#"{{
-  "asset": {{"version": "2.0"}},
-  "scene": 0,
-  "scenes": [{{"nodes": [0]}}],
-  "nodes": {nodes},
-  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
-  "buffers": [{{"uri": "{uri}", "byteLength": {byte_length}}}],
-  "bufferViews": [
-    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
-    {{"buffer": 0, "byteOffset": 48, "byteLength": 24}}
-  ],
-  "accessors": [
-    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-      "min": [0, 0, 0], "max": [1, 1, 1]}},
-    {{"bufferView": 1, "componentType": 5123, "count": {index_count}, "type": "SCALAR"}}
-  ]
-}}"#
-    )
-}
-
-const NODES: &str = r#"[{"mesh": 0}]"#;
+use common::{CUBE_OBJ, NODES, Scratch, edit, gltf, tetra_bin, with_gltf, with_obj};
 
 /// A scratch directory with `tetra.bin`, `m.gltf` (the given document) and `s.toml`.
 fn setup(doc: &str) -> Scratch {
     let s = Scratch::new();
     s.write("tetra.bin", tetra_bin());
     s.write("m.gltf", doc);
-    s.write(
-        "s.toml",
-        edit(
-            MINIMAL,
-            "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
-            "type = \"gltf\"\nname = \"tet\"\nmaterial = \"m\"\npath = \"m.gltf\"",
-        ),
-    );
+    s.write("s.toml", with_gltf("m.gltf"));
     s
 }
 
 /// Runs a render of `s.toml` with a time limit (a FIFO buffer used to hang the loader).
 fn render(dir: &Path) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
-        .args(["render", "s.toml", "--method", "pt", "--out", "out.exr"])
-        .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    loop {
-        if child.try_wait().unwrap().is_some() {
-            let out = child.wait_with_output().unwrap();
-            return (
-                out.status.code(),
-                String::from_utf8_lossy(&out.stderr).into_owned(),
-            );
-        }
-        if start.elapsed() > Duration::from_secs(30) {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("het-bssrdf render hung for 30 s");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let r = common::run_within(
+        dir,
+        &["render", "s.toml", "--method", "pt", "--out", "out.exr"],
+        30,
+    );
+    (r.code, r.stderr)
 }
 
 #[track_caller]

@@ -87,3 +87,32 @@ fn an_unwritable_cache_falls_back_to_the_output_directory() {
     assert!(r.stderr.contains("cannot be written"), "{}", r.stderr);
     assert_eq!(cached(&s, "out").len(), 1, "{:?}", listing(s.path()));
 }
+
+/// Issue 39, case 3: a glTF model's external buffer edited between two `converge` runs was not
+/// in the cache key, and the stale reference was reused.
+#[test]
+fn the_cache_key_covers_a_gltf_models_buffers() {
+    let s = Scratch::new();
+    s.write("scenes/tetra.bin", common::tetra_bin());
+    s.write(
+        "scenes/m.gltf",
+        common::gltf(common::NODES, 12, 72, "tetra.bin"),
+    );
+    s.write("scenes/t.toml", common::with_gltf("m.gltf"));
+    let first = converge(&s, "scenes/t.toml", "o1", "cache");
+    assert_eq!(first.code, Some(0), "{}", first.stderr);
+    assert_eq!(cached(&s, "cache").len(), 1);
+    let mut bin = common::tetra_bin();
+    bin[44..48].copy_from_slice(&2f32.to_le_bytes());
+    s.write("scenes/tetra.bin", bin);
+    let second = converge(&s, "scenes/t.toml", "o2", "cache");
+    assert_eq!(second.code, Some(0), "{}", second.stderr);
+    assert!(
+        second
+            .stderr
+            .contains("rendering the path-traced reference"),
+        "the reference of the old buffer was reused:\n{}",
+        second.stderr
+    );
+    assert_eq!(cached(&s, "cache").len(), 2);
+}

@@ -344,3 +344,180 @@ fn a_time_budgeted_merge_holds_each_shards_sample_count() {
     let listed: Vec<String> = spps.iter().map(u64::to_string).collect();
     assert_eq!(per_shard.1, listed.join(","));
 }
+
+/// Renders the 3 shards `s-{0,1,2}.exr` of the issue's reproduction (`--method sone --spp 4
+/// --seed 3`), then `x.exr`: shard 1 again with `extra` flags (replacing those of the same
+/// name).
+fn shards_and_a_stranger(s: &Scratch, extra: &[&str]) {
+    let flags = ["--method", "sone", "--spp", "4", "--seed", "3"];
+    std::thread::scope(|scope| {
+        for i in 0..3 {
+            scope.spawn(move || {
+                let (tile, out) = (format!("{i}/3"), format!("s-{i}.exr"));
+                let mut a = vec!["render", "s.toml", "--tile", &tile, "-o", &out];
+                a.extend_from_slice(&flags);
+                ok(s, &a);
+            });
+        }
+    });
+    let mut a = vec!["render", "s.toml", "--tile", "1/3", "-o", "x.exr"];
+    for pair in flags.chunks(2) {
+        if !extra.contains(&pair[0]) {
+            a.extend_from_slice(pair);
+        }
+    }
+    a.extend_from_slice(extra);
+    ok(s, &a);
+}
+
+/// Issue 39, case 1: a shard EXR of another render beside a good sidecar (here: another spp,
+/// seed, method or exposure) was merged, and the merged header claimed the sidecar's values.
+/// Each EXR's own header is now checked against its sidecar.
+#[test]
+fn a_shard_exr_from_another_render_beside_a_good_sidecar_is_refused() {
+    let s = Scratch::new();
+    s.write("s.toml", scene());
+    let good = bytes(&s, "s.toml");
+    for (extra, needles) in [
+        (
+            &["--spp", "8"][..],
+            &["samplesPerPixel is 8", "spp is 4"][..],
+        ),
+        (&["--seed", "4"], &["seed is 4", "seed is 3"]),
+        (&["--method", "kernel"], &["method is kernel"]),
+        (
+            &["--exposure", "2"],
+            &["exposure is 2", "preview_exposure is 0"],
+        ),
+    ] {
+        shards_and_a_stranger(&s, extra);
+        std::fs::copy(s.join("x.exr"), s.join("s-1.exr")).unwrap();
+        let mut n = vec!["s-1.exr", "does not match its sidecar", "s-1.json"];
+        n.extend_from_slice(needles);
+        s.assert_rejected(
+            &["merge", "s-0.exr", "s-1.exr", "s-2.exr", "-o", "m.exr"],
+            1,
+            &n,
+        );
+        assert_eq!(bytes(&s, "s.toml"), good);
+    }
+}
+
+/// Issue 39, case 2: shards rendered with different `--exposure` were merged (the merged PNG
+/// took the first shard's); the merge's own `--exposure` makes the choice explicit.
+#[test]
+fn shards_with_different_exposures_need_an_explicit_one() {
+    let s = Scratch::new();
+    s.write("s.toml", scene());
+    shards_and_a_stranger(&s, &["--exposure", "2"]);
+    for ext in ["exr", "png", "json"] {
+        std::fs::copy(s.join(&format!("x.{ext}")), s.join(&format!("s-1.{ext}"))).unwrap();
+    }
+    s.assert_rejected(
+        &["merge", "s-0.exr", "s-1.exr", "s-2.exr", "-o", "m.exr"],
+        1,
+        &[
+            "s-1.exr",
+            "s-0.exr",
+            "preview exposure",
+            "2.0 vs 0.0",
+            "--exposure",
+        ],
+    );
+    ok(
+        &s,
+        &[
+            "merge",
+            "s-0.exr",
+            "s-1.exr",
+            "s-2.exr",
+            "-o",
+            "m.exr",
+            "--exposure",
+            "1",
+        ],
+    );
+    assert_eq!(json(&s, "m.json")["preview_exposure"], 1.0);
+}
+
+/// Issue 39, case 2: one flipped bit in a shard's pixel blocks decoded to about 4,000 pixels
+/// × 65,536 and the merge succeeded. Every flip of a bit that still decodes to other pixels
+/// is now refused by the pixel checksum (and one that does not decode, by the decoder).
+#[test]
+fn a_flipped_bit_in_a_shards_pixels_is_refused() {
+    let s = Scratch::new();
+    s.write("s.toml", scene());
+    shards_and_a_stranger(&s, &[]);
+    let original = bytes(&s, "s-1.exr");
+    let pixels = tracer::output::read_exr(&s.join("s-1.exr")).unwrap().pixels;
+    // Flips that still decode, to different pixels: the case the decoder cannot see.
+    let mut silent = 0;
+    for at in (original.len() / 2..original.len()).rev().step_by(7) {
+        let mut flipped = original.clone();
+        flipped[at] ^= 0x10;
+        std::fs::write(s.join("s-1.exr"), &flipped).unwrap();
+        let decodes_to_other_pixels =
+            tracer::output::read_exr(&s.join("s-1.exr")).is_ok_and(|f| f.pixels != pixels);
+        let r = s.run(&["merge", "s-0.exr", "s-1.exr", "s-2.exr", "-o", "m.exr"]);
+        assert_eq!(
+            r.code,
+            Some(1),
+            "bit flip at byte {at} merged:\n{}",
+            r.stderr
+        );
+        assert!(!s.join("m.exr").exists());
+        if decodes_to_other_pixels {
+            assert!(r.stderr.contains("checksum"), "byte {at}: {}", r.stderr);
+            silent += 1;
+            if silent == 5 {
+                break;
+            }
+        }
+    }
+    assert!(
+        silent > 0,
+        "no bit flip decoded to other pixels: the test tests nothing"
+    );
+    std::fs::write(s.join("s-1.exr"), &original).unwrap();
+    ok(
+        &s,
+        &["merge", "s-0.exr", "s-1.exr", "s-2.exr", "-o", "m.exr"],
+    );
+}
+
+/// Issue 39, case 3: a glTF model's external buffer edited between two tiles was not in the
+/// scene hash, so the shards merged into a wrong image (relative L2 0.52 against the right
+/// one). The buffer is now hashed with the scene.
+#[test]
+fn a_gltf_buffer_edited_between_tiles_is_refused() {
+    let s = Scratch::new();
+    s.write("tetra.bin", common::tetra_bin());
+    s.write("m.gltf", common::gltf(common::NODES, 12, 72, "tetra.bin"));
+    s.write("t.toml", common::with_gltf("m.gltf"));
+    let tile = |i: &str| {
+        ok(
+            &s,
+            &[
+                "render",
+                "t.toml",
+                "--method",
+                "pt",
+                "--tile",
+                &format!("{i}/2"),
+                "-o",
+                &format!("t-{i}.exr"),
+            ],
+        )
+    };
+    tile("0");
+    // The same file name and length, another vertex: the tetrahedron's apex moves.
+    let mut bin = common::tetra_bin();
+    bin[44..48].copy_from_slice(&2f32.to_le_bytes());
+    s.write("tetra.bin", bin);
+    tile("1");
+    s.assert_rejected(
+        &["merge", "t-0.exr", "t-1.exr", "-o", "t.exr"],
+        1,
+        &["t-1.exr", "t-0.exr", "scene (hash of its files)"],
+    );
+}

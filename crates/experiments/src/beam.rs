@@ -13,7 +13,9 @@
 //! * `pt` ([`trace_photons`]): light tracing with the volumetric random walk of the path
 //!   tracer ([`tracer::integrator::walk`]). Every photon carries weight 1 (analog tracking,
 //!   η = 1), so a pixel's value is an integer count of exits / (photons · Δ²): sums of
-//!   integers are exact, so the map is identical whatever the thread count.
+//!   integers are exact, so the map is identical whatever the thread count. The medium is
+//!   grey (the texture and σs are the same in every channel), so the walk of channel 0 is the
+//!   walk of all three: no spectral MIS is needed (`docs/physics.md#spectral-mis`).
 //! * BSSRDF methods ([`bssrdf_map`]): for `k × k` stratified jittered points x_o per pixel,
 //!   estimate the homogeneous coefficients for (x_i, x_o) and evaluate the profile R(r) at
 //!   r = |x_o − x_i|.

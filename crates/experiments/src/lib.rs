@@ -16,3 +16,4 @@ pub mod run;
 pub mod scenes;
 pub mod shard;
 pub mod study;
+pub mod time_to_error;

@@ -122,6 +122,19 @@ impl RenderOutcome {
     }
 }
 
+impl RenderOutcome {
+    /// `final`, `checkpoint` or `interrupted`, as a shard's EXR header records it.
+    pub fn state(&self) -> &'static str {
+        if self.interrupted {
+            "interrupted"
+        } else if self.checkpoint {
+            "checkpoint"
+        } else {
+            "final"
+        }
+    }
+}
+
 /// Renders `scene` with `job`.
 pub fn render_scene(scene: &Scene, job: &RenderJob) -> Result<RenderOutcome, RenderError> {
     Ok(render_prepared_with_bar(scene, &prepare(scene, job)?, job))
@@ -331,8 +344,18 @@ pub fn write_render(
     let film = outcome.film.as_stored();
     let mut attributes =
         render_attributes(outcome.spp, job.seed, &outcome.method, profile.as_deref());
+    let time_budget_seconds = match job.budget {
+        Budget::Time(t) => Some(t.as_secs_f64()),
+        Budget::Samples(_) => None,
+    };
+    let checksum = crate::shard::pixel_checksum(&film);
     if let Some(shard) = &job.shard {
-        attributes.extend(shard.attributes());
+        attributes.extend(shard.attributes(&crate::shard::ShardHeader {
+            exposure,
+            time_budget_seconds,
+            state: outcome.state(),
+            pixel_checksum: checksum.clone(),
+        }));
     }
     let value = json!({
         "scene": scene.source_path().map(|p| p.display().to_string()).unwrap_or_else(|| scene.display_name().to_string()),
@@ -347,10 +370,7 @@ pub fn write_render(
             .collect::<serde_json::Map<_, _>>(),
         "scattering": job.scattering.name(),
         "spp": outcome.spp,
-        "time_budget_seconds": match job.budget {
-            Budget::Time(t) => Some(t.as_secs_f64()),
-            Budget::Samples(_) => None,
-        },
+        "time_budget_seconds": time_budget_seconds,
         "seed": job.seed,
         "max_depth": job.max_depth,
         "width": film.width,
@@ -376,6 +396,7 @@ pub fn write_render(
         "counters": outcome.counters,
         "warnings": outcome.warnings,
         "mean_rgb": film.mean().0,
+        "pixel_checksum": checksum,
         "interrupted": outcome.interrupted,
         "checkpoint": outcome.checkpoint,
         "max_collisions": tracer::integrator::walk::collision_cap(),

@@ -9,17 +9,23 @@
 //!
 //! **Shard files.** A shard is an ordinary render's set of files: a full-size EXR whose rows
 //! outside the shard are black, its PNG preview and its JSON sidecar. The EXR header records
-//! `shard=I/N`, `partition=interleaved-rows` and `sceneHash=…` besides the usual metadata;
-//! the sidecar's `shard` object holds the same (`index`, `count`, `partition`, `scene_hash`).
-//! The scene hash is 64-bit FNV-1a over the scene file's bytes followed by those of every
-//! file it reads (meshes, textures), in order: an identity check against mixing renders of
-//! edited scenes, not a cryptographic one.
+//! `shard=I/N`, `partition=interleaved-rows`, `sceneHash=…`, `exposure`, `timeBudget`,
+//! `state` (`final`, `checkpoint` or `interrupted`) and `pixelChecksum` besides the usual
+//! metadata (generator, spp, seed, method, profile); the sidecar's `shard` object holds the
+//! shard's identity (`index`, `count`, `partition`, `scene_hash`) and its `pixel_checksum`
+//! the checksum. The scene hash is 64-bit FNV-1a over the scene file's bytes followed by those
+//! of every file it reads (meshes, textures, a glTF file's external buffers and images), in
+//! order; the pixel checksum is FNV-1a over the stored `f32` values ([`pixel_checksum`]).
+//! Both are identity checks against mixed or corrupted files, not cryptographic ones.
 //!
 //! **Merge.** [`merge`] takes every shard's EXR (the sidecar beside each is read too), checks
-//! that they are shards of one render (same scene hash, seed, method, profile, estimator
-//! parameters, scattering, depth, size, collision cap, tool version, budget and shard count)
-//! and that each index `0..N` is there exactly once, and copies each shard's rows into the
-//! image. With a sample budget the merged EXR and PNG are byte for byte those of the whole
+//! that each EXR's own header says what its sidecar says (spp, seed, method, profile, tool
+//! version, split, scene hash, exposure, budget, state, checksum) and that its decoded pixels
+//! have the checksum of its header (a flipped bit is refused), that they are shards of one
+//! render (same scene hash, seed, method, profile, estimator parameters, scattering, depth,
+//! size, collision cap, tool version, budget, preview exposure and shard count, in the
+//! sidecars and in the headers) and that each index `0..N` is there exactly once, and copies
+//! each shard's rows into the image. With a sample budget the merged EXR and PNG are byte for byte those of the whole
 //! render with the same seed: pixels are copied as stored (`f32`), the header is rebuilt by
 //! [`crate::run::render_attributes`] as a whole render's, and the preview is made from the
 //! stored values by both. The merged sidecar sums the shards' counters and rays, gives
@@ -66,12 +72,28 @@ impl ShardJob {
         })
     }
 
-    /// The EXR header entries of a shard (after a render's usual ones).
-    pub fn attributes(&self) -> Vec<(&'static str, ExrAttribute)> {
+    /// The EXR header entries of a shard (after a render's usual ones): which rows, the
+    /// scene's hash, and what else the merge checks against the sidecar and the other shards
+    /// (see [`ShardHeader`]).
+    pub fn attributes(&self, header: &ShardHeader) -> Vec<(&'static str, ExrAttribute)> {
         vec![
             ("shard", ExrAttribute::Text(self.shard.to_string())),
             ("partition", ExrAttribute::Text(PARTITION.to_string())),
             ("sceneHash", ExrAttribute::Text(self.scene_hash.clone())),
+            ("exposure", ExrAttribute::Text(header.exposure.to_string())),
+            (
+                "timeBudget",
+                ExrAttribute::Text(
+                    header
+                        .time_budget_seconds
+                        .map_or_else(|| "none".to_string(), |t| t.to_string()),
+                ),
+            ),
+            ("state", ExrAttribute::Text(header.state.to_string())),
+            (
+                "pixelChecksum",
+                ExrAttribute::Text(header.pixel_checksum.clone()),
+            ),
         ]
     }
 
@@ -86,6 +108,37 @@ impl ShardJob {
     }
 }
 
+/// What a shard's header records besides its rows and scene: the values that make a shard EXR
+/// beside a sidecar of another render (another exposure or budget, a checkpoint, a corrupted
+/// copy) detectable from the EXR alone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShardHeader {
+    /// Exposure of the PNG preview, in stops.
+    pub exposure: f64,
+    /// The time budget, when the render had one.
+    pub time_budget_seconds: Option<f64>,
+    /// `final`, `checkpoint` or `interrupted`.
+    pub state: &'static str,
+    /// [`pixel_checksum`] of the pixels the EXR holds.
+    pub pixel_checksum: String,
+}
+
+/// The checksum of an image's pixel data as an EXR stores it: `fnv1a64:` and 16 hex digits of
+/// FNV-1a over the `f32` values (little-endian R, G, B of each pixel, rows from the top). A
+/// flipped bit in the file's pixel blocks changes a decoded value, hence the checksum.
+pub fn pixel_checksum(film: &Film) -> String {
+    let mut hash = FNV_OFFSET;
+    for p in &film.pixels {
+        for c in 0..3 {
+            hash = fnv1a(hash, &(p[c] as f32).to_le_bytes());
+        }
+    }
+    format!("fnv1a64:{hash:016x}")
+}
+
+/// FNV-1a's 64-bit offset basis.
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
 /// 64-bit FNV-1a (Fowler, Noll, Vo) of `bytes`, continuing from `hash`.
 fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
     for &b in bytes {
@@ -99,19 +152,28 @@ fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
 /// file's bytes and then those of every file it reads, in order. A scene built in code (no
 /// file) hashes its name.
 pub fn scene_hash(scene: &Scene) -> Result<String, OutputError> {
-    let mut hash = 0xcbf2_9ce4_8422_2325;
+    let mut hash = FNV_OFFSET;
     let files = scene
         .source_path()
         .into_iter()
         .chain(scene.input_files().iter().map(PathBuf::as_path));
     let mut any = false;
     for path in files {
-        let bytes = std::fs::read(path).map_err(|source| OutputError::Io {
+        let io = |source| OutputError::Io {
             path: path.to_path_buf(),
             action: "read (to hash the scene)",
             source,
-        })?;
-        hash = fnv1a(hash, &bytes);
+        };
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let mut buf = vec![0u8; 1 << 16];
+        loop {
+            match std::io::Read::read(&mut file, &mut buf) {
+                Ok(0) => break,
+                Ok(n) => hash = fnv1a(hash, &buf[..n]),
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(io(e)),
+            }
+        }
         any = true;
     }
     if !any {
@@ -144,8 +206,11 @@ pub enum MergeError {
 struct Part {
     path: PathBuf,
     sidecar: Value,
+    /// The EXR header's metadata pairs.
+    header: Vec<(String, String)>,
     shard: Shard,
-    film: Film,
+    /// The image's width and height.
+    size: (u32, u32),
 }
 
 /// What [`merge`] made.
@@ -184,8 +249,9 @@ fn shard_err(path: &Path, message: impl Into<String>) -> MergeError {
     }
 }
 
-/// Reads one shard's EXR, its header and its sidecar, and checks that they agree.
-fn read_part(path: &Path) -> Result<Part, MergeError> {
+/// Reads one shard's EXR, its header and its sidecar, and checks that they agree; returns the
+/// image apart.
+fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
     let (_, json_path) = sidecar_paths(path);
     let text = std::fs::read_to_string(&json_path).map_err(|source| OutputError::Io {
         path: json_path.clone(),
@@ -250,26 +316,7 @@ fn read_part(path: &Path) -> Result<Part, MergeError> {
         }
     }
     let header = read_exr_metadata(path)?;
-    let get = |name: &str| {
-        header
-            .iter()
-            .find(|(k, _)| k == name)
-            .map(|(_, v)| v.as_str())
-    };
-    let hash = s["scene_hash"].as_str();
-    if get("shard") != Some(&shard.to_string()) || get("sceneHash") != hash {
-        return Err(shard_err(
-            path,
-            format!(
-                "its header (shard {}, scene hash {}) does not match its sidecar `{}` (shard \
-                 {shard}, scene hash {}): the files are from different renders",
-                get("shard").unwrap_or("none"),
-                get("sceneHash").unwrap_or("none"),
-                json_path.display(),
-                hash.unwrap_or("none"),
-            ),
-        ));
-    }
+    check_header(path, &json_path, &header, &sidecar, shard)?;
     let film = read_exr(path)?;
     let size = (sidecar["width"].as_u64(), sidecar["height"].as_u64());
     if size != (Some(film.width.into()), Some(film.height.into())) {
@@ -285,12 +332,149 @@ fn read_part(path: &Path) -> Result<Part, MergeError> {
             ),
         ));
     }
-    Ok(Part {
-        path: path.to_path_buf(),
-        sidecar,
-        shard,
+    let stated = header_value(&header, "pixelChecksum").unwrap_or("none");
+    let actual = pixel_checksum(&film);
+    if stated != actual {
+        return Err(shard_err(
+            path,
+            format!(
+                "its pixel data does not match the checksum in its header (pixelChecksum \
+                 {stated}, pixels {actual}): the file is corrupted; render this shard again"
+            ),
+        ));
+    }
+    Ok((
+        Part {
+            path: path.to_path_buf(),
+            sidecar,
+            header,
+            shard,
+            size: (film.width, film.height),
+        },
         film,
-    })
+    ))
+}
+
+/// The value of `name` in an EXR header's metadata pairs.
+fn header_value<'a>(header: &'a [(String, String)], name: &str) -> Option<&'a str> {
+    header
+        .iter()
+        .find(|(k, _)| k == name)
+        .map(|(_, v)| v.as_str())
+}
+
+/// A JSON number or string as the EXR header writes it (`f64` by Rust's shortest round-trip
+/// form, integers as integers).
+fn as_header_text(v: &Value) -> Option<String> {
+    match v {
+        Value::String(s) => Some(s.clone()),
+        Value::Number(n) if n.is_u64() || n.is_i64() => Some(n.to_string()),
+        Value::Number(n) => n.as_f64().map(|f| f.to_string()),
+        _ => None,
+    }
+}
+
+/// The header entries a shard's EXR must hold, each with what its sidecar says (the key
+/// named in errors and the value as header text; `None`: missing or invalid in the sidecar).
+fn expected_header(
+    sidecar: &Value,
+    shard: Shard,
+) -> Vec<(&'static str, &'static str, Option<String>)> {
+    let s = &sidecar["shard"];
+    let state = match (&sidecar["interrupted"], &sidecar["checkpoint"]) {
+        (Value::Bool(false), Value::Bool(false)) => Some("final".to_string()),
+        (Value::Bool(true), _) => Some("interrupted".to_string()),
+        (_, Value::Bool(true)) => Some("checkpoint".to_string()),
+        _ => None,
+    };
+    vec![
+        (
+            "generator",
+            "tool.version",
+            sidecar["tool"]["version"]
+                .as_str()
+                .map(|v| format!("het-bssrdf {v}")),
+        ),
+        ("samplesPerPixel", "spp", as_header_text(&sidecar["spp"])),
+        ("seed", "seed", as_header_text(&sidecar["seed"])),
+        ("method", "method", as_header_text(&sidecar["method"])),
+        (
+            "profile",
+            "profile",
+            match &sidecar["profile"] {
+                Value::Null => Some("none".to_string()),
+                v => as_header_text(v),
+            },
+        ),
+        ("shard", "shard", Some(shard.to_string())),
+        (
+            "partition",
+            "shard.partition",
+            as_header_text(&s["partition"]),
+        ),
+        (
+            "sceneHash",
+            "shard.scene_hash",
+            as_header_text(&s["scene_hash"]),
+        ),
+        (
+            "exposure",
+            "preview_exposure",
+            as_header_text(&sidecar["preview_exposure"]),
+        ),
+        (
+            "timeBudget",
+            "time_budget_seconds",
+            match &sidecar["time_budget_seconds"] {
+                Value::Null => Some("none".to_string()),
+                v => as_header_text(v),
+            },
+        ),
+        ("state", "interrupted, checkpoint", state),
+        (
+            "pixelChecksum",
+            "pixel_checksum",
+            as_header_text(&sidecar["pixel_checksum"]),
+        ),
+    ]
+}
+
+/// Checks that the shard EXR's own header says what its sidecar says (see
+/// [`expected_header`]): an EXR from another render (another spp, seed, method, exposure,
+/// scene or split; a checkpoint) beside a good sidecar is refused.
+fn check_header(
+    path: &Path,
+    json_path: &Path,
+    header: &[(String, String)],
+    sidecar: &Value,
+    shard: Shard,
+) -> Result<(), MergeError> {
+    for (name, key, expected) in expected_header(sidecar, shard) {
+        let found = header_value(header, name);
+        if found.is_none() {
+            return Err(shard_err(
+                path,
+                format!(
+                    "its header has no `{name}`: not a shard EXR of this version of \
+                     het-bssrdf ({}); render it again",
+                    env!("CARGO_PKG_VERSION")
+                ),
+            ));
+        }
+        if found != expected.as_deref() {
+            return Err(shard_err(
+                path,
+                format!(
+                    "its header does not match its sidecar `{}`: {name} is {} in the EXR, \
+                     {key} is {} in the sidecar; the files are from different renders",
+                    json_path.display(),
+                    found.unwrap_or("none"),
+                    expected.as_deref().unwrap_or("missing"),
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The value at a `/`-separated `key` of a sidecar.
@@ -298,8 +482,11 @@ fn at<'a>(v: &'a Value, key: &str) -> &'a Value {
     key.split('/').fold(v, |v, k| &v[k])
 }
 
-/// Checks that `parts` are the shards of one render, each index once.
-fn check_consistent(parts: &[Part]) -> Result<(), MergeError> {
+/// Checks that `parts` are the shards of one render, each index once: their sidecars agree on
+/// every key of [`SHARED`] (and on the preview's exposure unless `exposure_given`, the merge's
+/// own `--exposure`), and so do their EXR headers, but for the shard index, the pixel checksum
+/// and, under a time budget, the sample count.
+fn check_consistent(parts: &[Part], exposure_given: bool) -> Result<(), MergeError> {
     let first = &parts[0];
     let time_budget = !first.sidecar["time_budget_seconds"].is_null();
     let mut keys: Vec<(&str, &str)> = vec![
@@ -311,16 +498,43 @@ fn check_consistent(parts: &[Part]) -> Result<(), MergeError> {
     if !time_budget {
         keys.push(("spp", "samples per pixel"));
     }
+    if !exposure_given {
+        keys.push((
+            "preview_exposure",
+            "preview exposure (stops; give the merge --exposure to choose one)",
+        ));
+    }
+    let differs = |part: &Part, what: String| {
+        MergeError::Inconsistent(format!(
+            "`{}` and `{}` are shards of different renders: {what}",
+            part.path.display(),
+            first.path.display(),
+        ))
+    };
     for part in &parts[1..] {
         for (key, name) in &keys {
             let (a, b) = (at(&first.sidecar, key), at(&part.sidecar, key));
             if a != b {
-                return Err(MergeError::Inconsistent(format!(
-                    "`{}` and `{}` are shards of different renders: {name} {b} vs {a}",
-                    part.path.display(),
-                    first.path.display(),
-                )));
+                return Err(differs(part, format!("{name} {b} vs {a}")));
             }
+        }
+        for (name, value) in &part.header {
+            let own = matches!(name.as_str(), "shard" | "pixelChecksum")
+                || (time_budget && name == "samplesPerPixel")
+                || (exposure_given && name == "exposure");
+            let theirs = header_value(&first.header, name);
+            if !own && theirs != Some(value.as_str()) {
+                return Err(differs(
+                    part,
+                    format!("EXR header {name} {value} vs {}", theirs.unwrap_or("none")),
+                ));
+            }
+        }
+        if part.header.len() != first.header.len() {
+            return Err(differs(
+                part,
+                "their EXR headers hold different entries".into(),
+            ));
         }
     }
     let count = first.shard.count();
@@ -391,23 +605,47 @@ pub fn merge(
     if inputs.is_empty() {
         return Err(MergeError::Inconsistent("no shards given".into()));
     }
-    let parts = inputs
-        .iter()
-        .map(|p| read_part(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    check_consistent(&parts)?;
+    // Each shard's rows are copied as it is read, so that one shard's image is held at a time.
+    let mut parts: Vec<Part> = Vec::with_capacity(inputs.len());
+    let mut film: Option<Film> = None;
+    for path in inputs {
+        let (part, image) = read_part(path)?;
+        let merged = match &mut film {
+            Some(f) => f,
+            None => {
+                let (w, h) = part.size;
+                tracer::memory::check(
+                    || format!("merging {w}x{h} shards"),
+                    f64::from(w) * f64::from(h) * tracer::memory::RENDER_BYTES_PER_PIXEL,
+                )
+                .map_err(|e| shard_err(&part.path, e.to_string()))?;
+                film.insert(Film::new(w, h))
+            }
+        };
+        if (merged.width, merged.height) != part.size {
+            return Err(MergeError::Inconsistent(format!(
+                "`{}` and `{}` are shards of different renders: image size {}x{} vs {}x{}",
+                part.path.display(),
+                parts[0].path.display(),
+                part.size.0,
+                part.size.1,
+                merged.width,
+                merged.height
+            )));
+        }
+        let w = merged.width as usize;
+        for y in (0..merged.height).filter(|&y| part.shard.holds_row(y)) {
+            let row = y as usize * w..(y as usize + 1) * w;
+            merged.pixels[row.clone()].copy_from_slice(&image.pixels[row]);
+        }
+        parts.push(part);
+    }
+    let film = film.expect("at least one shard was read");
+    check_consistent(&parts, exposure.is_some())?;
     let first = &parts[0];
-    let (width, height) = (first.film.width, first.film.height);
     let count = first.shard.count();
     let mut by_index: Vec<&Part> = parts.iter().collect();
     by_index.sort_by_key(|p| p.shard.index());
-    let mut film = Film::new(width, height);
-    let w = width as usize;
-    for y in 0..height {
-        let src = &by_index[(y % count) as usize].film;
-        let row = y as usize * w..(y as usize + 1) * w;
-        film.pixels[row.clone()].copy_from_slice(&src.pixels[row]);
-    }
     let spp = |p: &Part| {
         p.sidecar["spp"]
             .as_u64()
@@ -463,8 +701,12 @@ pub fn merge(
             }
         }
     }
+    let exposure = exposure
+        .or_else(|| first.sidecar["preview_exposure"].as_f64())
+        .unwrap_or(0.0);
     let mut sidecar = first.sidecar.clone();
     if let Some(obj) = sidecar.as_object_mut() {
+        obj.insert("preview_exposure".into(), json!(exposure));
         obj.remove("shard");
         obj.remove("threads");
         obj.insert("spp".into(), json!(lo));
@@ -473,6 +715,7 @@ pub fn merge(
         obj.insert("counters".into(), summed_counters(&parts)?);
         obj.insert("warnings".into(), Value::Array(warnings));
         obj.insert("mean_rgb".into(), json!(film.mean().0));
+        obj.insert("pixel_checksum".into(), json!(pixel_checksum(&film)));
         obj.insert(
             "merged".into(),
             json!({
@@ -492,9 +735,6 @@ pub fn merge(
             }),
         );
     }
-    let exposure = exposure
-        .or_else(|| first.sidecar["preview_exposure"].as_f64())
-        .unwrap_or(0.0);
     write_image_set(
         &film,
         &attributes,
@@ -513,6 +753,41 @@ pub fn merge(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::{RenderJob, render_scene, write_render};
+    use tracer::render::Budget;
+
+    /// A checkpoint's EXR copied over a finished shard's (same spp, seed, pixels: only its
+    /// state differs) was merged; its header's `state` now refuses it.
+    #[test]
+    fn a_checkpoint_exr_beside_a_final_sidecar_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene::from_toml_str(crate::scenes::CHECKER_SLAB, Path::new("."), "slab")
+            .unwrap()
+            .with_resolution(6, 5)
+            .unwrap();
+        let mut job = RenderJob::from_scene(&scene, "pt".parse().unwrap());
+        job.budget = Budget::Samples(1);
+        let mut paths = Vec::new();
+        let mut last = None;
+        for i in 0..2 {
+            job.shard = Some(ShardJob::new(Shard::new(i, 2).unwrap(), &scene).unwrap());
+            let outcome = render_scene(&scene, &job).unwrap();
+            let path = dir.path().join(format!("s-{i}.exr"));
+            write_render(&outcome, &scene, &job, &path, 0.0).unwrap();
+            paths.push(path);
+            last = Some(outcome);
+        }
+        let out = dir.path().join("m.exr");
+        merge(&paths, &out, None).unwrap();
+        let mut checkpoint = last.unwrap();
+        checkpoint.checkpoint = true;
+        let x = dir.path().join("x.exr");
+        write_render(&checkpoint, &scene, &job, &x, 0.0).unwrap();
+        std::fs::copy(&x, &paths[1]).unwrap();
+        let e = merge(&paths, &out, None).unwrap_err().to_string();
+        assert!(e.contains("state is checkpoint in the EXR"), "{e}");
+        assert!(e.contains("s-1.exr"), "{e}");
+    }
 
     #[test]
     fn fnv1a_known_answers() {

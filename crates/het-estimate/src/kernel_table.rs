@@ -15,10 +15,12 @@
 //!
 //! # Grid
 //! * ρ: [`RHO_NODES`] nodes uniform in x = ρ/(ρ + [`RHO_SCALE`]) ∈ [0, 1) (spacing about 0.06
-//!   near 0, reaching ρ = 252 at the last node); beyond the last node h is held constant (the
-//!   e^{−κρ} factor is still exact; at κ = 0 the power-law tail is then over-weighted, see the
-//!   docs). The ρ = 0 node is evaluated at [`RHO_FLOOR`], because W₂ diverges logarithmically
-//!   where p is right above a source.
+//!   near 0, reaching ρ = 252 at the last node); beyond the last node h continues along each
+//!   axis that is out of range with the slope in ln ρ of the last cell
+//!   ([`KappaSlice::log_weight`]: the far field is a power law in ρ times the exact e^{−κρ}
+//!   factor, which holding h constant would over-weight without bound). The ρ = 0 node is
+//!   evaluated at [`RHO_FLOOR`], because W₂ diverges logarithmically where p is right above a
+//!   source.
 //! * κ: [`KAPPA_NODES`] nodes uniform on [0, √3].
 //! * Depth: composite 4-point Gauss–Legendre on panels one e-fold wide in ln|ζ − 1|, from 1e-5
 //!   to 1 above the sources' depth and to 1e4 below it (132 nodes shared by all entries, so

@@ -119,10 +119,112 @@ fn closed_forms_in_symmetric_cases() {
     assert!((f - 0.5).abs() < 1e-3, "{f}");
     // Too many cells: declined, so that the estimator samples.
     assert!(check_fraction(&check, &disk(DVec2::ZERO, 1e4)).is_none());
-    // Degenerate (zero-area) footprints are declined by the check.
+    // A segment (zero area) is the b → 0 limit: along x from −3 to 3 it lies in cells 0 and
+    // ±1 (value 0 for |x| < 2, 1 beyond), and the semicircle law puts 1 − F(2/3) + F(−2/3)
+    // of its weight beyond |x| = 2.
     let mut line = disk(DVec2::ZERO, 3.0);
     line.axis_v = DVec2::ZERO;
-    assert!(check_fraction(&check, &line).is_none());
+    let z: f64 = 2.0 / 3.0;
+    let beyond = 1.0 - 2.0 * (z * (1.0 - z * z).sqrt() + z.asin()) / std::f64::consts::PI;
+    let f = check_fraction(&check, &line).unwrap();
+    assert!((f - beyond).abs() < 1e-14, "{f} vs {beyond}");
+}
+
+/// The check fraction of `fp` by brute force, independently of the closed form's polygon
+/// areas: the unit disk cut into chords along the footprint's first axis (x), each chord's
+/// fraction of value 1 exact from its crossings of the cell edges, integrated over the
+/// chords' offset y (weight (2/π)√(1 − y²), midpoint rule in y = sin θ over 20,000 nodes).
+/// Thin footprints are cut along their length, so every chord sees them whole and the
+/// integrand varies slowly with y, whatever the aspect.
+fn brute_check_fraction(check: &Check, fp: &PlaneFootprint) -> f64 {
+    let n = 20_000;
+    let w = check.width;
+    let mut total = 0.0;
+    for k in 0..n {
+        let theta =
+            -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (k as f64 + 0.5) / n as f64;
+        let (y, half) = (theta.sin(), theta.cos());
+        // The chord p(x) = c + x·A + y·B, x ∈ [−half, half].
+        let base = fp.centre + y * fp.axis_v;
+        let mut cuts = vec![-half, half];
+        for (c, d) in [(base.x, fp.axis_u.x), (base.y, fp.axis_u.y)] {
+            if d == 0.0 {
+                continue;
+            }
+            let (lo, hi) = (c - half * d.abs(), c + half * d.abs());
+            let mut edge = ((lo / w - 0.5).ceil() + 0.5) * w;
+            while edge <= hi {
+                let x = (edge - c) / d;
+                if x > -half && x < half {
+                    cuts.push(x);
+                }
+                edge += w;
+            }
+        }
+        cuts.sort_by(f64::total_cmp);
+        let ones: f64 = cuts
+            .windows(2)
+            .map(|x| {
+                let p = base + 0.5 * (x[0] + x[1]) * fp.axis_u;
+                check.select(p.x, p.y) as f64 * (x[1] - x[0])
+            })
+            .sum();
+        // Weight of the chord: (2/π) cos²θ dθ; its fraction: ones / (2 half).
+        total += 2.0 / std::f64::consts::PI * half * half * std::f64::consts::PI / n as f64
+            * (ones / (2.0 * half));
+    }
+    total
+}
+
+/// Thin footprints (issue 38): the check's closed form against brute force at aspects b/a
+/// from 1 down to 10⁻¹², and a segment (b = 0), over orientations, shears, sizes and
+/// positions; the stripe's too. Below b/a = 10⁻⁶ the check takes the segment limit; above,
+/// the polygon areas, whose unit-disk images grow as a/b: before the limit existed they
+/// returned 0.83, 0 or 1 where 0.444 was right at b/a ≤ 3·10⁻⁹.
+#[test]
+fn closed_forms_hold_for_thin_footprints() {
+    let mut rng = SplitMix64::new(38);
+    let mut r = move || rng.next_f64();
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for exponent in 0..=13 {
+        let aspect = if exponent == 13 {
+            0.0
+        } else {
+            10f64.powi(-exponent)
+        };
+        for k in 0..12 {
+            let a = [0.7, 3.0, 11.0][k % 3] * (0.5 + r());
+            let angle = 6.3 * r();
+            let (s, c) = angle.sin_cos();
+            // Conjugate semi-axes: B = b (n + shear·u) keeps the area π a b.
+            let shear = 2.0 * r() - 1.0;
+            let fp = PlaneFootprint {
+                centre: DVec2::new(20.0 * r() - 10.0, 20.0 * r() - 10.0),
+                axis_u: DVec2::new(c, s) * a,
+                axis_v: (DVec2::new(-s, c) + shear * DVec2::new(c, s)) * (aspect * a),
+                weight: FootprintWeight::Uniform,
+            };
+            let width = [4.0, 1.3, 0.7][(k / 3) % 3];
+            let check = Check { width };
+            let got = check_fraction(&check, &fp).expect("a thin footprint has a closed form");
+            let want = brute_check_fraction(&check, &fp);
+            worst = worst.max((got - want).abs());
+            assert!(
+                (got - want).abs() < 2e-6,
+                "b/a {aspect:e}, footprint {k}: check {got}, brute force {want}"
+            );
+            let stripe = Stripe::new(width, angle + 0.3 + r());
+            let got = stripe_fraction(&stripe, &fp).unwrap();
+            let (mc, se) = mc_fraction(&stripe, &fp, 3800 + 20 * exponent as u64 + k as u64);
+            assert!(
+                (got - mc).abs() <= K_SE * se + 1e-12,
+                "b/a {aspect:e}, footprint {k}: stripe {got}, Monte Carlo {mc} ± {se}"
+            );
+            checked += 1;
+        }
+    }
+    eprintln!("thin check footprints: {checked}, largest difference from brute force {worst:.1e}");
 }
 
 fn check_preset() -> CheckField {

@@ -372,11 +372,27 @@ pub enum OutputError {
         /// The cargo feature to enable.
         feature: &'static str,
     },
+    /// Another process holds the lock of the output set (see [`crate::output::OutputLock`]).
+    #[error("cannot write `{}`: another het-bssrdf run ({holder}) is writing it and the files beside it; wait for it to end or choose another output", path.display())]
+    Busy {
+        /// The requested output path.
+        path: PathBuf,
+        /// Who holds the lock, as it wrote in the lock file (`pid 1234 on node7`).
+        holder: String,
+    },
+    /// The output would replace a file the run reads.
+    #[error("cannot write `{}`: it is `{}`, an input of this run, which it would replace; choose another output", path.display(), input.display())]
+    IsInput {
+        /// The requested output path.
+        path: PathBuf,
+        /// The input it resolves to.
+        input: PathBuf,
+    },
 }
 /// Work that would need more memory than the machine has available, refused before anything
 /// is allocated.
 #[derive(Debug, thiserror::Error)]
-#[error("{what} would need about {} of memory, more than the {} available", human_bytes(*bytes), human_bytes(*available))]
+#[error("{what} would need about {} of memory, more than the {} available (limit: {limit})", human_bytes(*bytes), human_bytes(*available))]
 pub struct TooLarge {
     /// What is too large, with its size (`"a 20000x20000 render"`).
     pub what: String,
@@ -384,6 +400,8 @@ pub struct TooLarge {
     pub bytes: f64,
     /// The memory available, in bytes.
     pub available: f64,
+    /// Which limit gives `available` (see [`crate::memory::headroom`]).
+    pub limit: &'static str,
 }
 
 /// A byte count in words: `9.6 GB`, `512 MB`, `12 kB` (decimal units).

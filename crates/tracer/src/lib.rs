@@ -18,4 +18,5 @@ pub mod output;
 pub mod render;
 pub mod rng;
 pub mod scene;
+pub mod spectral;
 pub mod volume;

@@ -6,7 +6,15 @@
 //! replaced only on success. Errors name the path. A symbolic link at the destination is written
 //! through (its target gets the bytes); a device, FIFO or socket is refused, never replaced.
 //! [`OutputSet`] commits several files (EXR, PNG, JSON) together or not at all, and
-//! [`remove_temporary_files`] lets an interrupted process remove its unfinished temporaries.
+//! [`remove_temporary_files`] lets an interrupted process remove its unfinished temporaries
+//! ([`abandon_and_exit`] also removes its locks and exits).
+//!
+//! **Sets and runs.** An [`OutputLock`] (an advisory `flock` on `.<name>.lock` beside the main
+//! file) makes one run at a time the writer of an output set: a second run is refused
+//! ([`OutputError::Busy`]) instead of mixing its files with the first one's. The lock holder
+//! removes the temporaries a killed run left for the set ([`remove_stale_temporaries`]).
+//! [`check_not_inputs`] refuses an output that is one of the run's inputs (same file, however
+//! reached).
 
 use std::fs;
 use std::io::Write;
@@ -29,6 +37,14 @@ fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     PENDING.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Lock files of the [`OutputLock`]s this process holds, so that [`abandon_and_exit`] can
+/// remove them.
+static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn locks() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LOCKS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// Removes every temporary file an atomic write of this process has not finished; for a
 /// signal handler that is about to exit the process. Returns how many were removed.
 pub fn remove_temporary_files() -> usize {
@@ -36,6 +52,195 @@ pub fn remove_temporary_files() -> usize {
     let n = list.iter().filter(|p| fs::remove_file(p).is_ok()).count();
     list.clear();
     n
+}
+
+/// Removes this process's unfinished temporary files and its lock files, then exits with
+/// `code`, all while holding the registry of temporaries: no other thread can start a new one
+/// in between (a write creates its temporary under the same lock). For a signal handler.
+pub fn abandon_and_exit(code: i32) -> ! {
+    let mut list = pending();
+    for p in list.iter() {
+        let _ = fs::remove_file(p);
+    }
+    list.clear();
+    for p in locks().iter() {
+        let _ = fs::remove_file(p);
+    }
+    std::process::exit(code)
+}
+
+/// The name of the temporary file of a write to `dest` (see the module docs):
+/// `.<name>.<pid>.<n>.tmp` beside it.
+fn temporary_name(dest: &Path) -> PathBuf {
+    let name = dest.file_name().unwrap_or_default().to_string_lossy();
+    parent_dir(dest).join(format!(
+        ".{name}.{}.{}.tmp",
+        std::process::id(),
+        TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
+    ))
+}
+
+/// Removes the temporary files other processes left for the output `path` (its target when a
+/// symbolic link): `.<name>.<pid>.<n>.tmp` of any process but this one, which a run killed
+/// while writing leaves behind. Call it only while holding the set's [`OutputLock`]: then no
+/// other run is writing them. Returns how many were removed.
+pub fn remove_stale_temporaries(path: &Path) -> usize {
+    let Ok(dest) = resolve_output(path) else {
+        return 0;
+    };
+    let Some(name) = dest.file_name().map(|n| n.to_string_lossy().into_owned()) else {
+        return 0;
+    };
+    let prefix = format!(".{name}.");
+    let ours = format!(".{name}.{}.", std::process::id());
+    let Ok(entries) = fs::read_dir(parent_dir(&dest)) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .filter(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            let Some(middle) = n
+                .strip_prefix(&prefix)
+                .and_then(|rest| rest.strip_suffix(".tmp"))
+            else {
+                return false;
+            };
+            // `<pid>.<n>`, both numbers, and not this process's.
+            let numbers = middle
+                .split_once('.')
+                .is_some_and(|(a, b)| a.parse::<u32>().is_ok() && b.parse::<u64>().is_ok());
+            numbers && !n.starts_with(&ours) && e.file_type().is_ok_and(|t| t.is_file())
+        })
+        .filter(|e| fs::remove_file(e.path()).is_ok())
+        .count()
+}
+
+/// The lock of an output set, held from before a run's work until its last file is written:
+/// an exclusive `flock` on `.<name>.lock` beside the set's main file (its target when a
+/// symbolic link), which holds the owner's pid and host for the message of a refused run.
+/// Released, and its file removed, when dropped or by [`abandon_and_exit`]; the kernel releases
+/// a killed process's lock, and the next run reuses the file.
+#[derive(Debug)]
+pub struct OutputLock {
+    /// Held open: closing it releases the lock.
+    _file: fs::File,
+    path: PathBuf,
+    /// False when the file system does not support locks (some network file systems): the set
+    /// is then written unlocked.
+    held: bool,
+}
+
+impl OutputLock {
+    /// Takes the lock of the set whose main file is `path`, or fails with
+    /// [`OutputError::Busy`] when another process holds it.
+    pub fn acquire(path: &Path) -> Result<OutputLock, OutputError> {
+        use std::os::fd::AsRawFd;
+        use std::os::unix::fs::MetadataExt;
+        let dest = resolve_output(path)?;
+        let name = dest
+            .file_name()
+            .expect("resolve_output checks the file name")
+            .to_string_lossy();
+        let lock_path = parent_dir(&dest).join(format!(".{name}.lock"));
+        let io = |action, source| OutputError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        };
+        loop {
+            let mut file = fs::OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(&lock_path)
+                .map_err(|e| io("create the lock file of", e))?;
+            // SAFETY: flock on a descriptor this function owns.
+            if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) } != 0 {
+                let e = std::io::Error::last_os_error();
+                let unsupported = [libc::ENOLCK, libc::EOPNOTSUPP, libc::ENOSYS];
+                if e.raw_os_error().is_some_and(|c| unsupported.contains(&c)) {
+                    locks().push(lock_path.clone());
+                    return Ok(OutputLock {
+                        _file: file,
+                        path: lock_path,
+                        held: false,
+                    });
+                }
+                if e.raw_os_error() == Some(libc::EWOULDBLOCK) {
+                    let holder = fs::read_to_string(&lock_path)
+                        .ok()
+                        .map(|t| t.trim().to_string())
+                        .filter(|t| !t.is_empty())
+                        .unwrap_or_else(|| "a process".to_string());
+                    return Err(OutputError::Busy {
+                        path: path.to_path_buf(),
+                        holder,
+                    });
+                }
+                return Err(io("lock", e));
+            }
+            // The holder before us may have removed the file after we opened it (and another
+            // run created a new one): our lock is then on a file nobody else will see.
+            let ours = file.metadata().map(|m| (m.dev(), m.ino()));
+            let named = fs::metadata(&lock_path).map(|m| (m.dev(), m.ino()));
+            match (ours, named) {
+                (Ok(a), Ok(b)) if a == b => {}
+                _ => continue,
+            }
+            let host = fs::read_to_string("/proc/sys/kernel/hostname")
+                .map(|h| h.trim().to_string())
+                .unwrap_or_default();
+            let who = format!("pid {} on {host}", std::process::id());
+            let _ = file.set_len(0);
+            let _ = file.write_all(who.as_bytes());
+            locks().push(lock_path.clone());
+            return Ok(OutputLock {
+                _file: file,
+                path: lock_path,
+                held: true,
+            });
+        }
+    }
+
+    /// False when the file system refused to lock (`ENOLCK`, `EOPNOTSUPP`): the set is written
+    /// as before locks, and another run writing it would not be seen.
+    pub fn is_held(&self) -> bool {
+        self.held
+    }
+}
+
+impl Drop for OutputLock {
+    fn drop(&mut self) {
+        // Removed before it is unlocked (when the file closes, after this): a run that opened
+        // this file meanwhile then sees it gone and opens a new one.
+        let _ = fs::remove_file(&self.path);
+        locks().retain(|p| p != &self.path);
+    }
+}
+
+/// Refuses any of `outputs` that is the same file as one of `inputs` (compared by device and
+/// inode, so symbolic links, hard links and other spellings of a path are caught); outputs and
+/// inputs that do not exist are skipped.
+pub fn check_not_inputs<'a>(
+    outputs: impl IntoIterator<Item = &'a Path>,
+    inputs: &[&Path],
+) -> Result<(), OutputError> {
+    use std::os::unix::fs::MetadataExt;
+    let id = |p: &Path| fs::metadata(p).ok().map(|m| (m.dev(), m.ino()));
+    let inputs: Vec<_> = inputs.iter().filter_map(|p| Some((id(p)?, *p))).collect();
+    for out in outputs {
+        if let Some(o) = id(out)
+            && let Some((_, input)) = inputs.iter().find(|(i, _)| *i == o)
+        {
+            return Err(OutputError::IsInput {
+                path: out.to_path_buf(),
+                input: input.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// What kind of filesystem object something that is not a regular file is, in words
@@ -148,31 +353,29 @@ impl Staged {
     /// Writes `bytes` to a new temporary file beside `path`'s target (see [`resolve_output`]).
     fn write(path: &Path, bytes: &[u8]) -> Result<Staged, OutputError> {
         let dest = resolve_output(path)?;
-        let name = dest
-            .file_name()
-            .expect("resolve_output checks the file name");
-        let tmp = parent_dir(&dest).join(format!(
-            ".{}.{}.{}.tmp",
-            name.to_string_lossy(),
-            std::process::id(),
-            TEMP_COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
-        pending().push(tmp.clone());
-        let staged = Staged {
-            tmp,
-            dest,
-            path: path.to_path_buf(),
-        };
+        let tmp = temporary_name(&dest);
         let io = |action, source| OutputError::Io {
             path: path.to_path_buf(),
             action,
             source,
         };
-        let mut f = fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&staged.tmp)
-            .map_err(|e| io("create a temporary file for", e))?;
+        // Created and registered under the registry's lock, so that [`abandon_and_exit`]
+        // sees every temporary file that exists.
+        let mut f = {
+            let mut list = pending();
+            let f = fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&tmp)
+                .map_err(|e| io("create a temporary file for", e))?;
+            list.push(tmp.clone());
+            f
+        };
+        let staged = Staged {
+            tmp,
+            dest,
+            path: path.to_path_buf(),
+        };
         f.write_all(bytes).map_err(|e| io("write", e))?;
         f.sync_all().map_err(|e| io("flush", e))?;
         Ok(staged)
@@ -573,6 +776,38 @@ pub fn read_exr_metadata(path: &Path) -> Result<Vec<(String, String)>, OutputErr
 pub(crate) enum ExrReadError {
     Io(std::io::Error),
     Decode(String),
+}
+
+/// The size (width, height) and channel count of the first layer of the EXR at `path`, from
+/// its header alone.
+pub(crate) fn exr_size(path: &Path) -> Result<(u32, u32, usize), ExrReadError> {
+    #[cfg(feature = "exr")]
+    {
+        let file = fs::File::open(path).map_err(ExrReadError::Io)?;
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
+            .map_err(|e| ExrReadError::Decode(e.to_string()))?;
+        let header = meta
+            .headers
+            .first()
+            .ok_or_else(|| ExrReadError::Decode("no layer".into()))?;
+        let size = header.layer_size;
+        let dim = |v: usize| {
+            u32::try_from(v)
+                .map_err(|_| ExrReadError::Decode(format!("image side {v} is too large")))
+        };
+        Ok((
+            dim(size.width())?,
+            dim(size.height())?,
+            header.channels.list.len(),
+        ))
+    }
+    #[cfg(not(feature = "exr"))]
+    {
+        let _ = path;
+        Err(ExrReadError::Decode(
+            "EXR support needs the `exr` feature of het-bssrdf-tracer".into(),
+        ))
+    }
 }
 
 /// Reads the first valid layer of an EXR as RGB `f32` (row-major, row 0 at the top).

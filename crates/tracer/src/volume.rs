@@ -20,6 +20,7 @@
 //! Units: distances in scene units, coefficients in 1/scene unit. Directions must be unit
 //! vectors so that `t` is a distance.
 
+use bssrdf_core::Rgb;
 use glam::DVec3;
 
 use crate::field::MediumField;
@@ -47,7 +48,7 @@ pub trait ChannelMedium {
 /// (`ln` of 1 − u rather than `ln_1p` of −u: the same numbers to within rounding, where it
 /// cannot matter for a free-flight distance, at less than half the cost.)
 #[inline]
-fn unit_exponential(rng: &mut Rng) -> f64 {
+pub(crate) fn unit_exponential(rng: &mut Rng) -> f64 {
     -(1.0 - rng.uniform()).ln()
 }
 
@@ -106,6 +107,45 @@ pub fn sample_interaction<M: ChannelMedium + ?Sized>(
         if xi < sigma_a + sigma_s {
             return Interaction::Scatter { t };
         }
+    }
+}
+
+/// A free-flight sampler the random walk ([`crate::integrator::walk`]) can use: the next real
+/// interaction along `origin + t·dir`, `t ∈ (0, t_max)`, and what the sampled event does to
+/// the per-channel path weight `weight` (which it multiplies; only ratios between its channels
+/// matter, so a sampler may rescale it).
+///
+/// * One channel ([`ChannelMedium`], blanket implementation): analog delta tracking
+///   ([`sample_interaction`]), the weight untouched: a grey medium, or a medium traced one
+///   channel at a time.
+/// * Every channel at once, sampled with a hero channel ([`crate::spectral::HeroTracking`]):
+///   the weight takes the ratio of each channel's path density to the hero's (spectral MIS,
+///   `docs/physics.md#spectral-mis`).
+pub trait FreeFlight {
+    /// Samples the next interaction (see the trait docs).
+    fn sample_flight(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        rng: &mut Rng,
+        counters: &mut TrackingCounters,
+        weight: &mut Rgb,
+    ) -> Interaction;
+}
+
+impl<M: ChannelMedium> FreeFlight for M {
+    #[inline]
+    fn sample_flight(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_max: f64,
+        rng: &mut Rng,
+        counters: &mut TrackingCounters,
+        _weight: &mut Rgb,
+    ) -> Interaction {
+        sample_interaction(self, origin, dir, t_max, rng, counters)
     }
 }
 

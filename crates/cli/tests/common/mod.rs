@@ -4,7 +4,8 @@
 #![allow(dead_code)] // each test crate uses a different subset
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
 
 use bssrdf_core::Rgb;
 use tracer::film::Film;
@@ -31,6 +32,46 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Run {
         code: out.status.code(),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// Runs `het-bssrdf args…` in `dir` like [`run_in`], but kills it and panics if it has not
+/// ended after `seconds` (for inputs that used to hang or grow without bound).
+#[track_caller]
+pub fn run_within(dir: &Path, args: &[&str], seconds: u64) -> Run {
+    run_program_within(dir, env!("CARGO_BIN_EXE_het-bssrdf"), args, seconds)
+}
+
+/// Runs `program args…` in `dir`, killed (and the test failed) after `seconds`.
+#[track_caller]
+pub fn run_program_within(dir: &Path, program: &str, args: &[&str], seconds: u64) -> Run {
+    let mut child = Command::new(program)
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run het-bssrdf");
+    let start = Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            let out = child.wait_with_output().expect("output");
+            return Run {
+                code: out.status.code(),
+                stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+            };
+        }
+        if start.elapsed() > Duration::from_secs(seconds) {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!(
+                "het-bssrdf {} did not end within {seconds} s",
+                args.join(" ")
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
     }
 }
 
@@ -279,4 +320,235 @@ pub fn gradient(w: u32, h: u32) -> Film {
         }
     }
     f
+}
+
+/// A closed tetrahedron: 4 `f32` positions (48 bytes) then 12 `u16` indices (24 bytes).
+pub fn tetra_bin() -> Vec<u8> {
+    let mut b = Vec::new();
+    for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.]] {
+        for c in p {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3] {
+        b.extend_from_slice(&i.to_le_bytes());
+    }
+    b
+}
+
+/// The glTF document with the given nodes, index count, buffer length and buffer URI.
+pub fn gltf(nodes: &str, index_count: u32, byte_length: u32, uri: &str) -> String {
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0]}}],
+  "nodes": {nodes},
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}],
+  "buffers": [{{"uri": "{uri}", "byteLength": {byte_length}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": 24}}
+  ],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+      "min": [0, 0, 0], "max": [1, 1, 1]}},
+    {{"bufferView": 1, "componentType": 5123, "count": {index_count}, "type": "SCALAR"}}
+  ]
+}}"#
+    )
+}
+
+/// The nodes of [`gltf`]'s usual document: one node holding the mesh.
+pub const NODES: &str = r#"[{"mesh": 0}]"#;
+
+/// [`MINIMAL`] with its box replaced by a glTF shape named `tet` reading `path`.
+pub fn with_gltf(path: &str) -> String {
+    edit(
+        MINIMAL,
+        "type = \"box\"\nmaterial = \"m\"\nmin = [-1.0, -1.0, -1.0]\nmax = [1.0, 1.0, 0.0]",
+        &format!("type = \"gltf\"\nname = \"tet\"\nmaterial = \"m\"\npath = \"{path}\""),
+    )
+}
+
+/// A `w × h` 8-bit greyscale PNG of zeros, made without holding its pixels: the zlib stream is
+/// one fixed-Huffman deflate block (a literal 0, then matches of 258 bytes at distance 1), so
+/// a 20000² image (400 MB decoded) is a file of about 2.5 MB.
+pub fn black_grey_png(w: u32, h: u32) -> Vec<u8> {
+    /// Deflate's bit order: values LSB first, Huffman codes MSB first.
+    struct Bits {
+        out: Vec<u8>,
+        acc: u32,
+        n: u32,
+    }
+    impl Bits {
+        fn bit(&mut self, b: u32) {
+            self.acc |= (b & 1) << self.n;
+            self.n += 1;
+            if self.n == 8 {
+                self.out.push(self.acc as u8);
+                self.acc = 0;
+                self.n = 0;
+            }
+        }
+        fn code(&mut self, code: u32, len: u32) {
+            for i in (0..len).rev() {
+                self.bit(code >> i);
+            }
+        }
+    }
+    let total = u64::from(h) * (u64::from(w) + 1); // a filter byte (0) per row
+    let mut bits = Bits {
+        out: vec![0x78, 0x01],
+        acc: 0,
+        n: 0,
+    };
+    bits.bit(1); // BFINAL
+    bits.bit(1); // BTYPE = 01 (fixed Huffman), LSB first
+    bits.bit(0);
+    bits.code(0x30, 8); // literal 0
+    let rest = total - 1;
+    for _ in 0..rest / 258 {
+        bits.code(0xC5, 8); // length 258 (symbol 285)
+        bits.code(0, 5); // distance 1
+    }
+    for _ in 0..rest % 258 {
+        bits.code(0x30, 8);
+    }
+    bits.code(0, 7); // end of block (symbol 256)
+    while bits.n != 0 {
+        bits.bit(0);
+    }
+    let mut zlib = bits.out;
+    // Adler-32 of `total` zero bytes: a stays 1, b adds 1 per byte.
+    let adler = (((total % 65521) as u32) << 16) | 1;
+    zlib.extend_from_slice(&adler.to_be_bytes());
+    let crc = |bytes: &[u8]| {
+        let mut c = 0xFFFF_FFFFu32;
+        for &b in bytes {
+            c ^= u32::from(b);
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    };
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut chunk = |kind: &[u8], data: &[u8]| {
+        png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut body = kind.to_vec();
+        body.extend_from_slice(data);
+        png.extend_from_slice(&body);
+        png.extend_from_slice(&crc(&body).to_be_bytes());
+    };
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&w.to_be_bytes());
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]); // 8-bit grey, deflate, no interlace
+    chunk(b"IHDR", &ihdr);
+    chunk(b"IDAT", &zlib);
+    chunk(b"IEND", &[]);
+    png
+}
+
+/// Runs `het-bssrdf args…` in `dir` under the shell limits `limits` (e.g. `ulimit -v
+/// 1000000`), within `seconds`.
+#[track_caller]
+pub fn run_limited(dir: &Path, limits: &str, args: &[&str], seconds: u64) -> Run {
+    let script = format!("{limits} && exec \"$0\" \"$@\"");
+    let mut sh_args = vec!["-c", &script, env!("CARGO_BIN_EXE_het-bssrdf")];
+    sh_args.extend_from_slice(args);
+    run_program_within(dir, "sh", &sh_args, seconds)
+}
+
+/// A running `het-bssrdf`, killed if the test fails before waiting for it.
+pub struct Running(Option<Child>);
+
+impl Running {
+    pub fn id(&self) -> u32 {
+        self.0.as_ref().expect("running").id()
+    }
+    pub fn wait_with_output(mut self) -> std::io::Result<std::process::Output> {
+        self.0.take().expect("running").wait_with_output()
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        if let Some(c) = &mut self.0 {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+/// Starts `het-bssrdf args…` in `dir` without waiting.
+pub fn spawn(dir: &Path, args: &[&str]) -> Running {
+    Running(Some(
+        Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
+            .args(args)
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn het-bssrdf"),
+    ))
+}
+
+/// Sends `signal` (`INT`, `TERM`) to the child.
+pub fn signal(child: &Running, signal: &str) {
+    let ok = Command::new("kill")
+        .args([format!("-{signal}"), child.id().to_string()])
+        .status()
+        .expect("run kill")
+        .success();
+    assert!(ok, "kill -{signal} failed");
+}
+
+/// Waits for `cond` for at most 60 s.
+#[track_caller]
+pub fn wait_for(what: &str, cond: impl Fn() -> bool) {
+    let start = Instant::now();
+    while !cond() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "timed out waiting for {what}"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Runs `het-bssrdf args…` in `dir`, sends it `sig` 1.5 s after it started, and returns its
+/// exit code and stderr.
+pub fn interrupted_after_a_while(dir: &Path, args: &[&str], sig: &str) -> (Option<i32>, String) {
+    let child = spawn(dir, args);
+    std::thread::sleep(Duration::from_millis(1500));
+    signal(&child, sig);
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The JSON sidecar at `path`.
+pub fn sidecar(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).expect("read sidecar")).expect("sidecar JSON")
+}
+
+/// No temporary (`.….tmp`) or probe file left in `dir`.
+#[track_caller]
+pub fn assert_no_temporaries(dir: &Path) {
+    let files = listing(dir);
+    assert!(
+        !files
+            .iter()
+            .any(|f| f.ends_with(".tmp") || f.contains(".het-bssrdf-probe")),
+        "temporary files left: {files:?}"
+    );
 }

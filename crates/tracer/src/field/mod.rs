@@ -23,7 +23,7 @@ mod texture;
 mod texture_mapping;
 
 pub use artist::{ArtistMap, InvertAt, MFP_FLOOR_FRACTION};
-pub use texture::{Filter, Texture, Wrap};
+pub use texture::{Filter, TEXTURE_LIMIT_VAR, Texture, Wrap, check_decoded_size, decoder_limit_mb};
 pub use texture_mapping::{Axis, PlanarProjection};
 
 use std::sync::Arc;
@@ -882,6 +882,21 @@ impl MediumField {
                 f.texture.area_table();
             }
         }
+    }
+
+    /// The textures whose summed-area tables [`MediumField::build_area_tables`] would build
+    /// (none already built), for a memory estimate before a render is prepared.
+    pub fn area_table_textures(&self) -> Vec<&Arc<Texture>> {
+        if !CoefficientField::<Hit>::has_ellipse_average(self) {
+            return Vec::new();
+        }
+        [&self.sigma_a, &self.sigma_s]
+            .into_iter()
+            .filter_map(|field| match field {
+                Field::Image(f) if !f.texture.has_area_table() => Some(&f.texture),
+                _ => None,
+            })
+            .collect()
     }
 
     /// Channel-wise bounds of both coefficients (σa and σs, for every parametrisation).

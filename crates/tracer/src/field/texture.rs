@@ -122,99 +122,114 @@ impl Texture {
     }
 
     /// Decodes an image file: `.exr` (linear) through `exr`, anything else through `image`
-    /// (PNG; 8/16-bit decoded from sRGB unless `linear`, float images linear).
+    /// (PNG; 8/16-bit decoded from sRGB unless `linear`, float images linear). The decoded
+    /// size is checked before any pixel is decoded ([`check_decoded_size`]).
     pub fn load(path: &Path, linear: bool) -> Result<Texture, TextureError> {
         let file = path.display().to_string();
         let is_exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let read_error = |e| match e {
+            crate::output::ExrReadError::Io(source) => TextureError::Io {
+                file: file.clone(),
+                source,
+            },
+            crate::output::ExrReadError::Decode(message) => TextureError::Decode {
+                file: file.clone(),
+                message,
+            },
+        };
         if is_exr {
-            let (w, h, px) = crate::output::decode_exr_rgb(path).map_err(|e| match e {
-                crate::output::ExrReadError::Io(source) => TextureError::Io {
-                    file: file.clone(),
-                    source,
-                },
-                crate::output::ExrReadError::Decode(message) => TextureError::Decode {
-                    file: file.clone(),
-                    message,
-                },
-            })?;
+            let (w, h, channels) = crate::output::exr_size(path).map_err(read_error)?;
+            // The decoder's channels (as f32), the R, G, B copies and the pixels.
+            check_decoded_size(
+                &file,
+                w,
+                h,
+                f64::from(w) * f64::from(h) * (4.0 * channels as f64 + 24.0),
+            )?;
+            let (w, h, px) = crate::output::decode_exr_rgb(path).map_err(read_error)?;
             return Texture::from_texels(&file, w, h, px);
         }
-        Self::load_ldr(path, &file, linear)
-    }
-
-    #[cfg(feature = "png")]
-    fn load_ldr(path: &Path, file: &str, linear: bool) -> Result<Texture, TextureError> {
-        use image::DynamicImage;
         let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
-            file: file.to_string(),
+            file: file.clone(),
             source,
         })?;
+        Self::from_encoded(&file, &bytes, linear)
+    }
+
+    /// Decodes an encoded image held in memory (PNG, and the other formats the `image` crate
+    /// was built with, such as the JPEG of glTF files): 8- and 16-bit images from sRGB unless
+    /// `linear`, float images linear; grey images give equal channels, alpha is dropped. The
+    /// image's size is read from its header and checked ([`check_decoded_size`]) before any
+    /// pixel is decoded. `file` names the texture in errors.
+    #[cfg(feature = "png")]
+    pub fn from_encoded(file: &str, bytes: &[u8], linear: bool) -> Result<Texture, TextureError> {
+        use image::{DynamicImage, ImageDecoder};
+        let decode_error = |message: String| TextureError::Decode {
+            file: file.to_string(),
+            message,
+        };
         let limit_mb = decoder_limit_mb();
         let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
-            .map_err(|e| TextureError::Decode {
-                file: file.to_string(),
-                message: e.to_string(),
-            })?;
+            .map_err(|e| decode_error(e.to_string()))?;
         let mut limits = image::Limits::default();
         limits.max_alloc = Some(limit_mb.saturating_mul(1 << 20));
         reader.limits(limits);
-        let img = reader.decode().map_err(|e| TextureError::Decode {
-            file: file.to_string(),
-            message: match e {
+        let limit_error = |e: image::ImageError| {
+            decode_error(match e {
                 image::ImageError::Limits(l) => format!(
                     "{l}: the image needs more than the decoder's memory limit of {limit_mb} MiB; \
                      set {TEXTURE_LIMIT_VAR}=<MiB> to raise it"
                 ),
                 e => e.to_string(),
-            },
-        })?;
-        let (w, h) = (img.width(), img.height());
-        let texels: Vec<[f32; 3]> = match &img {
-            DynamicImage::ImageLuma8(_)
-            | DynamicImage::ImageLumaA8(_)
-            | DynamicImage::ImageRgb8(_)
-            | DynamicImage::ImageRgba8(_) => {
-                let lut: Vec<f32> = (0..256)
-                    .map(|i| {
-                        let x = i as f64 / 255.0;
-                        (if linear {
-                            x
-                        } else {
-                            crate::output::srgb_decode(x)
-                        }) as f32
-                    })
-                    .collect();
-                img.to_rgb8()
-                    .pixels()
-                    .map(|p| p.0.map(|b| lut[b as usize]))
-                    .collect()
-            }
-            DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_) => {
-                img.to_rgb32f().pixels().map(|p| p.0).collect()
-            }
-            _ => img
-                .to_rgb16()
-                .pixels()
-                .map(|p| {
-                    p.0.map(|s| {
-                        let x = s as f64 / 65535.0;
-                        (if linear {
-                            x
-                        } else {
-                            crate::output::srgb_decode(x)
-                        }) as f32
-                    })
-                })
-                .collect(),
+            })
         };
+        let decoder = reader.into_decoder().map_err(limit_error)?;
+        let (w, h) = decoder.dimensions();
+        check_decoded_size(file, w, h, decoder.total_bytes() as f64)?;
+        let img = DynamicImage::from_decoder(decoder).map_err(limit_error)?;
+        let lut: Vec<f32> = (0..256)
+            .map(|i| {
+                let x = i as f64 / 255.0;
+                (if linear {
+                    x
+                } else {
+                    crate::output::srgb_decode(x)
+                }) as f32
+            })
+            .collect();
+        let wide = |s: u16| {
+            let x = s as f64 / 65535.0;
+            (if linear {
+                x
+            } else {
+                crate::output::srgb_decode(x)
+            }) as f32
+        };
+        let narrow = |b: u8| lut[b as usize];
+        let float = |x: f32| x;
+        let texels = match &img {
+            DynamicImage::ImageLuma8(b) => spread(b.as_raw(), 1, narrow),
+            DynamicImage::ImageLumaA8(b) => spread(b.as_raw(), 2, narrow),
+            DynamicImage::ImageRgb8(b) => spread(b.as_raw(), 3, narrow),
+            DynamicImage::ImageRgba8(b) => spread(b.as_raw(), 4, narrow),
+            DynamicImage::ImageLuma16(b) => spread(b.as_raw(), 1, wide),
+            DynamicImage::ImageLumaA16(b) => spread(b.as_raw(), 2, wide),
+            DynamicImage::ImageRgb16(b) => spread(b.as_raw(), 3, wide),
+            DynamicImage::ImageRgba16(b) => spread(b.as_raw(), 4, wide),
+            DynamicImage::ImageRgb32F(b) => spread(b.as_raw(), 3, float),
+            DynamicImage::ImageRgba32F(b) => spread(b.as_raw(), 4, float),
+            other => spread(other.to_rgb16().as_raw(), 3, wide),
+        };
+        drop(img);
         Texture::from_texels(file, w, h, texels)
     }
 
+    /// Without the `png` feature no encoded image can be decoded.
     #[cfg(not(feature = "png"))]
-    fn load_ldr(_path: &Path, file: &str, _linear: bool) -> Result<Texture, TextureError> {
+    pub fn from_encoded(file: &str, _bytes: &[u8], _linear: bool) -> Result<Texture, TextureError> {
         Err(TextureError::Unsupported {
             file: file.to_string(),
             message: "PNG textures need the `png` feature of het-bssrdf-tracer".into(),
@@ -292,14 +307,55 @@ impl Texture {
     }
 }
 
-/// The environment variable that overrides the image decoder's memory limit (MiB).
+/// Linear RGB texels from interleaved samples with `channels` per pixel (1 or 2: grey, read
+/// from the first; 3 or 4: RGB, alpha dropped), each converted by `f`.
 #[cfg_attr(not(feature = "png"), allow(dead_code))]
+fn spread<S: Copy>(raw: &[S], channels: usize, f: impl Fn(S) -> f32) -> Vec<[f32; 3]> {
+    raw.chunks_exact(channels)
+        .map(|px| {
+            if channels < 3 {
+                [f(px[0]); 3]
+            } else {
+                [f(px[0]), f(px[1]), f(px[2])]
+            }
+        })
+        .collect()
+}
+
+/// Refuses, before any pixel is decoded, a `w × h` texture whose decoding would need more
+/// than the decoder's memory limit ([`decoder_limit_mb`]) or than the memory this process may
+/// still allocate ([`crate::memory::check`]): `decoded` bytes of the decoder's own image plus
+/// the texture's `f32` texels, both held while one is converted to the other. (A 20000²
+/// greyscale PNG is 400 MB decoded, but 4.8 GB of texels.)
+pub fn check_decoded_size(file: &str, w: u32, h: u32, decoded: f64) -> Result<(), TextureError> {
+    let texels = f64::from(w) * f64::from(h) * crate::memory::TEXTURE_BYTES_PER_TEXEL;
+    let total = decoded + texels;
+    let limit_mb = decoder_limit_mb();
+    let error = |message: String| TextureError::Decode {
+        file: file.to_string(),
+        message,
+    };
+    if total > limit_mb as f64 * (1u64 << 20) as f64 {
+        return Err(error(format!(
+            "the {w}x{h} image needs about {} decoded ({} for the decoder's image, {} for its \
+             f32 texels), more than the decoder's memory limit of {limit_mb} MiB; set \
+             {TEXTURE_LIMIT_VAR}=<MiB> to raise it",
+            crate::error::human_bytes(total),
+            crate::error::human_bytes(decoded),
+            crate::error::human_bytes(texels),
+        )));
+    }
+    crate::memory::check(|| format!("decoding the {w}x{h} image"), total)
+        .map_err(|e| error(e.to_string()))
+}
+
+/// The environment variable that overrides the image decoder's memory limit (MiB).
 pub const TEXTURE_LIMIT_VAR: &str = "HET_BSSRDF_TEXTURE_LIMIT_MB";
 
 /// The image decoder's memory limit in MiB: [`TEXTURE_LIMIT_VAR`] when set to a positive whole
-/// number, else 512 (the `image` crate's default), which refuses decompression bombs (a 20000²
-/// PNG) before they are allocated.
-#[cfg_attr(not(feature = "png"), allow(dead_code))]
+/// number, else 512 (the `image` crate's default). It bounds the decoder's allocations and the
+/// decoded texture as a whole ([`check_decoded_size`]), which refuses decompression bombs (a
+/// 20000² PNG of 389 kB) before they are allocated.
 pub fn decoder_limit_mb() -> u64 {
     std::env::var(TEXTURE_LIMIT_VAR)
         .ok()

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use glam::{DAffine3, DMat4, DVec3, Vec2, Vec3};
 
 use super::TriangleMesh;
+use super::gltf_assets::{self, AssetScope, ModelFolder, Resolved};
 use super::gltf_material::GltfMaterial;
 use crate::error::{MeshError, TextureError};
 use crate::field::Texture;
@@ -13,19 +14,94 @@ use crate::field::Texture;
 /// Receives each triangle primitive, transformed to world space, with its material index.
 type Sink<'s> = dyn FnMut(Option<usize>, &TriangleMesh) + 's;
 
-/// An opened glTF file: its document and buffers, read once.
+/// An opened glTF file: its document and buffers, read once, and its images' sources
+/// resolved (not read).
 struct Opened {
     document: gltf::Document,
     buffers: Vec<gltf::buffer::Data>,
+    /// Each image's URI, resolved (`None`: the image is in a buffer view).
+    images: Vec<Option<Resolved>>,
+    /// The external files read (buffers), canonical, in buffer order.
+    files: Vec<PathBuf>,
 }
 
-fn open(path: &Path, err: &dyn Fn(String) -> MeshError) -> Result<Opened, MeshError> {
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(|e| err(e.to_string()))?;
-    check_buffer_uris(&document, path, err)?;
-    let buffers =
-        gltf::import_buffers(&document, path.parent(), blob).map_err(|e| err(e.to_string()))?;
-    check_buffer_lengths(&document, &buffers, err)?;
-    Ok(Opened { document, buffers })
+fn open(
+    path: &Path,
+    scope: AssetScope,
+    err: &dyn Fn(String) -> MeshError,
+) -> Result<Opened, MeshError> {
+    let gltf::Gltf { document, mut blob } =
+        gltf::Gltf::open(path).map_err(|e| err(e.to_string()))?;
+    let folder = ModelFolder::of(path).map_err(&err)?;
+    let mut buffers = Vec::new();
+    let mut files = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let declared = buffer.length();
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                err(format!(
+                    "buffer {i} refers to the binary chunk of a .glb, but the file has none"
+                ))
+            })?,
+            gltf::buffer::Source::Uri(uri) => {
+                match gltf_assets::resolve(uri, &folder, scope)
+                    .map_err(|m| err(format!("buffer {i}: {m}")))?
+                {
+                    Resolved::Data => {
+                        gltf::buffer::Data::from_source(buffer.source(), None)
+                            .map_err(|e| err(format!("buffer {i}: {e}")))?
+                            .0
+                    }
+                    Resolved::Missing => {
+                        return Err(err(format!("buffer {i} uri `{uri}`: no such file")));
+                    }
+                    Resolved::File(file) => {
+                        let bound = declared.next_multiple_of(4) as u64;
+                        let bytes = gltf_assets::read_bounded(
+                            &file,
+                            bound,
+                            &format!("byteLength {declared}"),
+                        )
+                        .map_err(|m| err(format!("buffer {i} uri `{uri}`: {m}")))?;
+                        files.push(file);
+                        bytes
+                    }
+                }
+            }
+        };
+        // Every buffer must hold exactly its declared `byteLength`, up to the padding to a
+        // multiple of 4 bytes (the sizes are the document's, never a file's).
+        if data.len() < declared {
+            return Err(err(format!(
+                "buffer {i} declares byteLength {declared} but holds fewer bytes"
+            )));
+        }
+        if data.len() > declared.next_multiple_of(4) {
+            return Err(err(format!(
+                "buffer {i} declares byteLength {declared} but holds more bytes"
+            )));
+        }
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
+        buffers.push(gltf::buffer::Data(data));
+    }
+    let images = document
+        .images()
+        .map(|image| match image.source() {
+            gltf::image::Source::View { .. } => Ok(None),
+            gltf::image::Source::Uri { uri, .. } => gltf_assets::resolve(uri, &folder, scope)
+                .map(Some)
+                .map_err(|m| err(format!("image {}: {m}", image.index()))),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Opened {
+        document,
+        buffers,
+        images,
+        files,
+    })
 }
 
 /// Walks the nodes of the default scene (or the first scene; with no scene at all, every
@@ -68,13 +144,23 @@ fn load_error(path: &Path) -> impl Fn(String) -> MeshError {
 /// with the node transforms applied (normals by the inverse transpose). Strips and fans are
 /// converted to triangle lists; points and lines are skipped. Texture coordinates (set 0) are
 /// converted to the OBJ convention `v ↦ 1 − v`. Images are not decoded. The mesh is not
-/// validated here: call [`TriangleMesh::prepare`].
+/// validated here: call [`TriangleMesh::prepare`]. External files must be inside the model's
+/// folder ([`load_gltf_with`] takes another scope).
 pub fn load_gltf(path: &Path) -> Result<TriangleMesh, MeshError> {
+    load_gltf_with(path, AssetScope::default()).map(|(mesh, _)| mesh)
+}
+
+/// [`load_gltf`] with external files read within `scope` ([`gltf_assets`]); also returns the
+/// external files read (canonical paths), for the scene's list of inputs.
+pub fn load_gltf_with(
+    path: &Path,
+    scope: AssetScope,
+) -> Result<(TriangleMesh, Vec<PathBuf>), MeshError> {
     let err = load_error(path);
-    let opened = open(path, &err)?;
+    let opened = open(path, scope, &err)?;
     let mut mesh = TriangleMesh::default();
     walk(&opened, &mut |_, part| mesh.append(part), &err)?;
-    Ok(mesh)
+    Ok((mesh, opened.files))
 }
 
 /// One material's share of a glTF file: its triangles (world space) and what the material
@@ -109,8 +195,13 @@ impl std::fmt::Debug for GltfModel {
 /// [`GltfMaterial`] for what is read from the materials). Images are not decoded here:
 /// [`GltfModel::decode_image`] decodes the ones a scene uses.
 pub fn load_gltf_parts(path: &Path) -> Result<GltfModel, MeshError> {
+    load_gltf_parts_with(path, AssetScope::default())
+}
+
+/// [`load_gltf_parts`] with external files read within `scope` ([`gltf_assets`]).
+pub fn load_gltf_parts_with(path: &Path, scope: AssetScope) -> Result<GltfModel, MeshError> {
     let err = load_error(path);
-    let opened = open(path, &err)?;
+    let opened = open(path, scope, &err)?;
     // Material index → triangles; `None` (glTF's default material) sorts first in a BTreeMap,
     // and is moved last below.
     let mut by_material: BTreeMap<Option<usize>, TriangleMesh> = BTreeMap::new();
@@ -155,8 +246,24 @@ impl GltfModel {
         &self.file
     }
 
+    /// The external files read so far (buffers), canonical paths.
+    pub fn files_read(&self) -> &[PathBuf] {
+        &self.opened.files
+    }
+
+    /// The file image `index` is read from, when it is an external file (canonical path).
+    pub fn image_file(&self, index: usize) -> Option<&Path> {
+        match self.opened.images.get(index) {
+            Some(Some(Resolved::File(p))) => Some(p),
+            _ => None,
+        }
+    }
+
     /// Decodes image `index` of the file (8- and 16-bit images from sRGB, as glTF specifies
-    /// for base colour; float images linear). The texture is named `file#image[index]`.
+    /// for base colour; float images linear) through [`Texture::from_encoded`], which checks
+    /// the decoded size first. The texture is named `file#image[index]`. An external image
+    /// file is read up to the decoder's memory limit
+    /// ([`crate::field::decoder_limit_mb`]).
     pub fn decode_image(&self, index: usize) -> Result<Texture, TextureError> {
         let name = format!("{}#image[{index}]", self.file.display());
         let decode = |message: String| TextureError::Decode {
@@ -169,61 +276,44 @@ impl GltfModel {
             .images()
             .nth(index)
             .ok_or_else(|| decode(format!("the file has no image {index}")))?;
-        let data = gltf::image::Data::from_source(
-            image.source(),
-            self.file.parent(),
-            &self.opened.buffers,
-        )
-        .map_err(|e| decode(e.to_string()))?;
-        let texels = image_texels(&data).map_err(decode)?;
-        Texture::from_texels(&name, data.width, data.height, texels)
+        let owned;
+        let bytes: &[u8] = match (image.source(), &self.opened.images[index]) {
+            (gltf::image::Source::View { view, .. }, _) => {
+                let buffer = &self.opened.buffers[view.buffer().index()].0;
+                let (start, len) = (view.offset(), view.length());
+                start
+                    .checked_add(len)
+                    .and_then(|end| buffer.get(start..end))
+                    .ok_or_else(|| {
+                        decode(format!(
+                            "buffer view {} (offset {start}, length {len}) lies outside its buffer",
+                            view.index()
+                        ))
+                    })?
+            }
+            (gltf::image::Source::Uri { uri, .. }, Some(Resolved::Data)) => {
+                owned = gltf::buffer::Data::from_source(gltf::buffer::Source::Uri(uri), None)
+                    .map_err(|e| decode(e.to_string()))?;
+                &owned.0
+            }
+            (gltf::image::Source::Uri { uri, .. }, Some(Resolved::File(file))) => {
+                let limit_mb = crate::field::decoder_limit_mb();
+                owned = gltf::buffer::Data(
+                    gltf_assets::read_bounded(
+                        file,
+                        limit_mb.saturating_mul(1 << 20),
+                        &format!("the decoder's memory limit of {limit_mb} MiB"),
+                    )
+                    .map_err(|m| decode(format!("uri `{uri}`: {m}")))?,
+                );
+                &owned.0
+            }
+            (gltf::image::Source::Uri { uri, .. }, _) => {
+                return Err(decode(format!("uri `{uri}`: no such file")));
+            }
+        };
+        Texture::from_encoded(&name, bytes, false)
     }
-}
-
-/// Linear RGB texels of a decoded glTF image (grey and grey-alpha images are spread to RGB,
-/// alpha is dropped).
-fn image_texels(d: &gltf::image::Data) -> Result<Vec<[f32; 3]>, String> {
-    use gltf::image::Format;
-    let srgb8: Vec<f32> = (0..256)
-        .map(|i| crate::output::srgb_decode(i as f64 / 255.0) as f32)
-        .collect();
-    let srgb16 = |x: u16| crate::output::srgb_decode(x as f64 / 65535.0) as f32;
-    let (channels, bytes_per) = match d.format {
-        Format::R8 => (1, 1),
-        Format::R8G8 => (2, 1),
-        Format::R8G8B8 => (3, 1),
-        Format::R8G8B8A8 => (4, 1),
-        Format::R16 => (1, 2),
-        Format::R16G16 => (2, 2),
-        Format::R16G16B16 => (3, 2),
-        Format::R16G16B16A16 => (4, 2),
-        Format::R32G32B32FLOAT => (3, 4),
-        Format::R32G32B32A32FLOAT => (4, 4),
-    };
-    let stride = channels * bytes_per;
-    let n = d.width as usize * d.height as usize;
-    if d.pixels.len() < n * stride {
-        return Err(format!(
-            "{}×{} image holds {} bytes, fewer than its size needs",
-            d.width,
-            d.height,
-            d.pixels.len()
-        ));
-    }
-    let value = |px: &[u8], c: usize| -> f32 {
-        // Grey (1 or 2 channels): every colour channel reads channel 0.
-        let c = if channels < 3 { 0 } else { c };
-        let at = c * bytes_per;
-        match bytes_per {
-            1 => srgb8[px[at] as usize],
-            2 => srgb16(u16::from_le_bytes([px[at], px[at + 1]])),
-            _ => f32::from_le_bytes([px[at], px[at + 1], px[at + 2], px[at + 3]]),
-        }
-    };
-    Ok(d.pixels[..n * stride]
-        .chunks_exact(stride)
-        .map(|px| [value(px, 0), value(px, 1), value(px, 2)])
-        .collect())
 }
 
 /// Most nested nodes (the glTF node hierarchy must be a forest; deeper chains are refused
@@ -269,78 +359,6 @@ fn visit(
         visit(&child, world, buffers, out, path, err)?;
     }
     path.pop();
-    Ok(())
-}
-
-/// Refuses buffer URIs that name something other than a regular file (a device such as
-/// `/dev/zero` reads until memory runs out, a FIFO blocks forever), before anything is read.
-fn check_buffer_uris(
-    document: &gltf::Document,
-    path: &Path,
-    err: &dyn Fn(String) -> MeshError,
-) -> Result<(), MeshError> {
-    let base = path.parent().unwrap_or(Path::new("."));
-    for buffer in document.buffers() {
-        let gltf::buffer::Source::Uri(uri) = buffer.source() else {
-            continue;
-        };
-        if uri.starts_with("data:") {
-            continue;
-        }
-        let decoded = percent_decode(uri);
-        let file = base.join(&decoded);
-        match std::fs::metadata(&file) {
-            Ok(m) if !m.is_file() => {
-                return Err(err(format!(
-                    "buffer {} uri `{uri}` names a {}, not a regular file",
-                    buffer.index(),
-                    crate::output::file_kind(&m.file_type())
-                )));
-            }
-            _ => {} // missing files are reported by the importer
-        }
-    }
-    Ok(())
-}
-
-/// `%XX` escapes of a relative URI decoded (glTF buffer URIs are RFC 3986 references).
-fn percent_decode(uri: &str) -> String {
-    let bytes = uri.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        let hex = |b: u8| (b as char).to_digit(16);
-        if bytes[i] == b'%'
-            && i + 2 < bytes.len()
-            && let (Some(h), Some(l)) = (hex(bytes[i + 1]), hex(bytes[i + 2]))
-        {
-            out.push((h * 16 + l) as u8);
-            i += 3;
-        } else {
-            out.push(bytes[i]);
-            i += 1;
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
-}
-
-/// Every buffer must hold exactly its declared `byteLength` (the importer pads the data to a
-/// multiple of 4 bytes, and accepts longer data).
-fn check_buffer_lengths(
-    document: &gltf::Document,
-    buffers: &[gltf::buffer::Data],
-    err: &dyn Fn(String) -> MeshError,
-) -> Result<(), MeshError> {
-    for (buffer, data) in document.buffers().zip(buffers) {
-        let declared = buffer.length();
-        if data.0.len() != declared.next_multiple_of(4) && data.0.len() != declared {
-            return Err(err(format!(
-                "buffer {} declares byteLength {declared} but holds {} bytes",
-                buffer.index(),
-                data.0.len()
-            )));
-        }
-    }
     Ok(())
 }
 

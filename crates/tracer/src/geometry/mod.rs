@@ -27,6 +27,7 @@ pub mod closest;
 mod curvature;
 #[cfg(feature = "gltf")]
 pub mod gltf;
+pub mod gltf_assets;
 #[cfg(feature = "gltf")]
 pub mod gltf_material;
 pub mod mesh;

@@ -5,23 +5,34 @@ use std::path::Path;
 use glam::{DVec3, Vec2, Vec3};
 
 use super::TriangleMesh;
+use super::obj_lines::TextGuard;
 use crate::error::MeshError;
 
 /// Loads every object and group of an OBJ file into one mesh (faces triangulated, one index
-/// per vertex; materials are ignored). Normals are kept only when every part has them;
-/// texture coordinates when any part has them (see [`TriangleMesh::append`]). The mesh is not
-/// validated here: call [`TriangleMesh::prepare`].
+/// per vertex; materials are ignored, and `mtllib` files are not opened). Normals are kept
+/// only when every part has them; texture coordinates when any part has them (see
+/// [`TriangleMesh::append`]). The file is read as a stream of lines through a guard: a
+/// binary file (a NUL byte, a line over 16 MiB) is refused after one buffer, not read whole. The mesh is not validated here: call
+/// [`TriangleMesh::prepare`].
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
     let file = path.display().to_string();
-    let (models, _materials) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS).map_err(|e| {
-        located(
-            path,
-            MeshError::Load {
-                file: file.clone(),
-                message: e.to_string(),
-            },
-        )
-    })?;
+    let load_error = |message: String| MeshError::Load {
+        file: file.clone(),
+        message,
+    };
+    let opened = std::fs::File::open(path).map_err(|e| load_error(format!("cannot open: {e}")))?;
+    let mut reader = TextGuard::new(std::io::BufReader::with_capacity(1 << 16, opened));
+    let loaded = tobj::load_obj_buf(&mut reader, &tobj::GPU_LOAD_OPTIONS, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    });
+    if let Some((line, message)) = reader.problem() {
+        return Err(MeshError::AtLine {
+            file: file.clone(),
+            line: *line,
+            message: message.clone(),
+        });
+    }
+    let (models, _materials) = loaded.map_err(|e| located(path, load_error(e.to_string())))?;
     let mut mesh = TriangleMesh::default();
     for m in &models {
         let m = &m.mesh;
@@ -60,10 +71,10 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
 /// `error` with the OBJ file line that causes it, when one can be found
 /// ([`super::obj_lines::first_problem`]); otherwise `error` itself.
 fn located(path: &Path, error: MeshError) -> MeshError {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    let Ok(file) = std::fs::File::open(path) else {
         return error;
     };
-    match super::obj_lines::first_problem(&text) {
+    match super::obj_lines::first_problem(std::io::BufReader::with_capacity(1 << 16, file)) {
         Some((line, message)) => MeshError::AtLine {
             file: path.display().to_string(),
             line,

@@ -14,12 +14,19 @@
 //!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
 //!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
 //!
-//! Radiance is RGB. A path carries all three channels until it enters a medium whose
-//! coefficients differ between channels; there it picks one channel uniformly (weight 3) and
-//! traces only that one from then on, so the estimator stays unbiased per channel and paths
-//! that never enter a chromatic medium (the background, diffuse surfaces lit directly) keep the
-//! variance of an RGB render. A grey medium is walked once for all three channels. Shadow rays
-//! of an RGB path through a chromatic medium estimate each channel's transmittance.
+//! Radiance is RGB, and every path carries all three channels. A grey medium is walked once
+//! for all three. In a medium whose coefficients differ between channels the path uses
+//! *spectral MIS* (pbrt-v4 §14.2.2; `docs/physics.md#spectral-mis`): on entering the first one
+//! it picks a hero channel uniformly, whose coefficients drive free-flight sampling from then
+//! on ([`crate::spectral`]), and carries the other channels with the ratios of their path
+//! densities to the hero's. The path keeps `r_u`, each channel's unidirectional path density
+//! relative to the hero's, and its throughput `beta` is kept divided by the mean of `r_u` (the
+//! one-sample balance heuristic over the channels): `beta` is the weighted throughput that
+//! light found by the path, by chance or by next-event estimation, multiplies. Next-event
+//! estimation is weighted against direction sampling as before (power heuristic on the
+//! solid-angle pdfs), and its shadow rays estimate each channel's transmittance through a
+//! chromatic medium by that channel's own ratio tracking; the two weights together still sum
+//! to 1 per channel (`docs/physics.md#spectral-mis`).
 //!
 //! Objects inside a medium: a path inside a translucent object (path tracing) carries that
 //! object as its current medium. The walk ends at any other object's surface
@@ -43,7 +50,8 @@ use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
 use crate::scene::{Material, Scene, Translucent};
-use crate::volume::{ChannelView, direction_about, transmittance};
+use crate::spectral::{HeroTracking, SpectralView};
+use crate::volume::{ChannelView, FreeFlight, direction_about, transmittance};
 
 /// Russian roulette starts after this many surface interactions.
 const RR_DEPTH: u32 = 3;
@@ -241,24 +249,6 @@ impl std::ops::Deref for MaterialOf<'_> {
     }
 }
 
-/// Which colour channels a path carries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Channels {
-    /// All three channels (a grey medium is walked with the coefficients of channel 0).
-    All,
-    /// Only this channel (its weight is multiplied by 3).
-    One(usize),
-}
-
-impl Channels {
-    fn medium_channel(self) -> usize {
-        match self {
-            Channels::All => 0,
-            Channels::One(c) => c,
-        }
-    }
-}
-
 /// A cosine-distributed direction about the unit normal `n` (pdf `cos/π`, pbrt-v4 §A.5.3 by
 /// the `cos = √u` inversion) and its cosine; `None` at grazing (`cos = 0`), where the pdf
 /// vanishes. The continuation of both a diffuse bounce and a BSSRDF's incident side.
@@ -445,8 +435,13 @@ impl LightStrategy {
 
 struct PathState {
     l: Rgb,
+    /// Throughput per channel, divided by the mean of `r_u` (spectral MIS).
     beta: Rgb,
-    channels: Channels,
+    /// The hero channel, chosen on entering the first chromatic medium.
+    hero: Option<usize>,
+    /// Each channel's unidirectional path density relative to the hero's, scaled to mean 1
+    /// (pbrt-v4's `r_u`); all 1 until the path enters a chromatic medium.
+    r_u: Rgb,
     /// Real scattering events inside media so far.
     order: u32,
     /// The path has been inside a medium (the scattering-order filter applies).
@@ -485,18 +480,33 @@ impl PathState {
     /// Adds `contribution` if the scattering-order filter lets this path's light through.
     fn add(&mut self, contribution: Rgb, order: u32, entered: bool, filter: Scattering) {
         if !entered || filter.counts(order) {
-            self.l += self.mask(contribution);
+            self.l += contribution;
         }
     }
-    fn mask(&self, v: Rgb) -> Rgb {
-        match self.channels {
-            Channels::All => v,
-            Channels::One(c) => {
-                let mut m = Rgb::ZERO;
-                m[c] = v[c] * 3.0;
-                m
-            }
+
+    /// Multiplies the path by the per-channel density ratios `q` of a walk (see
+    /// [`carried`]).
+    fn carry(&mut self, q: Rgb) {
+        if q != Rgb::ONE {
+            (self.beta, self.r_u) = carried(self.beta, self.r_u, q);
         }
+    }
+}
+
+/// The throughput and `r_u` of a path with throughput `beta` and relative densities `r_u`
+/// (mean 1) after a walk that multiplied each channel's density relative to the hero's by
+/// `q` (up to a common factor, [`crate::spectral`]): both times `q`, divided by the mean of
+/// the new `r_u` — pbrt-v4's `beta / r_u.Average()` kept as the throughput itself, so that
+/// every contribution is simply `beta` times the light. The hero's channel of `q` and of `r_u`
+/// is positive, so the mean is.
+#[inline]
+fn carried(beta: Rgb, r_u: Rgb, q: Rgb) -> (Rgb, Rgb) {
+    let r = r_u * q;
+    let s = r.mean();
+    if s > 0.0 && s.is_finite() {
+        (beta * q * (1.0 / s), r * (1.0 / s))
+    } else {
+        (Rgb::ZERO, Rgb::ONE)
     }
 }
 
@@ -686,7 +696,8 @@ impl<'s> PathIntegrator<'s> {
         let mut st = PathState {
             l: Rgb::ZERO,
             beta: Rgb::ONE,
-            channels: Channels::All,
+            hero: None,
+            r_u: Rgb::ONE,
             order: 0,
             entered: false,
             medium: None,
@@ -804,16 +815,15 @@ impl<'s> PathIntegrator<'s> {
 
     /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
     /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
-    /// pdf), times the shadow ray's transmittance (per channel of `channels`; the ray starts
-    /// inside `medium`, if any). Returns radiance (before path weight) and whether the shadow
-    /// ray crossed a medium.
+    /// pdf), times the shadow ray's transmittance per channel (the ray starts inside `medium`,
+    /// if any). Returns radiance (before path weight) and whether the shadow ray crossed a
+    /// medium.
     #[allow(clippy::too_many_arguments)]
     fn direct(
         &self,
         p: DVec3,
         origin_for: impl Fn(DVec3) -> DVec3,
         f_and_pdf: impl Fn(DVec3) -> (f64, f64),
-        channels: Channels,
         medium: Option<u32>,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -838,7 +848,7 @@ impl<'s> PathIntegrator<'s> {
         let Some(seg) = ShadowSegment::toward(origin, &ls) else {
             return Direct::NONE;
         };
-        let shadow = self.shadow(&seg, medium, channels, rng, counters);
+        let shadow = self.shadow(&seg, medium, rng, counters);
         if shadow.tr.is_zero() {
             return Direct::NONE;
         }
@@ -857,13 +867,12 @@ impl<'s> PathIntegrator<'s> {
 
     /// Transmittance of the shadow segment `seg`, which starts inside `medium` (if any): 0 if
     /// anything opaque is in the way; through index-matched media (path tracing only) by ratio
-    /// tracking, per channel of `channels`. A hit on the sampled light's own object ends the
-    /// segment: the light is reached.
+    /// tracking, per channel. A hit on the sampled light's own object ends the segment: the
+    /// light is reached.
     fn shadow(
         &self,
         seg: &ShadowSegment,
         medium: Option<u32>,
-        channels: Channels,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Transmission {
@@ -882,7 +891,7 @@ impl<'s> PathIntegrator<'s> {
                 let t = hit.map_or(remaining, |h| h.t);
                 through_medium = true;
                 if t.is_finite() {
-                    tr *= self.medium_transmittance(m, origin, dir, t, channels, rng, counters);
+                    tr *= self.medium_transmittance(m, origin, dir, t, rng, counters);
                     if tr.is_zero() {
                         return Transmission::BLOCKED;
                     }
@@ -916,15 +925,15 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Transmittance of the medium of `object` along `origin + t·dir`, `t ∈ (0, t_max)`: one
-    /// estimate for a grey medium or a single traced channel, one per channel otherwise.
-    #[allow(clippy::too_many_arguments)]
+    /// estimate for a grey medium, one per channel, each by its own residual ratio tracking,
+    /// for a chromatic one (whatever the path's hero: the shadow ray's own sampling does not
+    /// depend on it, `docs/physics.md#spectral-mis`).
     fn medium_transmittance(
         &self,
         object: u32,
         origin: DVec3,
         dir: DVec3,
         t_max: f64,
-        channels: Channels,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Rgb {
@@ -936,9 +945,10 @@ impl<'s> PathIntegrator<'s> {
             let view = ChannelView::new(&material.medium, c);
             transmittance(&view, origin, dir, t_max, rng, &mut tc)
         };
-        let tr = match channels {
-            Channels::All if !*grey => Rgb([one(0), one(1), one(2)]),
-            _ => Rgb::splat(one(channels.medium_channel())),
+        let tr = if *grey {
+            Rgb::splat(one(0))
+        } else {
+            Rgb([one(0), one(1), one(2)])
         };
         counters.add_tracking(&tc);
         tr
@@ -971,7 +981,6 @@ impl<'s> PathIntegrator<'s> {
                     (0.0, 0.0)
                 }
             },
-            st.channels,
             st.medium,
             rng,
             counters,
@@ -1069,8 +1078,10 @@ impl<'s> PathIntegrator<'s> {
     /// The volumetric random walk in `object` from `start` along `dir` (see [`super::walk`]),
     /// with next-event estimation at every counted scattering vertex through an index-matched
     /// boundary. `from` is the light-sampled vertex the walk starts from (a diffuse surface
-    /// inside the medium), for MIS if the walk leaves or reaches an emitter unscattered. An RGB
-    /// path entering a chromatic medium picks its channel here.
+    /// inside the medium), for MIS if the walk leaves or reaches an emitter unscattered. A path
+    /// entering its first chromatic medium picks its hero channel here; a chromatic medium is
+    /// walked with hero tracking, its density ratios carried into `beta` and `r_u` (spectral
+    /// MIS, [`carried`]).
     #[allow(clippy::too_many_arguments)]
     fn traverse(
         &self,
@@ -1084,57 +1095,63 @@ impl<'s> PathIntegrator<'s> {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Step {
-        if st.channels == Channels::All && !grey {
-            st.channels = Channels::One(rng.below(3) as usize);
+        if st.hero.is_none() && !grey {
+            st.hero = Some(rng.below(3) as usize);
         }
         st.medium = Some(object);
         let interface = Interface { eta: material.eta };
-        let channels = st.channels;
-        let view = ChannelView::new(&material.medium, channels.medium_channel());
-        let walk = WalkMedium {
-            geometry: self.scene.geometry(),
-            object,
-            medium: &view,
-            g: material.g,
-            interface,
-        };
         let nee = interface.is_index_matched() && !self.lights.is_empty();
         let filter = self.options.scattering;
         self.settle(st, rng, counters);
-        let beta = st.beta;
+        let (beta, r_u) = (st.beta, st.r_u);
         let mut added = Rgb::ZERO;
         let mut scattered = false;
         let mut nee_counters = PathCounters::default();
         let mut order = st.order;
-        let end = walk.walk(
-            start,
-            dir,
-            from,
-            &mut order,
-            rng,
-            counters,
-            |p, d_in, k, rng| {
-                scattered = true;
-                if nee && filter.counts(k) {
-                    let g = material.g;
-                    let ld = self.direct(
-                        p,
-                        |_| p,
-                        |wi| {
-                            let f = bssrdf_core::hg::phase(d_in.dot(wi), g);
-                            (f, f)
-                        },
-                        channels,
-                        Some(object),
-                        rng,
-                        &mut nee_counters,
-                    );
-                    added += beta * ld.l;
+        let mut q = Rgb::ONE;
+        let on_scatter = |p: DVec3, d_in: DVec3, k: u32, q: Rgb, rng: &mut Rng| {
+            scattered = true;
+            if nee && filter.counts(k) {
+                let g = material.g;
+                let ld = self.direct(
+                    p,
+                    |_| p,
+                    |wi| {
+                        let f = bssrdf_core::hg::phase(d_in.dot(wi), g);
+                        (f, f)
+                    },
+                    Some(object),
+                    rng,
+                    &mut nee_counters,
+                );
+                if !ld.l.is_zero() {
+                    // The throughput at this vertex, weighted over the heroes.
+                    added += carried(beta, r_u, q).0 * ld.l;
                 }
-            },
-        );
+            }
+        };
+        let end = match st.hero {
+            Some(hero) if !grey => {
+                let flight = HeroTracking {
+                    medium: SpectralView::new(&material.medium),
+                    hero,
+                };
+                self.walk_with(
+                    object, material, &flight, start, dir, from, &mut order, &mut q, rng, counters,
+                    on_scatter,
+                )
+            }
+            _ => {
+                let flight = ChannelView::new(&material.medium, 0);
+                self.walk_with(
+                    object, material, &flight, start, dir, from, &mut order, &mut q, rng, counters,
+                    on_scatter,
+                )
+            }
+        };
         counters.merge(&nee_counters);
-        st.l += st.mask(added);
+        st.l += added;
+        st.carry(q);
         st.order = order;
         // A scattering vertex without light sampling (η > 1) leaves nothing to weigh against.
         let prev = |last_scatter: Option<(DVec3, f64)>| match last_scatter {
@@ -1161,6 +1178,33 @@ impl<'s> PathIntegrator<'s> {
             }
             WalkEnd::Absorbed | WalkEnd::Capped | WalkEnd::Leaked => Step::Stop,
         }
+    }
+
+    /// The walk of [`Self::traverse`] in `object` with the free-flight sampler `flight`
+    /// ([`WalkMedium::walk_carrying`]), `q` collecting the walk's density ratios.
+    #[allow(clippy::too_many_arguments)]
+    fn walk_with<M: FreeFlight>(
+        &self,
+        object: u32,
+        material: &Translucent,
+        flight: &M,
+        start: DVec3,
+        dir: DVec3,
+        from: Option<(DVec3, f64)>,
+        order: &mut u32,
+        q: &mut Rgb,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+        on_scatter: impl FnMut(DVec3, DVec3, u32, Rgb, &mut Rng),
+    ) -> WalkEnd {
+        WalkMedium {
+            geometry: self.scene.geometry(),
+            object,
+            medium: flight,
+            g: material.g,
+            interface: Interface { eta: material.eta },
+        }
+        .walk_carrying(start, dir, from, order, q, rng, counters, on_scatter)
     }
 
     /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then incident points x_i from
@@ -1232,7 +1276,6 @@ impl<'s> PathIntegrator<'s> {
                     let pdf = wi.dot(x_i.ns).max(0.0) / std::f64::consts::PI;
                     (b.entry_lobe(cos) * cos, pdf)
                 },
-                Channels::All,
                 None,
                 rng,
                 counters,

@@ -54,10 +54,16 @@
 //!   symmetries imposed and the azimuthal dependence kept to its first harmonic
 //!   ([`Sums::regularised`]); f is interpolated from the points the same way at render time.
 //!
+//! In a heterogeneous medium that the walks go through, B weighs each probe pair at the
+//! estimator's coefficients for it, on the body and on the tangent plane (whose half-space
+//! holds the same field), as the render does; so c measures what the shape does to the
+//! BSSRDF actually rendered, whose light reaches as far as the averaged coefficients say
+//! (with x_o's own coefficients instead, a point in an absorbing stripe next to clear ones was
+//! corrected for a short profile while the render used a long one). A uniform or UV-mapped
+//! medium keeps x_o's coefficients, in which its walks scatter too.
+//!
 //! What it does not correct: the spatial and angular distribution of non-uniform light (c is
-//! exact for uniform light, a first-order correction otherwise), and nothing of the
-//! estimators' averaging (B uses the coefficients at x_o, not the estimates; measured in
-//! docs/shapes.md, "Heterogeneous bodies").
+//! exact for uniform light, a first-order correction otherwise).
 
 use std::f64::consts::TAU;
 
@@ -455,9 +461,15 @@ impl ShapeCorrection {
                     steps
                         .step(|| {
                             sums.as_ref()?;
-                            Some(body_response(bssrdf, &surface, x, *coeffs, key(i), |x_i| {
-                                corr.at(x_i.p, x_i.ns).incident_mean(&weights)
-                            }))
+                            Some(body_response(
+                                bssrdf,
+                                &surface,
+                                walk_medium,
+                                x,
+                                *coeffs,
+                                key(i),
+                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
+                            ))
                         })
                         .flatten()
                 })
@@ -718,15 +730,28 @@ fn point_sums(
             p_half[d] = Rgb::splat(p_half[d][0]);
         }
     }
-    // B: probes, all channels at once.
-    let b_body = body_response(bssrdf, surface, x_o, coeffs, key, |_| Rgb::ONE);
+    // B: probes, all channels at once; in a heterogeneous medium the walks go through, each
+    // pair weighed at the estimator's coefficients for it, on the body and on the plane (the
+    // half-space below it holds the same field), as the render weighs it.
+    let b_body = body_response(bssrdf, surface, field, x_o, coeffs, key, |_| Rgb::ONE);
     let mut b_half = Rgb::ZERO;
     let mut counters = PathCounters::default();
     for k in 0..PROBES_PER_POINT as u64 {
         let mut rng = key.rng(PointKey::PROBES, k);
         for hit in bssrdf.probe_set(&plane, x_o, coeffs, &mut rng).iter() {
             let r = (hit.hit.p - x_o.p).length();
-            b_half += counters.eval_profile(&bssrdf.family, coeffs, r) * hit.weight;
+            let c = match field {
+                Some(field) => {
+                    let mut own = Rng::from_keys(rng.next_u64(), &[]);
+                    let est = bssrdf
+                        .estimator
+                        .estimate(&plane, field, &hit.hit, x_o, &mut own);
+                    counters.record_estimate(&est.diagnostics);
+                    est.coefficients
+                }
+                None => coeffs,
+            };
+            b_half += counters.eval_profile(&bssrdf.family, c, r) * hit.weight;
         }
     }
     Sums {
@@ -851,11 +876,14 @@ impl Sums {
 
 /// Σ over [`PROBES_PER_POINT`] probe sets around x_o on the body of R(x_i, x_o)·g(x_i)/p(x_i)
 /// (per channel): B_body for g = 1, the body's response to uniform light with the incident
-/// factors of the current correction for g = ⟨f(x_i)⟩. The same probes for every g (and as
-/// the tangent plane's, common random numbers).
+/// factors of the current correction for g = ⟨f(x_i)⟩. R at x_o's coefficients `coeffs`, or,
+/// for a heterogeneous `field` (the one the walks go through), at the estimator's coefficients
+/// for each pair, as the render weighs it. The same probes for every g (and as the tangent
+/// plane's, common random numbers).
 fn body_response(
     bssrdf: &BssrdfObject,
     surface: &ObjectSurface<'_>,
+    field: Option<&MediumField>,
     x_o: &Hit,
     coeffs: Coefficients,
     key: PointKey,
@@ -866,7 +894,18 @@ fn body_response(
     for k in 0..PROBES_PER_POINT as u64 {
         let mut rng = key.rng(PointKey::PROBES, k);
         for hit in bssrdf.probe_set(surface, x_o, coeffs, &mut rng).iter() {
-            let (r, _) = bssrdf.weigh(surface, coeffs, &hit.hit, x_o, &mut counters);
+            let r = match field {
+                Some(field) => {
+                    bssrdf
+                        .profile(surface, field, &hit.hit, x_o, &mut rng, &mut counters)
+                        .rd
+                }
+                None => {
+                    bssrdf
+                        .weigh(surface, coeffs, &hit.hit, x_o, &mut counters)
+                        .0
+                }
+            };
             sum += r * g(&hit.hit) * hit.weight;
         }
     }
@@ -929,6 +968,23 @@ impl ProbeChords for TangentPlane {
         if (0.0..=t_max).contains(&t) {
             f(&self.hit(t, origin + t * dir));
         }
+    }
+}
+
+/// The tangent plane as the estimators' surface: a projection is the line's crossing with
+/// the plane (it meets it once, in one direction or the other), and the plane is flat.
+impl het_estimate::SurfaceQuery for TangentPlane {
+    type Point = Hit;
+    fn project(&self, origin: DVec3, dir: DVec3) -> Option<Hit> {
+        let dn = dir.dot(self.n);
+        if dn == 0.0 {
+            return None;
+        }
+        let t = (self.p0 - origin).dot(self.n) / dn;
+        t.is_finite().then(|| self.hit(t.abs(), origin + t * dir))
+    }
+    fn curvature(&self, _: &Hit) -> Option<het_estimate::Curvature> {
+        Some(het_estimate::Curvature::ZERO)
     }
 }
 

@@ -18,12 +18,13 @@
 //! it) guards against pathological inputs,
 //! and every capped path is counted ([`PathCounters::capped`]) rather than dropped silently.
 
+use bssrdf_core::Rgb;
 use glam::DVec3;
 
 use crate::geometry::{Geometry, Hit, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::rng::Rng;
-use crate::volume::{ChannelMedium, Interaction, TrackingCounters, sample_hg, sample_interaction};
+use crate::volume::{FreeFlight, Interaction, TrackingCounters, sample_hg};
 
 /// Collisions allowed in one walk before it is stopped and counted as capped, by default.
 pub const MAX_COLLISIONS: u64 = 100_000_000;
@@ -142,12 +143,13 @@ pub enum WalkEnd {
 }
 
 /// One object's medium as the walk sees it.
-pub struct WalkMedium<'a, M: ChannelMedium> {
+pub struct WalkMedium<'a, M: FreeFlight> {
     /// The scene geometry.
     pub geometry: &'a Geometry,
     /// The object's index.
     pub object: u32,
-    /// Coefficients of the traced channel.
+    /// The free-flight sampler: one channel ([`crate::volume::ChannelView`]) or every channel
+    /// with a hero ([`crate::spectral::HeroTracking`]).
     pub medium: &'a M,
     /// HG mean cosine.
     pub g: f64,
@@ -155,7 +157,7 @@ pub struct WalkMedium<'a, M: ChannelMedium> {
     pub interface: Interface,
 }
 
-impl<M: ChannelMedium> WalkMedium<'_, M> {
+impl<M: FreeFlight> WalkMedium<'_, M> {
     /// Walks from `start`, a point inside the medium (the entry hit's `spawn_origin(dir)`, or
     /// a point just off a surface inside it), along the unit direction `dir`, until the path
     /// leaves, meets another object's surface, is absorbed or is capped. `last_scatter` is the
@@ -168,23 +170,65 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
         &self,
         start: DVec3,
         dir: DVec3,
-        mut last_scatter: Option<(DVec3, f64)>,
+        last_scatter: Option<(DVec3, f64)>,
         order: &mut u32,
         rng: &mut Rng,
         counters: &mut PathCounters,
         mut on_scatter: impl FnMut(DVec3, DVec3, u32, &mut Rng),
+    ) -> WalkEnd {
+        let mut weight = Rgb::ONE;
+        self.walk_carrying(
+            start,
+            dir,
+            last_scatter,
+            order,
+            &mut weight,
+            rng,
+            counters,
+            |p, d, k, _, rng| on_scatter(p, d, k, rng),
+        )
+    }
+
+    /// [`WalkMedium::walk`] carrying the per-channel path weight `weight`, which every flight
+    /// multiplies ([`FreeFlight`]: unchanged for one channel, the density ratios to the hero
+    /// for hero tracking, up to a common factor); `on_scatter` also receives the weight at the
+    /// scattering vertex.
+    #[allow(clippy::too_many_arguments)]
+    pub fn walk_carrying(
+        &self,
+        start: DVec3,
+        dir: DVec3,
+        mut last_scatter: Option<(DVec3, f64)>,
+        order: &mut u32,
+        weight: &mut Rgb,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+        mut on_scatter: impl FnMut(DVec3, DVec3, u32, Rgb, &mut Rng),
     ) -> WalkEnd {
         let mut origin = start;
         let mut d = dir;
         let mut collisions = 0u64;
         let cap = collision_cap();
         let mut tracking = TrackingCounters::default();
+        let (lo, hi) = self.geometry.object_bounds(self.object);
         let end = loop {
-            let Some(boundary) = self.geometry.intersect(&Ray::new(origin, d)) else {
-                counters.leaks += 1;
-                break WalkEnd::Leaked;
+            // The flight first, up to where the ray leaves the object's bounding box; the scene
+            // only when the flight reaches a surface (see [`Self::flight`]).
+            let (interaction, boundary) = match self.flight(
+                origin,
+                d,
+                box_exit(origin, d, lo, hi),
+                rng,
+                &mut tracking,
+                weight,
+            ) {
+                Some(found) => found,
+                None => {
+                    counters.leaks += 1;
+                    break WalkEnd::Leaked;
+                }
             };
-            match sample_interaction(self.medium, origin, d, boundary.t, rng, &mut tracking) {
+            match interaction {
                 Interaction::Absorb { .. } => break WalkEnd::Absorbed,
                 Interaction::Scatter { t } => {
                     collisions += 1;
@@ -194,20 +238,21 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
                     }
                     let p = origin + t * d;
                     *order += 1;
-                    on_scatter(p, d, *order, rng);
+                    on_scatter(p, d, *order, *weight, rng);
                     let nd = sample_hg(d, self.g, rng);
                     last_scatter = Some((p, bssrdf_core::hg::phase(d.dot(nd), self.g)));
                     origin = p;
                     d = nd;
                 }
-                Interaction::Pass if boundary.object != self.object => {
+                Interaction::Pass if boundary.is_some_and(|b| b.object != self.object) => {
                     break WalkEnd::Surface {
-                        hit: boundary,
+                        hit: boundary.expect("a pass has its surface"),
                         dir: d,
                         last_scatter,
                     };
                 }
                 Interaction::Pass => {
+                    let boundary = boundary.expect("a pass has its surface");
                     if boundary.ng.dot(d) <= 0.0 {
                         // Seen from outside although we are inside: the origin sat numerically
                         // on the far side of a face. Step over the face and go on.
@@ -236,11 +281,249 @@ impl<M: ChannelMedium> WalkMedium<'_, M> {
         counters.add_tracking(&tracking);
         end
     }
+
+    /// One flight from `origin` along `d`: the next real interaction before the first surface
+    /// of the scene, with that surface when the flight reaches it (`Pass`); `None` when no
+    /// surface is found (the ray has leaked out of the closed object).
+    ///
+    /// The flight is sampled first, up to `t_box` (where the ray leaves the object's bounding
+    /// box, beyond which no surface that ends the walk can lie), and the scene is asked only
+    /// whether anything lies on the segment up to the sampled collision: inside a medium
+    /// most flights end in a collision far from any surface, and an occlusion query on a
+    /// short segment costs less than the closest hit of the whole ray. When a surface is on
+    /// the segment (or the flight reached `t_box`), the flight is sampled again up to the
+    /// closest hit with the same random numbers: its tentative collisions are the same up to
+    /// that surface, where it passes, and it leaves `rng` and `weight` exactly as sampling
+    /// up to the surface from the start does. The outcome is therefore the same sample as
+    /// delta tracking against the closest hit, random number for random number (up to the
+    /// rounding of the two hit tests, for a collision within it of a surface).
+    fn flight(
+        &self,
+        origin: DVec3,
+        d: DVec3,
+        t_box: f64,
+        rng: &mut Rng,
+        tracking: &mut TrackingCounters,
+        weight: &mut Rgb,
+    ) -> Option<(Interaction, Option<Hit>)> {
+        if t_box > 0.0 {
+            let (saved_rng, saved_weight) = (rng.clone(), *weight);
+            let sampled = self
+                .medium
+                .sample_flight(origin, d, t_box, rng, tracking, weight);
+            match sampled {
+                Interaction::Scatter { t } | Interaction::Absorb { t }
+                    if !self.geometry.occluded(&Ray::with_range(origin, d, 0.0, t)) =>
+                {
+                    return Some((sampled, None));
+                }
+                _ => {
+                    // (The tentative collisions drawn stay counted: they were work done.)
+                    *rng = saved_rng;
+                    *weight = saved_weight;
+                }
+            }
+        }
+        let boundary = self.geometry.intersect(&Ray::new(origin, d))?;
+        let sampled = self
+            .medium
+            .sample_flight(origin, d, boundary.t, rng, tracking, weight);
+        Some((sampled, Some(boundary)))
+    }
+}
+
+/// The distance along `origin + t·d` at which the ray leaves the box `[lo, hi]` (slab test),
+/// 0 when `origin` is outside it (or anything is NaN).
+#[inline]
+fn box_exit(origin: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> f64 {
+    let mut far = f64::INFINITY;
+    for k in 0..3 {
+        let (o, lo, hi) = (origin[k], lo[k], hi[k]);
+        // `!(lo <= o && o <= hi)` is also true for NaN.
+        if !(lo <= o && o <= hi) {
+            return 0.0;
+        }
+        // Moving along this axis, the ray leaves through the face it moves toward; parallel
+        // to it (d = 0), never through this pair of faces.
+        let exit = if d[k] > 0.0 {
+            (hi - o) / d[k]
+        } else if d[k] < 0.0 {
+            (lo - o) / d[k]
+        } else {
+            f64::INFINITY
+        };
+        far = far.min(exit);
+    }
+    far
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::camera::Camera;
+    use crate::field::{Axis, Field, MediumField, PlanarProjection};
+    use crate::geometry::primitives;
+    use crate::light::Light;
+    use crate::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
+    use crate::spectral::{HeroTracking, SpectralView};
+
+    #[test]
+    fn box_exit_is_the_nearest_far_face_and_zero_outside() {
+        let (lo, hi) = (DVec3::splat(-1.0), DVec3::splat(1.0));
+        assert_eq!(box_exit(DVec3::ZERO, DVec3::X, lo, hi), 1.0);
+        let d = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!((box_exit(DVec3::new(0.5, 0.0, 0.0), d, lo, hi) - 0.5 * 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(box_exit(DVec3::new(2.0, 0.0, 0.0), DVec3::X, lo, hi), 0.0);
+        assert_eq!(
+            box_exit(DVec3::new(2.0, 0.0, 0.0), DVec3::NEG_X, lo, hi),
+            0.0
+        );
+        // On a face: along its plane, or out through it.
+        assert_eq!(box_exit(DVec3::new(0.0, 1.0, 0.0), DVec3::X, lo, hi), 1.0);
+        assert_eq!(box_exit(DVec3::new(0.0, 1.0, 0.0), DVec3::Y, lo, hi), 0.0);
+        assert_eq!(box_exit(DVec3::splat(f64::NAN), DVec3::X, lo, hi), 0.0);
+    }
+
+    /// A chromatic checked sphere (radius 1.5, η 1.3) with an opaque cube inside it.
+    fn sphere_with_core() -> Scene {
+        let projection = PlanarProjection::new(Axis::Z, DVec3::ZERO);
+        let sigma_a = Field::check(
+            0.4,
+            [Rgb::new(0.05, 0.2, 0.5), Rgb::new(1.0, 0.3, 0.1)],
+            projection,
+        )
+        .unwrap();
+        let sigma_s = Field::constant(Rgb::new(2.0, 3.0, 4.0)).unwrap();
+        let medium = MediumField::new(sigma_a, sigma_s);
+        let camera =
+            Camera::orthographic(DVec3::Z * 5.0, DVec3::NEG_Z, DVec3::Y, 4.0, 4.0, 8, 8).unwrap();
+        SceneBuilder::new(RenderSettings::new(8, 8, 1), camera)
+            .light(Light::environment(Rgb::ONE).unwrap())
+            .object(
+                "ball",
+                primitives::icosphere(DVec3::ZERO, 1.5, 3),
+                Material::Translucent(Translucent::new("m", medium, 0.3, 1.3)),
+            )
+            .object(
+                "core",
+                primitives::cuboid(DVec3::splat(-0.3), DVec3::splat(0.3)),
+                Material::Diffuse {
+                    albedo: Rgb::splat(0.5),
+                },
+            )
+            .build()
+            .unwrap()
+    }
+
+    /// The walk as delta tracking against the closest hit of every flight (what
+    /// [`WalkMedium::flight`] must reproduce): the boundary first, then the flight up to it.
+    fn closest_hit_walk<M: FreeFlight>(
+        walk: &WalkMedium<'_, M>,
+        start: DVec3,
+        dir: DVec3,
+        weight: &mut Rgb,
+        rng: &mut Rng,
+    ) -> WalkEnd {
+        let (mut origin, mut d, mut last) = (start, dir, None);
+        let mut tracking = TrackingCounters::default();
+        loop {
+            let Some(b) = walk.geometry.intersect(&Ray::new(origin, d)) else {
+                return WalkEnd::Leaked;
+            };
+            match walk
+                .medium
+                .sample_flight(origin, d, b.t, rng, &mut tracking, weight)
+            {
+                Interaction::Absorb { .. } => return WalkEnd::Absorbed,
+                Interaction::Scatter { t } => {
+                    let p = origin + t * d;
+                    let nd = sample_hg(d, walk.g, rng);
+                    last = Some((p, bssrdf_core::hg::phase(d.dot(nd), walk.g)));
+                    (origin, d) = (p, nd);
+                }
+                Interaction::Pass if b.object != walk.object => {
+                    return WalkEnd::Surface {
+                        hit: b,
+                        dir: d,
+                        last_scatter: last,
+                    };
+                }
+                Interaction::Pass => {
+                    if b.ng.dot(d) <= 0.0 {
+                        origin = b.spawn_origin(d);
+                        continue;
+                    }
+                    match walk.interface.cross(d, b.ng, rng) {
+                        Crossing::Transmit(out) => {
+                            return WalkEnd::Exited {
+                                hit: b,
+                                dir: out,
+                                last_scatter: last,
+                            };
+                        }
+                        Crossing::Reflect(r) => {
+                            last = None;
+                            origin = b.spawn_origin(r);
+                            d = r;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sampling each flight first and querying the scene only on its segment gives the walks
+    /// of delta tracking against the closest hit, random number for random number: the same
+    /// ends, weights and random streams afterwards, for 3000 walks in a chromatic sphere
+    /// (hero tracking) with a surface inside.
+    #[test]
+    fn flights_first_walk_as_closest_hit_tracking_does() {
+        let scene = sphere_with_core();
+        let Material::Translucent(t) = &scene.objects()[0].material else {
+            unreachable!()
+        };
+        let (mut surfaces, mut exits) = (0, 0);
+        for k in 0..3000u64 {
+            let flight = HeroTracking {
+                medium: SpectralView::new(&t.medium),
+                hero: (k % 3) as usize,
+            };
+            let walk = WalkMedium {
+                geometry: scene.geometry(),
+                object: 0,
+                medium: &flight,
+                g: t.g,
+                interface: Interface { eta: t.eta },
+            };
+            let entry = scene
+                .geometry()
+                .intersect(&Ray::new(DVec3::new(0.1, -0.2, 5.0), DVec3::NEG_Z))
+                .unwrap();
+            let start = entry.spawn_origin(DVec3::NEG_Z);
+            let (mut a, mut b) = (Rng::from_keys(7, &[k]), Rng::from_keys(7, &[k]));
+            let (mut wa, mut wb) = (Rgb::ONE, Rgb::ONE);
+            let mut order = 0;
+            let mut counters = PathCounters::default();
+            let end = walk.walk_carrying(
+                start,
+                DVec3::NEG_Z,
+                None,
+                &mut order,
+                &mut wa,
+                &mut a,
+                &mut counters,
+                |_, _, _, _, _| {},
+            );
+            let want = closest_hit_walk(&walk, start, DVec3::NEG_Z, &mut wb, &mut b);
+            assert_eq!(end, want, "walk {k}");
+            assert_eq!(wa, wb, "walk {k}");
+            assert_eq!(a.next_u64(), b.next_u64(), "walk {k}");
+            surfaces += matches!(end, WalkEnd::Surface { .. }) as u32;
+            exits += matches!(end, WalkEnd::Exited { .. }) as u32;
+        }
+        // Both kinds of pass happened.
+        assert!(surfaces > 100 && exits > 100, "{surfaces} {exits}");
+    }
 
     #[test]
     fn refraction_obeys_snell_and_tir() {

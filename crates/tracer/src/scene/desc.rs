@@ -532,5 +532,8 @@ shape_desc!(
         shape_correction: Option<bool>,
         /// A glTF shape without `material` only: their `shape_correction_seed`.
         shape_correction_seed: Option<u64>,
+        /// glTF only: let the file's buffer and image URIs name files outside its own folder
+        /// (default false; see [`crate::geometry::gltf_assets`]).
+        allow_outside_assets: Option<bool>,
     }
 );

@@ -29,9 +29,33 @@ use crate::light::{Light, LightError};
 
 const SECTIONS: &[&str] = &["render", "camera", "texture", "material", "light", "shape"];
 
+/// How a scene file is loaded.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct LoadOptions {
+    /// Let every glTF file's buffer and image URIs name files outside the glTF file's own
+    /// folder (the command line's `--allow-outside-assets`; a shape's `allow_outside_assets =
+    /// true` allows it for that shape). Default: refused, since a glTF file downloaded from the
+    /// web is untrusted input ([`crate::geometry::gltf_assets`]).
+    pub allow_outside_assets: bool,
+}
+
+impl LoadOptions {
+    /// These options with `allow_outside_assets` set to `allow`.
+    pub fn allow_outside_assets(mut self, allow: bool) -> Self {
+        self.allow_outside_assets = allow;
+        self
+    }
+}
+
 impl Scene {
     /// Loads a scene file; relative paths inside it are relative to its directory.
     pub fn load(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+        Self::load_with(path, LoadOptions::default())
+    }
+
+    /// [`Scene::load`] with `options`.
+    pub fn load_with(path: impl AsRef<Path>, options: LoadOptions) -> Result<Scene, SceneError> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
             file: path.to_path_buf(),
@@ -41,7 +65,8 @@ impl Scene {
             source,
         })?;
         let base = path.parent().unwrap_or(Path::new("."));
-        let mut scene = Self::from_toml_str(&text, base, &path.display().to_string())?;
+        let mut scene =
+            Self::from_toml_str_with(&text, base, &path.display().to_string(), options)?;
         scene.source_path = Some(path.to_path_buf());
         Ok(scene)
     }
@@ -52,6 +77,16 @@ impl Scene {
         text: &str,
         base_dir: &Path,
         display_name: &str,
+    ) -> Result<Scene, SceneError> {
+        Self::from_toml_str_with(text, base_dir, display_name, LoadOptions::default())
+    }
+
+    /// [`Scene::from_toml_str`] with `options`.
+    pub fn from_toml_str_with(
+        text: &str,
+        base_dir: &Path,
+        display_name: &str,
+        options: LoadOptions,
     ) -> Result<Scene, SceneError> {
         let file = PathBuf::from(display_name);
         let root = DeTable::parse(text).map_err(|e| {
@@ -72,6 +107,7 @@ impl Scene {
             loc,
             inputs: Default::default(),
             notes: Default::default(),
+            options,
         };
         cx.load(&root, display_name)
     }
@@ -86,6 +122,7 @@ struct Cx {
     inputs: std::cell::RefCell<Vec<PathBuf>>,
     /// What was read but cannot be honoured (glTF material notes).
     notes: std::cell::RefCell<Vec<String>>,
+    options: LoadOptions,
 }
 
 type Val<'i> = Spanned<DeValue<'i>>;
@@ -123,9 +160,15 @@ impl Cx {
     }
 
     /// Refuses, before they are generated, primitives whose `triangles` so far would not fit
-    /// in memory (see [`crate::memory`]).
-    fn check_tessellation(&self, triangles: f64, key: &str) -> Result<(), SceneError> {
-        crate::memory::check(
+    /// in `room` (see [`crate::memory`]).
+    fn check_tessellation(
+        &self,
+        room: crate::memory::Headroom,
+        triangles: f64,
+        key: &str,
+    ) -> Result<(), SceneError> {
+        crate::memory::check_within(
+            room,
             || {
                 format!(
                     "the scene's primitives ({:.1} million triangles)",
@@ -875,10 +918,12 @@ impl Cx {
         let mut out: Vec<ShapePlan> = Vec::new();
         let mut names = HashSet::new();
         let shapes = self.elements(t, "shape")?;
-        // The primitives' triangles, counted before any is generated.
+        // The primitives' triangles, counted before any is generated; the limits are read
+        // once (a check per shape read them 100,000 times for as many boxes).
+        let room = crate::memory::headroom();
         let mut tessellated = 0.0;
         for (key, v) in &shapes {
-            tessellated += match self.type_of(v, key, KINDS)? {
+            let added = match self.type_of(v, key, KINDS)? {
                 "sphere" => {
                     let d: SphereDesc = self.de(v, key)?;
                     20.0 * 4f64.powi(d.subdivisions.unwrap_or(5).min(9) as i32)
@@ -887,9 +932,10 @@ impl Cx {
                     let d: HalfSpaceDesc = self.de(v, key)?;
                     2.0 * f64::from(d.subdivisions.unwrap_or(32).min(1024)).powi(2) + 10.0
                 }
-                _ => 0.0,
+                _ => continue,
             };
-            self.check_tessellation(tessellated, &format!("{key}.subdivisions"))?;
+            tessellated += added;
+            self.check_tessellation(room, tessellated, &format!("{key}.subdivisions"))?;
         }
         for (i, (key, v)) in shapes.into_iter().enumerate() {
             let k = |sub: &str| format!("{key}.{sub}");
@@ -987,6 +1033,20 @@ impl Cx {
                              turns off: remove one of the two",
                         ));
                     }
+                    if d.allow_outside_assets.is_some() && kind != "gltf" {
+                        return Err(self.invalid(
+                            &k("allow_outside_assets"),
+                            "only a glTF shape reads external files by URI",
+                        ));
+                    }
+                    #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
+                    let scope = if d.allow_outside_assets.unwrap_or(false)
+                        || self.options.allow_outside_assets
+                    {
+                        crate::geometry::gltf_assets::AssetScope::Anywhere
+                    } else {
+                        crate::geometry::gltf_assets::AssetScope::ModelFolder
+                    };
                     let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
                     self.check_readable(&k("path"), &path)?;
@@ -998,8 +1058,11 @@ impl Cx {
                     };
                     #[cfg(feature = "gltf")]
                     if kind == "gltf" && common.material.is_none() {
-                        let mut model =
-                            crate::geometry::gltf::load_gltf_parts(&path).map_err(mesh_error)?;
+                        let mut model = crate::geometry::gltf::load_gltf_parts_with(&path, scope)
+                            .map_err(mesh_error)?;
+                        self.inputs
+                            .borrow_mut()
+                            .extend_from_slice(model.files_read());
                         let shape = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
                         let xf = self.shape_transform(&common, &key)?;
                         let scale = xf.map_or(DVec3::ONE, |t| t.scale);
@@ -1038,7 +1101,7 @@ impl Cx {
                         }
                         continue;
                     }
-                    let mesh = self.load_mesh(kind, &path).map_err(mesh_error)?;
+                    let mesh = self.load_mesh(kind, &path, scope).map_err(mesh_error)?;
                     (common, mesh, path.display().to_string())
                 }
                 other => {
@@ -1134,6 +1197,9 @@ impl Cx {
                         let tex = match images.get(&texture.image) {
                             Some(t) => t.clone(),
                             None => {
+                                if let Some(file) = model.image_file(texture.image) {
+                                    self.inputs.borrow_mut().push(file.to_path_buf());
+                                }
                                 let t = model.decode_image(texture.image).map_err(|source| {
                                     SceneError::Texture {
                                         file: self.file.clone(),
@@ -1210,13 +1276,25 @@ impl Cx {
         Ok(())
     }
 
-    fn load_mesh(&self, kind: &str, path: &Path) -> Result<TriangleMesh, crate::error::MeshError> {
+    /// Loads a mesh file; a glTF file's external files (read within `scope`) are added to
+    /// the scene's inputs.
+    #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
+    fn load_mesh(
+        &self,
+        kind: &str,
+        path: &Path,
+        scope: crate::geometry::gltf_assets::AssetScope,
+    ) -> Result<TriangleMesh, crate::error::MeshError> {
         let file = path.display().to_string();
         match kind {
             #[cfg(feature = "obj")]
             "obj" => crate::geometry::obj::load_obj(path),
             #[cfg(feature = "gltf")]
-            "gltf" => crate::geometry::gltf::load_gltf(path),
+            "gltf" => {
+                let (mesh, files) = crate::geometry::gltf::load_gltf_with(path, scope)?;
+                self.inputs.borrow_mut().extend(files);
+                Ok(mesh)
+            }
             #[cfg(feature = "ply")]
             "ply" => crate::geometry::ply::load_ply(path),
             _ => Err(crate::error::MeshError::Unsupported {

@@ -6,14 +6,22 @@
 //! with the position where it starts, and a position belongs to the last key starting at or
 //! before it.
 
+use std::collections::HashMap;
+
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 /// Every key path of a document with its start offset, plus the text for line numbers.
+///
+/// [`Locator::line_of_key`] is a hash lookup (a scene of N shapes asks it for each shape: a
+/// scan of the key list made loading quadratic, 100,000 boxes taking over 20 minutes);
+/// [`Locator::key_at`] scans the list, but only errors ask it.
 #[derive(Debug, Default)]
 pub(crate) struct Locator {
     /// `(start offset, key path)`, in document order of traversal.
     keys: Vec<(usize, String)>,
+    /// Key path → start offset of its first occurrence in `keys`.
+    by_path: HashMap<String, usize>,
     /// Offsets of line starts.
     line_starts: Vec<usize>,
 }
@@ -22,9 +30,17 @@ impl Locator {
     pub fn new(text: &str, root: &Spanned<DeTable<'_>>) -> Self {
         let mut keys = Vec::new();
         collect_table(root.get_ref(), "", &mut keys);
+        let mut by_path = HashMap::with_capacity(keys.len());
+        for (pos, path) in &keys {
+            by_path.entry(path.clone()).or_insert(*pos);
+        }
         let mut line_starts = vec![0];
         line_starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        Self { keys, line_starts }
+        Self {
+            keys,
+            by_path,
+            line_starts,
+        }
     }
 
     /// A locator with no document (builder scenes).
@@ -59,7 +75,7 @@ impl Locator {
     pub fn line_of_key(&self, key: &str) -> Option<usize> {
         let mut k = key;
         loop {
-            if let Some((pos, _)) = self.keys.iter().find(|(_, p)| p == k) {
+            if let Some(pos) = self.by_path.get(k) {
                 return self.line_of(*pos);
             }
             // Strip the last segment: `.name` or `[i]`.

@@ -51,6 +51,7 @@ mod overlap;
 pub mod desc;
 
 pub use builder::SceneBuilder;
+pub use load::LoadOptions;
 
 use std::path::{Path, PathBuf};
 
