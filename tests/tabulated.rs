@@ -561,7 +561,7 @@ fn angular_coupling_gives_the_exact_response_to_a_uniform_sky() {
     for eta in [1.0, 1.3, 1.6] {
         let c = 1.0 - 2.0 * fresnel_moment(1, 1.0 / eta);
         for (single, sc) in [(true, Scattering::All), (false, Scattering::Multiple)] {
-            let coupling = AngularCoupling::new(eta, single, true).unwrap();
+            let coupling = AngularCoupling::new(eta, sc);
             let family = ProfileFamily::new(ProfileModel::Tabulated, sc, 0.0, eta).unwrap();
             for row in (0..N_ALBEDO).step_by(2) {
                 let alpha = albedo_of_row(row);
