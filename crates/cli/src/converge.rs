@@ -241,7 +241,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .expect("clap requires a scene without --beam");
     let scene = Scene::load_with(
         file,
-        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+        tracer::scene::LoadOptions::default().with_allow_outside_assets(args.allow_outside_assets),
     )?;
     let mut base = RenderJob::from_scene(&scene, Method::PathTraced);
     if given.has("scattering") {

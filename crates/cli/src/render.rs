@@ -120,7 +120,7 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = Scene::load_with(
         &args.scene,
-        tracer::scene::LoadOptions::default().allow_outside_assets(args.allow_outside_assets),
+        tracer::scene::LoadOptions::default().with_allow_outside_assets(args.allow_outside_assets),
     )?;
     let scene = match args.invert {
         Some(at) => scene.with_invert(at),

@@ -248,7 +248,7 @@ impl CoefficientField<PlanePoint> for RampField {
             return None;
         }
         let along = |v: DVec3| v - n * (v.z / n.z); // projection of a vector onto z = 0
-        let c = along(e.center);
+        let c = along(e.centre);
         let (u, v) = (along(e.semi_major), along(e.semi_minor));
         let ok = self.ramps().all(|q| {
             let (gu, gv) = (

@@ -123,7 +123,7 @@ impl Chord {
     /// axis `b` along n_i* × x̂, centred at m (b = d/2 gives the step-1 disk).
     pub fn ellipse(&self, b: f64) -> PlanarEllipse {
         PlanarEllipse {
-            center: self.mid,
+            centre: self.mid,
             semi_major: self.half_len * self.x_hat,
             semi_minor: b * self.minor_dir,
             normal: self.normal,

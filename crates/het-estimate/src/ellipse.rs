@@ -3,7 +3,7 @@
 
 use glam::{DVec2, DVec3};
 
-/// An ellipse in a plane of scene space: `center + s·semi_major + t·semi_minor` for
+/// An ellipse in a plane of scene space: `centre + s·semi_major + t·semi_minor` for
 /// `s² + t² ≤ 1`.
 ///
 /// Invariants kept by the estimators that build it: `semi_major`, `semi_minor` and `normal`
@@ -11,13 +11,13 @@ use glam::{DVec2, DVec3};
 /// required (Eq. (2) can give w > d for σa = 0 and long chords), and either semi-axis may have
 /// length zero (a degenerate ellipse: a segment or a point).
 ///
-/// For the Sone estimator (paper §3.1): `center` is the chord midpoint m = (x_i + x_o)/2,
+/// For the Sone estimator (paper §3.1): `centre` is the chord midpoint m = (x_i + x_o)/2,
 /// `semi_major` = (d/2)·x̂ along the chord, `semi_minor` = b·(n_i* × x̂), `normal` = n_i*
 /// (FHK14's modified normal). The step-1 disk is the same type with b = d/2.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarEllipse {
     /// Centre of the ellipse (scene units).
-    pub center: DVec3,
+    pub centre: DVec3,
     /// Semi-major axis vector (its length is the semi-axis length a).
     pub semi_major: DVec3,
     /// Semi-minor axis vector (its length is the semi-axis length b), orthogonal to
@@ -33,7 +33,7 @@ impl PlanarEllipse {
     /// its Jacobian `a·b` is constant).
     #[inline]
     pub fn point(&self, unit: DVec2) -> DVec3 {
-        self.center + unit.x * self.semi_major + unit.y * self.semi_minor
+        self.centre + unit.x * self.semi_major + unit.y * self.semi_minor
     }
 
     /// Area π·a·b (scene units²).

@@ -441,7 +441,7 @@ mod tests {
         assert_eq!(m.height(DVec3::new(5.0, -3.0, 0.0)), 0.0);
         assert_eq!(
             m.model_error(&PlanarEllipse {
-                center: DVec3::ZERO,
+                centre: DVec3::ZERO,
                 semi_major: DVec3::X,
                 semi_minor: DVec3::Y,
                 normal: DVec3::Z,

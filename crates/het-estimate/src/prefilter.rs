@@ -227,7 +227,7 @@ impl PlaneFootprint {
     /// (applied to the centre and to both semi-axis vectors), uniformly weighted.
     pub fn of_ellipse(e: &PlanarEllipse, to_plane: impl Fn(DVec3) -> DVec2) -> Self {
         Self {
-            centre: to_plane(e.center),
+            centre: to_plane(e.centre),
             axis_u: to_plane(e.semi_major),
             axis_v: to_plane(e.semi_minor),
             weight: FootprintWeight::Uniform,

@@ -141,7 +141,7 @@ impl ImageField {
         }
         let (w, h) = (self.texture.width as f64, self.texture.height as f64);
         let (c, a, b) = (
-            chart.uv_at(e.center),
+            chart.uv_at(e.centre),
             chart.map_vector(e.semi_major),
             chart.map_vector(e.semi_minor),
         );
@@ -1192,7 +1192,7 @@ mod tests {
         let major = normal.any_orthonormal_vector();
         let minor = normal.cross(major);
         let e = PlanarEllipse {
-            center: DVec3::new(3.0, 1.0, -2.0),
+            centre: DVec3::new(3.0, 1.0, -2.0),
             semi_major: 5.0 * major,
             semi_minor: 2.0 * minor,
             normal,
@@ -1213,7 +1213,7 @@ mod tests {
                         break u;
                     }
                 };
-                let v = field.at_point(e.center + u.x * e.semi_major + u.y * e.semi_minor);
+                let v = field.at_point(e.centre + u.x * e.semi_major + u.y * e.semi_minor);
                 ones += (v == b) as usize;
             }
             let mc = ones as f64 / n as f64;
@@ -1256,12 +1256,12 @@ mod tests {
         let normal = DVec3::new(0.1, -0.2, 1.0).normalize();
         let major = normal.cross(DVec3::new(1.0, 0.4, 0.0)).normalize();
         let minor = normal.cross(major);
-        for (semi_major, semi_minor, center) in [
+        for (semi_major, semi_minor, centre) in [
             (2.3, 1.0, DVec3::new(1.5, 0.9, 0.0)),
             (0.6, 0.35, DVec3::new(-1.8, -1.1, 0.0)),
         ] {
             let e = PlanarEllipse {
-                center,
+                centre,
                 semi_major: semi_major * major,
                 semi_minor: semi_minor * minor,
                 normal,
@@ -1291,7 +1291,7 @@ mod tests {
                                 break u;
                             }
                         };
-                        let v = field.at_point(e.center + u.x * e.semi_major + u.y * e.semi_minor);
+                        let v = field.at_point(e.centre + u.x * e.semi_major + u.y * e.semi_minor);
                         sum += v;
                         sq += v * v;
                     }

@@ -101,7 +101,7 @@ impl PlanarProjection {
             let (s, t) = self.st_vector(v);
             DVec2::new(s, t)
         });
-        let (s, t) = self.st(e.center);
+        let (s, t) = self.st(e.centre);
         fp.centre = DVec2::new(s, t);
         fp
     }

@@ -42,7 +42,7 @@ pub struct LoadOptions {
 
 impl LoadOptions {
     /// These options with `allow_outside_assets` set to `allow`.
-    pub fn allow_outside_assets(mut self, allow: bool) -> Self {
+    pub fn with_allow_outside_assets(mut self, allow: bool) -> Self {
         self.allow_outside_assets = allow;
         self
     }
