@@ -1,5 +1,6 @@
-//! Analytic implementations of the two traits, for tests, benchmarks and the beam
-//! experiments: the infinite plane z = 0 and closed-form coefficient fields over it.
+//! Analytic implementations of the two traits, for tests, examples, benchmarks, the beam
+//! experiments and the Python bindings: the infinite plane z = 0 and closed-form coefficient
+//! fields over it.
 //!
 //! The plane's outward normal is +z (the medium fills z < 0). Fields are functions of the
 //! point's (x, y), using the shared definitions of [`crate::pattern`].

@@ -17,8 +17,8 @@
 //!   checks, and the fallback criterion on curved surfaces; a field read through texture
 //!   coordinates averages through the region's [`UvChart`], which the surface provides). Geometry and texturing are separate because they vary separately
 //!   (one mesh, many textures; one procedural field, many shapes), and because tests and
-//!   benchmarks substitute analytic versions of each (module `analytic`, behind the
-//!   `fixtures` feature). The point type is the
+//!   benchmarks substitute analytic versions of each (module [`analytic`]: the plane z = 0 and
+//!   closed-form fields over it, also what the Python bindings estimate over). The point type is the
 //!   renderer's (`SurfaceQuery::Point`), so a lookup can use triangle ids and UVs.
 //! * **A closed set, resolved once.** [`Estimator`] is an enum (names `jensen-in`,
 //!   `jensen-out`, `endpoints`, `segment`, `sone`, `kernel`); [`Estimator::prepare`] validates it
@@ -45,7 +45,6 @@
 #[macro_use]
 pub mod names;
 
-#[cfg(feature = "fixtures")]
 pub mod analytic;
 pub mod budget;
 mod chord;
