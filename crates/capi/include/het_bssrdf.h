@@ -133,7 +133,7 @@ extern "C" {
 
 /**
  * Prepares a material: the profile `model` (`"dipole"`, `"pbd"`, `"better-dipole"`,
- * `"directional-dipole"`, `"tabulated"`), the orders counted (`scattering`: `"single"`,
+ * `"tabulated"`), the orders counted (`scattering`: `"single"`,
  * `"multiple"`, `"all"`), the estimator (`"jensen-in"`, `"jensen-out"`, `"endpoints"`,
  * `"segment"`, `"sone"`, `"kernel"`, with default parameters), the Henyey–Greenstein mean
  * cosine `g` (|g| < 1) and the relative index of refraction `eta` (in [1, 3]; at most 1.6

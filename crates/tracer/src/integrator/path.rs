@@ -765,7 +765,7 @@ impl<'s> PathIntegrator<'s> {
                 if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
                     break;
                 }
-                st.beta = st.beta / q;
+                st.beta /= q;
             }
         }
         st.l
