@@ -25,7 +25,7 @@ use het_bssrdf::het_estimate::pattern::{BinaryPattern, Stripe};
 use het_bssrdf::het_estimate::prefilter::{FootprintWeight, PlaneFootprint, stripe_fraction};
 use het_bssrdf::het_estimate::{KernelParams, SplitMix64, UniformSource};
 
-use glam::DVec2;
+use bssrdf_core::glam::DVec2;
 
 /// The stripe preset's σa values (σs = 1).
 const VALUES: [f64; 2] = [0.005, 0.1];

@@ -46,7 +46,7 @@ fn main() {
                         .with_samples(SampleBudget::fixed(samples))
                         .with_exponent(exponent),
                 ),
-                sidecar: serde_json::json!({
+                sidecar: experiments::serde_json::json!({
                     "iterations": iterations,
                     "samples": samples,
                     "exponent": exponent,

@@ -19,7 +19,7 @@
 
 use std::time::Instant;
 
-use glam::DVec3;
+use bssrdf_core::glam::DVec3;
 use het_bssrdf::tracer::geometry::{Geometry, Ray, primitives};
 use het_bssrdf::tracer::rng::Rng;
 use het_bssrdf::tracer::scene::Scene;

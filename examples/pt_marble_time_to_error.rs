@@ -71,7 +71,7 @@ fn main() {
         scenes.push(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/scenes/marble.toml").into());
     }
     if let Some(threads) = threads {
-        rayon::ThreadPoolBuilder::new()
+        tracer::rayon::ThreadPoolBuilder::new()
             .num_threads(threads as usize)
             .build_global()
             .unwrap();

@@ -32,7 +32,7 @@ fn main() {
     let spp = args.first().copied().unwrap_or(8);
     let runs = args.get(1).copied().unwrap_or(16).max(2);
     if let Some(&threads) = args.get(2) {
-        rayon::ThreadPoolBuilder::new()
+        tracer::rayon::ThreadPoolBuilder::new()
             .num_threads(threads as usize)
             .build_global()
             .unwrap();

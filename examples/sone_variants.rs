@@ -37,7 +37,7 @@ fn main() {
             Variant {
                 name: format!("sone-{name}"),
                 estimator: Estimator::Sone(p),
-                sidecar: serde_json::json!({"variant": name}),
+                sidecar: experiments::serde_json::json!({"variant": name}),
             }
         }),
     );

@@ -10,8 +10,8 @@
 //! The set-up follows `tests/common/shapes.rs` (σt = 1 in the clear stripes, so lengths are in
 //! mean free paths; g = 0; all scattering orders).
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{Rgb, Scattering};
-use glam::DVec3;
 use het_bssrdf::{bssrdf_core, tracer};
 use tracer::camera::Camera;
 use tracer::field::{Axis, Field, MediumField, PlanarProjection};

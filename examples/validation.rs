@@ -17,9 +17,9 @@ mod chandrasekhar;
 #[path = "../tests/common/half_space.rs"]
 mod half_space;
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
 use experiments::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
-use glam::DVec3;
 use het_bssrdf::{bssrdf_core, tracer};
 use tracer::integrator::Method;
 use tracer::integrator::probe::PROBE_ENERGY_FRACTION;

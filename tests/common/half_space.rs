@@ -1,8 +1,8 @@
 //! The index-matched half-space scene of the validation tests and `examples/validation.rs`,
 //! and the mean image value with its standard error over independent renders.
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{Rgb, Scattering};
-use glam::DVec3;
 use het_estimate::Coefficients;
 use tracer::camera::Camera;
 use tracer::field::MediumField;

@@ -12,8 +12,8 @@
 
 use std::path::Path;
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{ProfileModel, Rgb, Scattering};
-use glam::DVec3;
 use het_estimate::Coefficients;
 use tracer::camera::Camera;
 use tracer::field::MediumField;

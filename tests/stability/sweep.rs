@@ -31,8 +31,8 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{ProfileFamily, ProfileModel, ProfileTable, RadialProfile, Rgb, Scattering};
-use glam::DVec3;
 use het_estimate::analytic::{Plane, PlanePoint, StripeField};
 use het_estimate::path_integral::{self, MeanSquareAngle};
 use het_estimate::pattern::{Check, Stripe};
@@ -258,7 +258,7 @@ pub mod section {
 
 /// Runs the whole sweep (in parallel over (g, η) and over estimator cases).
 pub fn run(extent: Extent) -> Report {
-    use rayon::prelude::*;
+    use tracer::rayon::prelude::*;
     let start = Instant::now();
     let mut jobs: Vec<Job> = Vec::new();
     for &g in &GS {

@@ -9,8 +9,8 @@
 
 use std::time::Instant;
 
+use bssrdf_core::glam::DVec3;
 use bssrdf_core::{Rgb, Scattering};
-use glam::DVec3;
 use het_estimate::Coefficients;
 use tracer::camera::Camera;
 use tracer::field::MediumField;

@@ -2,6 +2,9 @@
 //! Figure 4, image comparison, error-against-time studies, plots and the `reproduce` report.
 #![deny(missing_docs)]
 
+/// The JSON library of the sidecars (`beam::Variant::sidecar` is a `serde_json::Value`),
+/// re-exported so that callers build them with the same version.
+pub use serde_json;
 pub mod beam;
 pub mod converge;
 pub mod error;

@@ -5,6 +5,9 @@
 //! (rendered by `cargo doc` as `het_bssrdf::physics`).
 #![deny(missing_docs)]
 
+/// The thread pool renders run on (`rayon`), re-exported so that a caller sizing it
+/// (`rayon::ThreadPoolBuilder`) uses the same version.
+pub use rayon;
 pub mod camera;
 pub mod error;
 pub mod field;
