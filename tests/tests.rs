@@ -9,6 +9,7 @@ mod integrators;
 mod precision;
 mod readme;
 mod reciprocity;
+mod separable;
 mod shapes;
 mod slab_table;
 mod spectral;
