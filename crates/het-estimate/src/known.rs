@@ -5,9 +5,11 @@ use bssrdf_core::Rgb;
 
 use crate::field::{Coefficients, FieldBounds};
 
-/// Values above this are clamped when accumulated, so that sums of up to 2³² samples cannot
-/// overflow (valid coefficients are ≤ 1e6; this only matters for broken input).
-pub(crate) const MAX_COEFFICIENT: f64 = 1e290;
+/// Values above this are clamped when looked up and when finished: the profiles' limit
+/// ([`bssrdf_core::SIGMA_MAX`], 1e12 per unit length), so that a field and the profile that
+/// reads its estimate share one valid range (a field returning 1e15 gives an estimate of 1e12,
+/// which every profile accepts). Sums of up to 2³² such samples cannot overflow.
+pub(crate) const MAX_COEFFICIENT: f64 = bssrdf_core::SIGMA_MAX;
 
 /// Clamps to `[0, MAX_COEFFICIENT]`, mapping NaN to 0 (unlike `f64::clamp`).
 #[inline]

@@ -108,8 +108,9 @@ pub const MAX_PROBE_HITS: usize = 16;
 /// structure (the tracer uses its per-object BVH).
 pub trait ProbeChords {
     /// The renderer's surface point. Its [`SurfacePoint::geometric_normal`] enters the
-    /// sampling density.
-    type Point: SurfacePoint + Copy;
+    /// sampling density. `Clone`, not `Copy`: a hit record may own data (a `Vec`, an `Arc`);
+    /// the probes clone each point they keep.
+    type Point: SurfacePoint + Clone;
 
     /// Calls `f` for every crossing of the segment `origin + t·dir`, `t ∈ [0, t_max]` (`dir` a
     /// unit vector), with the object being shaded, in increasing `t`. A crossing through a
@@ -481,7 +482,10 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
     density.trace(chords, rng, |h| match density.weight(h) {
         Some(weight) => {
-            set.hits[set.len] = Some(ProbeHit { hit: *h, weight });
+            set.hits[set.len] = Some(ProbeHit {
+                hit: h.clone(),
+                weight,
+            });
             set.len += 1;
             true
         }
@@ -498,17 +502,17 @@ pub struct ProbePoints<P> {
     len: usize,
 }
 
-impl<P: Copy> ProbePoints<P> {
+impl<P> ProbePoints<P> {
     /// An empty set.
     pub fn new() -> Self {
         Self {
-            hits: [None; 3 * MAX_PROBE_HITS],
+            hits: std::array::from_fn(|_| None),
             len: 0,
         }
     }
 }
 
-impl<P: Copy> Default for ProbePoints<P> {
+impl<P> Default for ProbePoints<P> {
     fn default() -> Self {
         Self::new()
     }
@@ -682,7 +686,7 @@ pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
     points.len = 0;
     let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
     density.trace(chords, rng, |h| {
-        points.hits[points.len] = Some(*h);
+        points.hits[points.len] = Some(h.clone());
         points.len += 1;
         true
     });

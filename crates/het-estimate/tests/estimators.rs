@@ -1247,3 +1247,38 @@ fn kernel_in_plane_reading_equals_projection() {
         }
     }
 }
+
+/// One valid range from fields to profiles: a field whose values exceed the profiles' limit
+/// (1e15, and 1e300 for σs) gives estimates clamped to `SIGMA_MAX` for every estimator, which
+/// the profiles accept, never the 5e289 the old accumulation limit allowed.
+#[test]
+fn estimates_stay_in_the_profiles_range() {
+    use het_estimate::bssrdf_core::{ProfileFamily, ProfileModel, SIGMA_MAX, Scattering};
+
+    struct Huge;
+    impl CoefficientField<PlanePoint> for Huge {
+        fn coefficients(&self, p: &PlanePoint) -> Coefficients {
+            let v = if p.x > 0.0 { 1e15 } else { 0.5 };
+            Coefficients::grey(v, 1e300)
+        }
+    }
+    let family = ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.3).unwrap();
+    let (x_i, x_o) = (PlanePoint::new(0.5, 0.1), PlanePoint::new(0.7, -0.2));
+    for estimator in Estimator::ALL {
+        let prepared = estimator.prepare(0.0, 1.3).unwrap();
+        let c = prepared
+            .estimate(&Plane, &Huge, &x_i, &x_o, &mut SplitMix64::new(3))
+            .coefficients;
+        for ch in 0..3 {
+            assert!(
+                (0.0..=SIGMA_MAX).contains(&c.sigma_a[ch]) && c.sigma_s[ch] == SIGMA_MAX,
+                "{estimator}: {c:?}"
+            );
+        }
+        assert!(c.validate().is_ok(), "{estimator}");
+        assert!(
+            family.profile_rgb(c.sigma_a, c.sigma_s).is_ok(),
+            "{estimator}"
+        );
+    }
+}
