@@ -32,7 +32,11 @@
 //!   one width of Eq. 2: what no implementation can avoid);
 //! * `mesh-stripe`: the tracer's BVH over a sphere of radius 10 tessellated into 81,920
 //!   triangles (icosphere, 6 subdivisions), the same stripe texture projected along z, and
-//!   pairs of surface points at most 8 apart: every projection is two BVH rays.
+//!   pairs of surface points at most 8 apart: a projection is two BVH rays. `sone sampled
+//!   samples=<N>` there is the default estimator over the same stripe with its closed forms
+//!   hidden (a field read point by point): each region is sampled on the pair's local
+//!   quadric where the quadric's error bound allows, by rays elsewhere (what a render pays
+//!   where it samples on a curved mesh); `sone samples=<N>` projects every point by rays.
 //! * `mesh-uv-image`: the `plane-image` texture UV-mapped on a flat box (a 60 × 60 top of
 //!   64 × 64 quads, texture coordinates the plane-image's projection), pairs of top-face
 //!   points at most 8 apart in x and y (x_i uniform in [−15, 15]²): `sone prefiltered` reads
@@ -441,6 +445,50 @@ fn bench_projection(c: &mut Criterion, surface: &ObjectSurface<'_>, pairs: &[(Hi
     group.finish();
 }
 
+/// A field read point by point only: the tracer's stripe with its closed forms hidden, as a
+/// procedural field or a texture without a summed-area table would be.
+struct PointsOnly<'f>(&'f MediumField);
+
+impl CoefficientField<Hit> for PointsOnly<'_> {
+    #[inline]
+    fn coefficients(&self, p: &Hit) -> Coefficients {
+        CoefficientField::<Hit>::coefficients(self.0, p)
+    }
+    fn bounds(&self) -> Option<FieldBounds> {
+        CoefficientField::<Hit>::bounds(self.0)
+    }
+    fn displacement_scale(&self, region: &PlanarEllipse) -> Option<f64> {
+        CoefficientField::<Hit>::displacement_scale(self.0, region)
+    }
+    #[inline]
+    fn averaged_at_point(&self, x: DVec3) -> Option<Coefficients> {
+        CoefficientField::<Hit>::averaged_at_point(self.0, x)
+    }
+    fn has_point_lookup(&self) -> bool {
+        CoefficientField::<Hit>::has_point_lookup(self.0)
+    }
+}
+
+/// `averaging/mesh-stripe/sone sampled samples=<N>`: the default (prefiltered) Sone estimator
+/// over a field without closed forms, so that every region is sampled: on the pair's local
+/// quadric where its error bound allows (no rays), by projection rays elsewhere. Against
+/// `sone samples=<N>` (Monte Carlo averaging, which projects every point by rays), the cost
+/// of sampling as renders do it on a curved mesh.
+fn bench_sampled_on_quadric(
+    c: &mut Criterion,
+    surface: &ObjectSurface<'_>,
+    field: &PointsOnly<'_>,
+    pairs: &[(Hit, Hit)],
+) {
+    let mut group = averaging_group(c, "mesh-stripe");
+    for n in [16u32, 64] {
+        let estimator = Estimator::Sone(SoneParams::paper().with_samples(SampleBudget::fixed(n)));
+        let label = format!("sone sampled samples={n}");
+        bench_estimator(&mut group, &label, estimator, surface, field, pairs);
+    }
+    group.finish();
+}
+
 /// `averaging/plane-one-band` (see the module docs): the prefiltered estimate's fixed cost,
 /// and `floor`, the least arithmetic it needs.
 fn bench_one_band(c: &mut Criterion, pairs: &[(PlanePoint, PlanePoint)]) {
@@ -520,6 +568,7 @@ fn averaging(c: &mut Criterion) {
     print_std_table("mesh-stripe", &surface, &field, &mesh_pairs[..64], 64);
     bench_scene(c, "mesh-stripe", &surface, &field, &mesh_pairs);
     bench_projection(c, &surface, &mesh_pairs);
+    bench_sampled_on_quadric(c, &surface, &PointsOnly(&field), &mesh_pairs);
     bench_uv_mesh(c);
 }
 

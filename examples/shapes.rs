@@ -9,6 +9,8 @@
 //! `--scattering all` counts every scattering order in both renderers (the default is
 //! multiple scattering, two or more events). `--only NONE` (a label no shape has) keeps the
 //! half-space alone.
+//! `--spheres 1.5,3,10` replaces the shapes by spheres of these radii (in mfp): the size
+//! sweep behind `--method auto`'s threshold (docs/curved-objects.md).
 //! `--oblique` replaces the shapes by the half-space seen at μ = 0.58 and 0.3 from its normal.
 //! `--half-space` turns the materials' `thickness_aware` off: the tabulated profile is the
 //! half-space one everywhere, as before the slab profile (docs/shapes.md).
@@ -77,7 +79,20 @@ fn main() {
         vec![ProfileModel::Tabulated, ProfileModel::Dipole]
     };
     let mut shapes_list = vec![Shape::HalfSpace];
-    if args.iter().any(|a| a == "--oblique") {
+    let spheres: Option<Vec<f64>> = args
+        .iter()
+        .position(|a| a == "--spheres")
+        .and_then(|i| args.get(i + 1))
+        .map(|s| {
+            s.split(',')
+                .map(|r| r.parse().expect("--spheres takes radii, comma-separated"))
+                .collect()
+        });
+    if let Some(radii) = spheres {
+        // A size sweep: how the half-space assumption's error grows as a body shrinks
+        // (the calibration of `--method auto`'s threshold, docs/curved-objects.md).
+        shapes_list.extend(radii.into_iter().map(Shape::Sphere));
+    } else if args.iter().any(|a| a == "--oblique") {
         // The half-space seen obliquely: the part of the error due to the exit direction.
         shapes_list.extend([Shape::Oblique(0.58), Shape::Oblique(0.3)]);
     } else {

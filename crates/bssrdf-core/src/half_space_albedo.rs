@@ -14,7 +14,9 @@
 //! rule is exact for polynomials of degree 2·[`SUB_NODES`] − 1, which is where the phase
 //! series is cut. The rest of the forward peak is the δ-M scaling of Wiscombe (1977):
 //! f = g^(L+1), ϖ* = ϖ(1 − f)/(1 − ϖf), moments (g^l − f)/(1 − f); it conserves energy exactly
-//! on these nodes. A layer of optical thickness 2⁻¹⁶ is initialised with its exact single
+//! on these nodes. For g < 0 (a backward peak, which a forward δ cannot stand for) f = 0: the
+//! series is cut at L, and the exact single-scattering correction below restores the peak's
+//! first order. A layer of optical thickness 2⁻¹⁶ is initialised with its exact single
 //! scattering, then doubled (van de Hulst 1980, ch. 4: R₂ = R + T R (1 − R R)⁻¹ T,
 //! T₂ = T (1 − R R)⁻¹ T, with the beam's diffuse reflection and transmission carried along)
 //! until it transmits nothing (at most 2²⁴ mean free paths). The dielectric boundary reflects
@@ -240,7 +242,10 @@ impl Discrete {
             }
         }
         let fresnel = mu.map(|m| dielectric(m, 1.0 / eta));
-        let f = g.powi(L as i32 + 1);
+        // δ-M truncates a forward peak only: for g < 0 the peak is backward, which a forward
+        // delta cannot stand for (at g = −0.99 it emptied the half-space), so the series is
+        // cut at L and the exact single scattering below replaces its first order.
+        let f = if g > 0.0 { g.powi(L as i32 + 1) } else { 0.0 };
         let moment = |l: usize| (g.powi(l as i32) - f) / (1.0 - f);
         // P_l at every node and at ±1.
         let legendre = |x: f64| {
@@ -556,6 +561,22 @@ fn solve_vec(a: Mat, b: Vector) -> Vector {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A conservative (ϖ = 1) index-matched half-space returns all the light that enters it,
+    /// whatever the phase function: the plane albedo is 1 (exact). Backward-peaked g held
+    /// it too (at g = −0.99 the forward δ-M truncation once gave 0, at −0.9 0.96).
+    #[test]
+    fn a_conservative_half_space_reflects_everything_at_every_g() {
+        for g in [-0.99, -0.9, -0.5, -0.1, 0.1, 0.5, 0.9, 0.99] {
+            let a = plane_albedo(1.0, g, 1.0);
+            assert!((a - 1.0).abs() < 3e-3, "g {g}: plane albedo {a}");
+            let t = AnisotropicTotals::get(g, 1.0);
+            assert!(
+                t.multiple(0.9) > 0.0 && t.multiple(0.9) < t.all(0.9),
+                "g {g}"
+            );
+        }
+    }
 
     /// Chandrasekhar's plane albedo 1 − H(1)√(1 − ϖ) (docs/physics.md#half-space, computed
     /// independently).

@@ -8,6 +8,7 @@ use common::{MINIMAL, Scratch, run_in};
 
 const METHODS: &[&str] = &[
     "pt",
+    "auto",
     "jensen-in",
     "jensen-out",
     "endpoints",

@@ -50,12 +50,45 @@ pub const BINS_PER_DECADE: usize = 20;
 pub const N_BINS: usize = 1 + 6 * BINS_PER_DECADE;
 
 /// Edge `j` of the radial bins (`edge(0) = 0`, `edge(N_BINS) = X_LAST`).
+#[inline]
 pub fn edge(j: usize) -> f64 {
-    if j == 0 {
-        0.0
-    } else {
-        X_FIRST * 10f64.powf((j - 1) as f64 / BINS_PER_DECADE as f64)
-    }
+    radii().edges[j]
+}
+
+/// The bins' edges and centres, computed once: they are read in every evaluation and in the
+/// table's preparation, where `powf` per read was most of the load time.
+struct Radii {
+    edges: [f64; N_BINS + 1],
+    centres: [f64; N_BINS],
+    /// ln of each edge (edge 0 is 0: −∞) and centre.
+    ln_edges: [f64; N_BINS + 1],
+    ln_centres: [f64; N_BINS],
+}
+
+fn radii() -> &'static Radii {
+    static RADII: std::sync::OnceLock<Radii> = std::sync::OnceLock::new();
+    RADII.get_or_init(|| {
+        let edges: [f64; N_BINS + 1] = std::array::from_fn(|j| {
+            if j == 0 {
+                0.0
+            } else {
+                X_FIRST * 10f64.powf((j - 1) as f64 / BINS_PER_DECADE as f64)
+            }
+        });
+        let centres = std::array::from_fn(|j| {
+            if j == 0 {
+                0.5 * X_FIRST
+            } else {
+                (edges[j] * edges[j + 1]).sqrt()
+            }
+        });
+        Radii {
+            edges,
+            centres,
+            ln_edges: edges.map(f64::ln),
+            ln_centres: centres.map(f64::ln),
+        }
+    })
 }
 
 /// The bin holding optical radius `x`, or `None` beyond [`X_LAST`].
@@ -68,13 +101,22 @@ pub fn bin_of(x: f64) -> Option<usize> {
     (j < N_BINS).then_some(j)
 }
 
+/// ln [`edge`]`(j)`.
+#[inline]
+pub(crate) fn ln_edge(j: usize) -> f64 {
+    radii().ln_edges[j]
+}
+
+/// ln [`centre`]`(j)`.
+#[inline]
+pub(crate) fn ln_centre(j: usize) -> f64 {
+    radii().ln_centres[j]
+}
+
 /// The representative radius of bin `j`: the geometric mean of its edges (0's: X_FIRST / 2).
+#[inline]
 pub fn centre(j: usize) -> f64 {
-    if j == 0 {
-        0.5 * X_FIRST
-    } else {
-        (edge(j) * edge(j + 1)).sqrt()
-    }
+    radii().centres[j]
 }
 
 /// Area of the annulus of bin `j` (optical units²).

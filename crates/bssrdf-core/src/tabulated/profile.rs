@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 use super::file::TableData;
 use super::grid::{
     BINS_PER_DECADE, ETAS, N_ALBEDO, N_BINS, S_MIN, X_FIRST, X_LAST, albedo_of_row_in,
-    annulus_area, centre, edge,
+    annulus_area, centre, edge, ln_centre, ln_edge,
 };
 use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_u, optical};
 
@@ -424,11 +424,10 @@ pub(crate) fn annulus_integrals(v: &[f64]) -> [f64; N_BINS] {
         TAU * ((v[0] - slope * c0) * (x1 * x1 - x0 * x0) / 2.0
             + slope * (x1.powi(3) - x0.powi(3)) / 3.0)
     };
-    // ∫ 2πx R̂ over [x0, x1] ⊂ [c_j, c_{j+1}], j ≥ 1.
-    let piece = |j: usize, x0: f64, x1: f64| {
+    // ∫ 2πx R̂ over [x0, x1] ⊂ [c_j, c_{j+1}], j ≥ 1, given t0 = ln x0 and t1 = ln x1.
+    let piece = |j: usize, t0: f64, t1: f64| {
         let (a, b) = (v[j], v[j + 1]);
-        let (tc, span) = (centre(j).ln(), (centre(j + 1) / centre(j)).ln());
-        let (t0, t1) = (x0.ln(), x1.ln());
+        let (tc, span) = (ln_centre(j), ln_centre(j + 1) - ln_centre(j));
         if a > 0.0 && b > 0.0 {
             // a e^{k(t − t_c)} with k = ln(b/a)/span: ∫ e^{2t} a e^{k(t − t_c)} dt.
             let k = (b / a).ln() / span;
@@ -466,11 +465,12 @@ pub(crate) fn annulus_integrals(v: &[f64]) -> [f64; N_BINS] {
     let last = N_BINS - 1;
     std::array::from_fn(|j| match j {
         0 => PI * c0 * c0 * v[0] + first_piece(c0, edge(1)),
-        1 => first_piece(edge(1), c1) + piece(1, c1, edge(2)),
+        1 => first_piece(edge(1), c1) + piece(1, ln_centre(1), ln_edge(2)),
         _ if j == last => {
-            piece(j - 1, edge(j), centre(j)) + PI * (X_LAST * X_LAST - centre(j) * centre(j)) * v[j]
+            piece(j - 1, ln_edge(j), ln_centre(j))
+                + PI * (X_LAST * X_LAST - centre(j) * centre(j)) * v[j]
         }
-        _ => piece(j - 1, edge(j), centre(j)) + piece(j, centre(j), edge(j + 1)),
+        _ => piece(j - 1, ln_edge(j), ln_centre(j)) + piece(j, ln_centre(j), ln_edge(j + 1)),
     })
 }
 
