@@ -580,7 +580,7 @@ fn light_traced_sone_agrees_with_camera_traced_sone_with_the_shape_correction() 
         let field = MediumField::homogeneous(het_estimate::Coefficients::grey(0.1, 0.9)).unwrap();
         let mut builder = SceneBuilder::new(RenderSettings::new(N, N, 1), *base.camera());
         for l in base.lights() {
-            builder = builder.light(*l);
+            builder = builder.light(l.clone());
         }
         builder
             .object(
@@ -661,9 +661,7 @@ fn light_tracer_refuses_what_it_cannot_render() {
                 10.0 * DVec3::X,
                 10.0 * DVec3::Y,
             ),
-            Material::Diffuse {
-                albedo: Rgb::splat(0.5),
-            },
+            Material::diffuse(Rgb::splat(0.5)),
         )
         .build()
         .unwrap();

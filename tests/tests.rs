@@ -2,6 +2,7 @@
 
 mod artist;
 mod common;
+mod environment_map;
 mod fuzz_regressions;
 mod image_prefilter;
 mod index_matched;

@@ -5,7 +5,9 @@
 //! (rendered by `cargo doc` as `het_bssrdf::physics`).
 #![deny(missing_docs)]
 
+pub mod bsdf;
 pub mod camera;
+pub mod distribution;
 pub mod error;
 pub mod field;
 pub mod film;

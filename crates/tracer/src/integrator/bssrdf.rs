@@ -11,6 +11,14 @@
 //! estimator gives for the pair (x_i, x_o). The directions ω_i (toward the light) and ω_o
 //! (toward the viewer) point out of the medium.
 //!
+//! Rough boundary (a material with `roughness`, η ≠ 1; `crate::bsdf::transmittance`): both
+//! Fresnel transmittances 1 − F_r(cos θ) become the rough dielectric's directional
+//! transmittance T(cos θ; α) at the point's α, and c becomes √(c(α_i) c(α_o)) with
+//! c(α) = 2 ∫₀¹ T(μ; α) μ dμ (c(α) for a constant roughness; the geometric mean keeps S
+//! symmetric when the roughness is textured). The camera path realises the exit's T by
+//! sampling the boundary (its transmitted weight has mean T), the light tracer evaluates it.
+//! Both tend to the smooth terms as α → 0.
+//!
 //! Reciprocity: written as R · (1 − F_r(cos θ_i))(1 − F_r(cos θ_o)) / (c π), S is symmetric
 //! under (x_i, ω_i) ↔ (x_o, ω_o) whenever the estimate is (every averaging estimator;
 //! not the point lookups `jensen-in`/`jensen-out`, see docs/reciprocity.md). Both cosines use
@@ -42,7 +50,8 @@ use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SlabFace};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
 
-use crate::field::MediumField;
+use crate::bsdf::{SMOOTH_ALPHA, TransmittanceTable, alpha_from_roughness};
+use crate::field::{Field, MediumField};
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::probe::ProbeSampler;
@@ -75,6 +84,16 @@ pub(crate) struct BssrdfObject {
     /// ([`bssrdf_core::tabulated::angular`]): with the tabulated model, unless the material
     /// turns it off (`angular_coupling = false`).
     coupling: Option<AngularCoupling>,
+    /// The rough boundary, when the material has one (module docs).
+    rough: Option<RoughBoundary>,
+}
+
+/// A rough boundary's roughness and its transmittance table.
+struct RoughBoundary {
+    /// r (α = r²) over the surface.
+    roughness: Field,
+    /// T(μ; α) and c(α) over the material's range of α.
+    table: TransmittanceTable,
 }
 
 /// The profile weight of one pair, with what the angular coupling needs to finish it
@@ -114,8 +133,19 @@ impl BssrdfObject {
         } else {
             None
         };
+        let rough = material.roughness.as_ref().and_then(|r| {
+            let (lo, hi) = (
+                alpha_from_roughness(r.min()[0]),
+                alpha_from_roughness(r.max()[0]),
+            );
+            (material.eta != 1.0 && hi >= SMOOTH_ALPHA).then(|| RoughBoundary {
+                roughness: r.clone(),
+                table: TransmittanceTable::new(material.eta, lo.max(SMOOTH_ALPHA), hi),
+            })
+        });
         Ok(Self {
             coupling,
+            rough,
             thickness_aware,
             sampler: ProbeSampler::new(family, &material.medium),
             family,
@@ -160,17 +190,57 @@ impl BssrdfObject {
             .probe_points_into(points, chords, x_o, coeffs, self.extent, rng)
     }
 
-    /// 1 − F_r(cos θ): the fraction of light crossing the boundary at incidence cosine `cos`
-    /// (unitless; 1 for η = 1).
+    /// The boundary's roughness α at `hit` where it acts as a rough one (α ≥
+    /// [`SMOOTH_ALPHA`]); `None` where it is smooth (and for every point of a smooth
+    /// material). The rule of [`crate::integrator::walk::Interface::rough_alpha`].
     #[inline]
-    pub fn transmission(&self, cos: f64) -> f64 {
-        1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta)
+    pub fn rough_alpha(&self, hit: &Hit) -> Option<f64> {
+        let r = self.rough.as_ref()?;
+        let alpha = alpha_from_roughness(r.roughness.eval(hit.p, hit.uv)[0]);
+        (alpha >= SMOOTH_ALPHA).then_some(alpha)
     }
 
-    /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π).
+    /// [`BssrdfObject::rough_alpha`], 0 where the boundary is smooth.
     #[inline]
-    pub fn entry_lobe(&self, cos: f64) -> f64 {
-        self.transmission(cos) / (self.sw_norm * PI)
+    pub fn alpha_at(&self, hit: &Hit) -> f64 {
+        self.rough_alpha(hit).unwrap_or(0.0)
+    }
+
+    /// The fraction of light crossing the boundary at incidence cosine `cos` (unitless): 1 −
+    /// F_r(cos θ) for a smooth boundary (`alpha` = 0; 1 for η = 1), the rough transmittance
+    /// T(cos; α) otherwise (module docs).
+    #[inline]
+    pub fn transmission(&self, cos: f64, alpha: f64) -> f64 {
+        match &self.rough {
+            Some(r) if alpha > 0.0 => r.table.transmittance(cos, alpha),
+            _ => 1.0 - bssrdf_core::fresnel::dielectric(cos, self.eta),
+        }
+    }
+
+    /// The normalisation of S_w for a pair whose boundary roughness is `alpha_i` at x_i and
+    /// `alpha_o` at x_o: c, or √(c(α_i) c(α_o)) through a rough boundary (module docs).
+    #[inline]
+    fn pair_norm(&self, alpha_i: f64, alpha_o: f64) -> f64 {
+        match &self.rough {
+            Some(r) if alpha_i > 0.0 || alpha_o > 0.0 => {
+                let c = |a: f64| {
+                    if a > 0.0 {
+                        r.table.norm(a)
+                    } else {
+                        self.sw_norm
+                    }
+                };
+                (c(alpha_i) * c(alpha_o)).sqrt()
+            }
+            _ => self.sw_norm,
+        }
+    }
+
+    /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π), or through a rough
+    /// boundary T(cos; α_i) / (√(c(α_i) c(α_o)) π).
+    #[inline]
+    pub fn entry_lobe(&self, cos: f64, alpha_i: f64, alpha_o: f64) -> f64 {
+        self.transmission(cos, alpha_i) / (self.pair_norm(alpha_i, alpha_o) * PI)
     }
 
     /// R(|x_i − x_o|) (1/length², per channel) at the coefficients the estimator gives for
@@ -278,9 +348,12 @@ impl BssrdfObject {
             return Rgb::ZERO;
         };
         let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
-        let fresnel = self.transmission(cos_i) * self.transmission(cos_o);
+        let (alpha_i, alpha_o) = (self.alpha_at(x_i), self.alpha_at(x_o));
+        let fresnel = self.transmission(cos_i, alpha_i) * self.transmission(cos_o, alpha_o);
         let w = self.profile(surface, medium, x_i, x_o, rng, counters);
-        let s = w.rd * (fresnel / (self.sw_norm * PI)) * self.coupling(&w, cos_i, cos_o);
+        let s = w.rd
+            * (fresnel / (self.pair_norm(alpha_i, alpha_o) * PI))
+            * self.coupling(&w, cos_i, cos_o);
         match (
             self.correction_along(x_i, w_i, n_i),
             self.correction_along(x_o, w_o, n_o),
