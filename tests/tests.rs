@@ -10,6 +10,7 @@ mod integrators;
 mod precision;
 mod readme;
 mod reciprocity;
+mod rough_surfaces;
 mod shapes;
 mod slab_table;
 mod spectral;

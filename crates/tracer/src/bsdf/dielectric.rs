@@ -24,12 +24,20 @@
 //! between microfacets more than once (Heitz et al. 2016, "Multiple-scattering microfacet
 //! BSDFs with the Smith model"), growing with α and at grazing angles.
 //!
+//! The renderers use the energy-conserving lobe `f / E(ω_o)` instead
+//! ([`RoughDielectric::sample_conserving`]), `E(ω_o) = ∫ f |cos θ_i| dω_i` the single-scattering
+//! albedo: the compensation of Turquin 2019 ("Tur19") for the light scattered more than once on
+//! the microsurface, given back in the single-scattering lobe's shape, so that a lossless
+//! boundary stays lossless (a white furnace renders white) and light crossing it many times
+//! from inside a translucent object is not darkened by the model's loss at every crossing.
+//!
 //! Below [`SMOOTH_ALPHA`] the boundary is the smooth one (the callers test
 //! [`RoughDielectric::is_smooth`]).
 
 use glam::DVec3;
 
 use super::microfacet::{SMOOTH_ALPHA, TrowbridgeReitz};
+use crate::rng::Rng;
 
 /// Which lobe a sample took.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,11 +70,16 @@ pub struct RoughDielectric {
     pub distribution: TrowbridgeReitz,
 }
 
+/// Most single-scattering samples [`RoughDielectric::sample_conserving`] draws before it gives
+/// up (the path is then lost). Each is kept with probability at least E(ω_o) ≥ 0.4 (α ≤ 1, η ≤
+/// 2.5), so giving up has probability below 0.6⁶⁴ ≈ 1e-14.
+pub const MAX_TRIES: u32 = 64;
+
 /// The direction refracted from `w` (unit, pointing away from the surface on the side `n`
 /// faces, `w·n > 0`) through the microfacet `n`, `eta` the relative index across it (n beyond
 /// over n on `w`'s side); `None` under total internal reflection (pbrt-v4's `Refract`).
 #[inline]
-fn refract(w: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
+pub(crate) fn refract(w: DVec3, n: DVec3, eta: f64) -> Option<DVec3> {
     let cos_i = n.dot(w);
     let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -210,6 +223,27 @@ impl RoughDielectric {
             weight,
             lobe,
         })
+    }
+
+    /// Samples the energy-conserving lobe `f / E(ω_o)` (module docs) at `ω_o` by rejection:
+    /// single-scattering samples ([`RoughDielectric::sample`]) are drawn until one is kept, each
+    /// with the probability of its weight `G/G1` (one lost to the wrong side is never kept). The
+    /// kept direction then has the density `pdf · weight / E(ω_o)` and the conserving lobe's
+    /// weight `f |cos θ_i| / density` is 1; the returned sample is the kept single-scattering
+    /// one (its `pdf` and `weight` those of the single-scattering lobe). `None` after
+    /// [`MAX_TRIES`] draws.
+    pub fn sample_conserving(&self, wo: DVec3, rng: &mut Rng) -> Option<DielectricSample> {
+        for _ in 0..MAX_TRIES {
+            let uc = rng.uniform();
+            let u = rng.uniform2();
+            let keep = rng.uniform();
+            if let Some(s) = self.sample(wo, uc, u)
+                && keep < s.weight
+            {
+                return Some(s);
+            }
+        }
+        None
     }
 }
 
@@ -419,6 +453,61 @@ mod tests {
                     "α {alpha}, wo {wo:?}: sampled {m} ± {se} vs quadrature {full}"
                 );
             }
+        }
+    }
+
+    /// The energy-conserving sampler: it loses no path, and the directions it keeps follow
+    /// the density `pdf · (G/G1) / E(ω_o)`, E the single-scattering albedo by quadrature of
+    /// `f` (χ², bins of the sphere).
+    #[test]
+    fn the_conserving_sampler_keeps_every_path_in_the_single_scattering_shape() {
+        let cases = [(0.5, 0.6), (1.0, -0.4)];
+        let test = ChiSquareTest::family(1e-4, cases.len() as u32);
+        for (k, (alpha, cos_o)) in cases.into_iter().enumerate() {
+            let b = RoughDielectric::new(1.5, alpha);
+            let d = b.distribution;
+            let wo = direction(cos_o, 0.2);
+            let e = sphere_integral(1000, |wi| b.f(wo, wi) * wi.z.abs());
+            let density = |wi: DVec3| {
+                let g1 = d.g1(wo);
+                if g1 > 0.0 {
+                    b.pdf(wo, wi) * d.g(wo, wi) / g1 / e
+                } else {
+                    0.0
+                }
+            };
+            let (nt, np, sub) = (30, 20, 10);
+            let mut expected = vec![0.0; nt * np];
+            for a in 0..nt {
+                for c in 0..np {
+                    let mut s = 0.0;
+                    for x in 0..sub {
+                        for y in 0..sub {
+                            let cos =
+                                1.0 - 2.0 * (a as f64 + (x as f64 + 0.5) / sub as f64) / nt as f64;
+                            let phi =
+                                2.0 * PI * (c as f64 + (y as f64 + 0.5) / sub as f64) / np as f64;
+                            s += density(direction(cos, phi));
+                        }
+                    }
+                    expected[a * np + c] = s / (sub * sub) as f64 * 4.0 * PI / (nt * np) as f64;
+                }
+            }
+            let total: f64 = expected.iter().sum();
+            assert!((total - 1.0).abs() < 3e-3, "∫ density = {total}");
+            let n = 200_000;
+            let mut counts = vec![0u64; nt * np];
+            let mut rng = Rng::from_keys(31, &[k as u64]);
+            for _ in 0..n {
+                let s = b.sample_conserving(wo, &mut rng).expect("no path is lost");
+                let a = (((1.0 - s.wi.z) / 2.0 * nt as f64) as usize).min(nt - 1);
+                let phi = s.wi.y.atan2(s.wi.x).rem_euclid(2.0 * PI);
+                let c = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
+                counts[a * np + c] += 1;
+            }
+            let expected: Vec<f64> = expected.iter().map(|p| p * n as f64).collect();
+            let r = test.check(&counts, &expected).unwrap();
+            assert!(r.passes(), "α {alpha}, cos {cos_o}: {r}");
         }
     }
 

@@ -1,27 +1,37 @@
-//! The directional transmittance of the rough dielectric boundary, for the BSSRDF's Fresnel
-//! terms (`integrator/bssrdf.rs`).
+//! What light arriving from outside at a rough dielectric boundary does, by direction: the
+//! single-scattering albedo E(μ; α) that the energy-conserving lobe divides by, and the
+//! fraction T(μ; α) that enters the medium, for the BSSRDF's Fresnel terms
+//! (`integrator/bssrdf.rs`).
+//!
+//! For light arriving from outside at cosine μ (ω_o, `cos θ_o = μ`), with ω_m a normal visible
+//! from ω_o and ω_r, ω_t the directions reflected and refracted through it
+//! ([`super::RoughDielectric`]):
+//!
+//! * `E(μ; α) = E[F(ω_o·ω_m) · G(ω_o, ω_r)/G1(ω_o) + (1 − F) · G(ω_o, ω_t)/G1(ω_o)]`, the
+//!   single-scattering albedo (each term 0 when its direction leaves to the wrong side);
+//! * `T(μ; α) = E[(1 − F) · G(ω_o, ω_t)/G1(ω_o)] / E(μ; α)`, the fraction of the light the
+//!   energy-conserving boundary ([`super::RoughDielectric::sample_conserving`]) lets in: the
+//!   probability that its sample is a refraction, which is how the camera path realises it.
 //!
 //! The separable BSSRDF weighs light crossing a smooth boundary by the Fresnel transmittance
-//! `1 − F_r(cos θ)` at each end. Through a rough boundary the fraction of the light arriving
-//! from outside at cosine μ that enters the medium is
+//! `1 − F_r(cos θ)` at each end, normalised by `c = 1 − 2 C1(1/η) = 2 ∫₀¹ (1 − F_r(μ)) μ dμ`.
+//! Through a rough boundary it takes T at each end (reciprocity of the boundary's flux transfer
+//! makes the fraction leaving toward cosine μ of diffuse light inside the same function, up to
+//! the η² the normalisation absorbs) and `c(α) = 2 ∫₀¹ T(μ; α) μ dμ`. As α → 0, T → 1 − F_r
+//! and c → 1 − 2 C1(1/η).
 //!
-//! `T(μ; α, η) = ∫ f_t(ω_o, ω_i) |cos θ_i| dω_i = E[(1 − F(ω_o·ω_m)) · G(ω_o, ω_t) / G1(ω_o)]`
-//!
-//! over the normals ω_m visible from ω_o (`cos θ_o = μ`), ω_t the direction refracted through
-//! ω_m ([`super::RoughDielectric`], whose sampler realises it: the path tracer's weight of a
-//! transmitted sample is `G / G1`). By reciprocity of the boundary's flux transfer it is also
-//! the fraction of diffuse light inside that leaves toward a direction of cosine μ, up to the
-//! η² the BSSRDF's normalisation absorbs; the BSSRDF uses it at both ends, with the
-//! normalisation `c(α) = 2 ∫₀¹ T(μ; α) μ dμ` in place of `1 − 2 C1(1/η)` (the smooth value,
-//! which `T` and `c` tend to as α → 0).
-//!
-//! The table holds T on a grid of μ (and of α over the material's range of roughness),
+//! The table holds T and E on a grid of μ (and of α over the material's range of roughness),
 //! each value a deterministic quadrature over the visible-normal sampler's unit square
-//! (`QUADRATURE²` midpoints); lookups interpolate linearly.
+//! (`QUADRATURE²` midpoints); lookups interpolate linearly. Tables are shared by every object
+//! and render of one process with the same η and range of α ([`TransmittanceTable::shared`]).
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use glam::DVec3;
 
-use super::{Lobe, RoughDielectric};
+use super::RoughDielectric;
+use super::dielectric::refract;
 
 /// Nodes in μ ∈ [0, 1].
 const MU_NODES: usize = 33;
@@ -30,43 +40,55 @@ const ALPHA_NODES: usize = 9;
 /// Midpoints per side of the quadrature of each value.
 const QUADRATURE: usize = 40;
 
-/// T(μ; α) and c(α) of one η on a grid (module docs).
+/// T(μ; α), E(μ; α) and c(α) of one η on a grid (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TransmittanceTable {
     /// The α of each row (increasing; one row when α is constant).
     alphas: Vec<f64>,
-    /// `values[row * MU_NODES + k]` = T(k / (MU_NODES − 1); alphas[row]).
-    values: Vec<f64>,
+    /// `transmitted[row * MU_NODES + k]` = T(k / (MU_NODES − 1); alphas[row]).
+    transmitted: Vec<f64>,
+    /// The single-scattering albedo E, laid out as `transmitted`.
+    albedo: Vec<f64>,
     /// c(α) per row.
     norms: Vec<f64>,
 }
 
-/// T(μ; α, η) by quadrature over the visible normals (module docs). At μ = 0 (grazing) the
-/// limit is taken as the value just above.
-pub fn directional_transmittance(eta: f64, alpha: f64, mu: f64) -> f64 {
+/// The single-scattering albedo E and the single-scattering transmitted fraction (before the
+/// division by E) of light arriving from outside at cosine `mu` (module docs), by quadrature
+/// over the visible normals. At μ = 0 (grazing) the values just above are taken.
+pub fn single_scattering(eta: f64, alpha: f64, mu: f64) -> (f64, f64) {
     let mu = mu.clamp(1e-4, 1.0);
     let b = RoughDielectric::new(eta, alpha);
+    let d = &b.distribution;
     let wo = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+    let g1 = d.g1(wo);
     let n = QUADRATURE;
-    let mut sum = 0.0;
+    let (mut albedo, mut transmitted) = (0.0, 0.0);
     for a in 0..n {
         for c in 0..n {
             let u = [(a as f64 + 0.5) / n as f64, (c as f64 + 0.5) / n as f64];
-            // The transmission lobe alone: its weight times the probability of choosing it
-            // (uc = 1 − ε never reflects unless F = 1).
-            let m = b.distribution.sample_visible(wo, u);
-            let f = bssrdf_core::fresnel::dielectric(wo.dot(m), eta);
-            if f >= 1.0 {
+            let m = d.sample_visible(wo, u);
+            let cos = wo.dot(m);
+            if cos <= 0.0 {
                 continue;
             }
-            if let Some(s) = b.sample(wo, 1.0 - f64::EPSILON, u)
-                && s.lobe == Lobe::Transmission
+            let f = bssrdf_core::fresnel::dielectric(cos, eta);
+            let r = -wo + 2.0 * cos * m;
+            if r.z > 0.0 {
+                albedo += f * d.g(wo, r) / g1;
+            }
+            if f < 1.0
+                && let Some(t) = refract(wo, m, eta)
+                && t.z < 0.0
             {
-                sum += (1.0 - f) * s.weight;
+                let w = (1.0 - f) * d.g(wo, t) / g1;
+                albedo += w;
+                transmitted += w;
             }
         }
     }
-    sum / (n * n) as f64
+    let k = (n * n) as f64;
+    (albedo / k, transmitted / k)
 }
 
 impl TransmittanceTable {
@@ -83,33 +105,54 @@ impl TransmittanceTable {
                 }
             })
             .collect();
-        let mut values = Vec::with_capacity(rows * MU_NODES);
+        let mut transmitted = Vec::with_capacity(rows * MU_NODES);
+        let mut albedo = Vec::with_capacity(rows * MU_NODES);
         let mut norms = Vec::with_capacity(rows);
+        let h = 1.0 / (MU_NODES - 1) as f64;
         for &alpha in &alphas {
-            let row: Vec<f64> = (0..MU_NODES)
-                .map(|k| directional_transmittance(eta, alpha, k as f64 / (MU_NODES - 1) as f64))
-                .collect();
-            // c = 2 ∫ T μ dμ by the trapezoid rule over the nodes.
-            let h = 1.0 / (MU_NODES - 1) as f64;
-            let integral: f64 = (0..MU_NODES)
-                .map(|k| {
-                    let w = if k == 0 || k == MU_NODES - 1 {
-                        0.5
-                    } else {
-                        1.0
-                    };
-                    w * row[k] * k as f64 * h
-                })
-                .sum::<f64>()
-                * h;
+            let mut integral = 0.0;
+            for k in 0..MU_NODES {
+                let (e, t) = single_scattering(eta, alpha, k as f64 * h);
+                let t = if e > 0.0 { t / e } else { 0.0 };
+                // c = 2 ∫ T μ dμ by the trapezoid rule over the nodes.
+                let w = if k == 0 || k == MU_NODES - 1 {
+                    0.5
+                } else {
+                    1.0
+                };
+                integral += w * t * k as f64 * h * h;
+                transmitted.push(t);
+                albedo.push(e);
+            }
             norms.push(2.0 * integral);
-            values.extend(row);
         }
         Self {
             alphas,
-            values,
+            transmitted,
+            albedo,
             norms,
         }
+    }
+
+    /// [`TransmittanceTable::new`], built once per process for each `(eta, alpha_lo, alpha_hi)`
+    /// and shared (a material's objects, its renders, the camera and light tracers).
+    pub fn shared(eta: f64, alpha_lo: f64, alpha_hi: f64) -> Arc<Self> {
+        static TABLES: OnceLock<Mutex<HashMap<[u64; 3], Arc<TransmittanceTable>>>> =
+            OnceLock::new();
+        let key = [eta.to_bits(), alpha_lo.to_bits(), alpha_hi.to_bits()];
+        let tables = TABLES.get_or_init(Default::default);
+        if let Some(t) = tables.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+            return t.clone();
+        }
+        // Built outside the lock (tens of milliseconds); a concurrent build of the same key
+        // gives the same table.
+        let table = Arc::new(Self::new(eta, alpha_lo, alpha_hi));
+        tables
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .entry(key)
+            .or_insert(table)
+            .clone()
     }
 
     /// The row below `alpha` and the weight of the row above (0 for one row).
@@ -125,14 +168,14 @@ impl TransmittanceTable {
         (r, x - r as f64)
     }
 
-    /// T(μ; α) (linear interpolation; α clamped to the table's range).
+    /// Linear interpolation of `values` at (μ, α).
     #[inline]
-    pub fn transmittance(&self, mu: f64, alpha: f64) -> f64 {
+    fn lookup(&self, values: &[f64], mu: f64, alpha: f64) -> f64 {
         let x = mu.clamp(0.0, 1.0) * (MU_NODES - 1) as f64;
         let k = (x as usize).min(MU_NODES - 2);
         let f = x - k as f64;
         let row = |r: usize| {
-            let v = &self.values[r * MU_NODES..];
+            let v = &values[r * MU_NODES..];
             v[k] + f * (v[k + 1] - v[k])
         };
         let (r, w) = self.rows(alpha);
@@ -141,6 +184,19 @@ impl TransmittanceTable {
         } else {
             row(r) + w * (row(r + 1) - row(r))
         }
+    }
+
+    /// T(μ; α): the fraction of the light arriving from outside at cosine μ that the
+    /// energy-conserving boundary lets in (α clamped to the table's range).
+    #[inline]
+    pub fn transmittance(&self, mu: f64, alpha: f64) -> f64 {
+        self.lookup(&self.transmitted, mu, alpha)
+    }
+
+    /// E(μ; α): the single-scattering albedo of light arriving from outside at cosine μ.
+    #[inline]
+    pub fn albedo(&self, mu: f64, alpha: f64) -> f64 {
+        self.lookup(&self.albedo, mu, alpha)
     }
 
     /// c(α) = 2 ∫₀¹ T(μ; α) μ dμ (linear interpolation in α).
@@ -158,13 +214,15 @@ impl TransmittanceTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::Lobe;
     use crate::rng::Rng;
 
-    /// The table against the path tracer's own estimate of the same fraction: sampled
-    /// crossings from outside, transmitted with their weight (3 SE + the quadrature's 2e-3);
-    /// and toward the smooth boundary's 1 − F and 1 − 2 C1(1/η) as α → 0.
+    /// The table against the path tracer's own crossings: the fraction of the energy-conserving
+    /// sampler's crossings from outside that refract (3 SE + the quadrature's 2e-3), and the
+    /// single-scattering albedo against the single-scattering sampler's mean weight; both
+    /// toward the smooth boundary's 1 − F, 1 and 1 − 2 C1(1/η) as α → 0.
     #[test]
-    fn transmittance_matches_sampled_crossings_and_the_smooth_limit() {
+    fn the_table_matches_sampled_crossings_and_the_smooth_limit() {
         let eta = 1.4;
         let table = TransmittanceTable::new(eta, 0.05, 0.8);
         let mut rng = Rng::from_keys(4, &[]);
@@ -172,22 +230,31 @@ mod tests {
             let b = RoughDielectric::new(eta, alpha);
             for mu in [0.9f64, 0.5, 0.15] {
                 let wo = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-                let n = 200_000;
+                let n = 100_000;
+                let mut entered = 0;
                 let (mut s, mut s2) = (0.0, 0.0);
                 for _ in 0..n {
-                    let w = match b.sample(wo, rng.uniform(), rng.uniform2()) {
-                        Some(x) if x.lobe == Lobe::Transmission => x.weight,
-                        _ => 0.0,
-                    };
+                    let c = b.sample_conserving(wo, &mut rng).unwrap();
+                    entered += usize::from(c.lobe == Lobe::Transmission);
+                    let w = b
+                        .sample(wo, rng.uniform(), rng.uniform2())
+                        .map_or(0.0, |x| x.weight);
                     s += w;
                     s2 += w * w;
                 }
+                let p = entered as f64 / n as f64;
+                let t = table.transmittance(mu, alpha);
+                let se = (t * (1.0 - t) / n as f64).sqrt();
+                assert!(
+                    (t - p).abs() < 3.0 * se + 2e-3,
+                    "α {alpha}, μ {mu}: table {t}, sampled {p} ± {se}"
+                );
                 let m = s / n as f64;
                 let se = ((s2 / n as f64 - m * m) / n as f64).sqrt();
-                let t = table.transmittance(mu, alpha);
+                let e = table.albedo(mu, alpha);
                 assert!(
-                    (t - m).abs() < 3.0 * se + 2e-3,
-                    "α {alpha}, μ {mu}: table {t}, sampled {m} ± {se}"
+                    (e - m).abs() < 3.0 * se + 2e-3,
+                    "α {alpha}, μ {mu}: albedo {e}, sampled {m} ± {se}"
                 );
             }
         }
@@ -196,6 +263,7 @@ mod tests {
             let want = 1.0 - bssrdf_core::fresnel::dielectric(mu, eta);
             let got = smooth.transmittance(mu, 2e-3);
             assert!((got - want).abs() < 5e-3, "μ {mu}: {got} vs 1 − F = {want}");
+            assert!((smooth.albedo(mu, 2e-3) - 1.0).abs() < 5e-3);
         }
         let c = 1.0 - 2.0 * bssrdf_core::fresnel::fresnel_moment(1, 1.0 / eta);
         assert!(
@@ -203,9 +271,7 @@ mod tests {
             "{} vs {c}",
             smooth.norm(2e-3)
         );
-        // Rougher boundaries let less light through at normal incidence (more is dropped)
-        // and more at grazing incidence (the microfacets face it).
-        assert!(table.transmittance(1.0, 0.8) < table.transmittance(1.0, 0.05));
-        assert!(table.transmittance(0.1, 0.8) > table.transmittance(0.1, 0.05));
+        // The shared table is the table.
+        assert_eq!(*TransmittanceTable::shared(eta, 0.05, 0.8), table);
     }
 }

@@ -12,12 +12,12 @@
 //! (toward the viewer) point out of the medium.
 //!
 //! Rough boundary (a material with `roughness`, η ≠ 1; `crate::bsdf::transmittance`): both
-//! Fresnel transmittances 1 − F_r(cos θ) become the rough dielectric's directional
-//! transmittance T(cos θ; α) at the point's α, and c becomes √(c(α_i) c(α_o)) with
-//! c(α) = 2 ∫₀¹ T(μ; α) μ dμ (c(α) for a constant roughness; the geometric mean keeps S
-//! symmetric when the roughness is textured). The camera path realises the exit's T by
-//! sampling the boundary (its transmitted weight has mean T), the light tracer evaluates it.
-//! Both tend to the smooth terms as α → 0.
+//! Fresnel transmittances 1 − F_r(cos θ) become the fraction T(cos θ; α) that the
+//! energy-conserving rough dielectric lets through at the point's α, and c becomes
+//! √(c(α_i) c(α_o)) with c(α) = 2 ∫₀¹ T(μ; α) μ dμ (c(α) for a constant roughness; the
+//! geometric mean keeps S symmetric when the roughness is textured). The camera path realises
+//! the exit's T by sampling the boundary (it refracts with probability T), the light tracer
+//! evaluates it. Both tend to the smooth terms as α → 0.
 //!
 //! Reciprocity: written as R · (1 − F_r(cos θ_i))(1 − F_r(cos θ_o)) / (c π), S is symmetric
 //! under (x_i, ω_i) ↔ (x_o, ω_o) whenever the estimate is (every averaging estimator;
@@ -44,6 +44,7 @@
 //! above.
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use bssrdf_core::tabulated::AngularCoupling;
 use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SlabFace};
@@ -93,7 +94,19 @@ struct RoughBoundary {
     /// r (α = r²) over the surface.
     roughness: Field,
     /// T(μ; α) and c(α) over the material's range of α.
-    table: TransmittanceTable,
+    table: Arc<TransmittanceTable>,
+}
+
+/// The table of `material`'s rough boundary over its range of α ([`TransmittanceTable`],
+/// shared); `None` for a smooth or index-matched boundary.
+pub(crate) fn boundary_table(material: &Translucent) -> Option<Arc<TransmittanceTable>> {
+    let r = material.roughness.as_ref()?;
+    let (lo, hi) = (
+        alpha_from_roughness(r.min()[0]),
+        alpha_from_roughness(r.max()[0]),
+    );
+    (material.eta != 1.0 && hi >= SMOOTH_ALPHA)
+        .then(|| TransmittanceTable::shared(material.eta, lo.max(SMOOTH_ALPHA), hi))
 }
 
 /// The profile weight of one pair, with what the angular coupling needs to finish it
@@ -133,15 +146,12 @@ impl BssrdfObject {
         } else {
             None
         };
-        let rough = material.roughness.as_ref().and_then(|r| {
-            let (lo, hi) = (
-                alpha_from_roughness(r.min()[0]),
-                alpha_from_roughness(r.max()[0]),
-            );
-            (material.eta != 1.0 && hi >= SMOOTH_ALPHA).then(|| RoughBoundary {
-                roughness: r.clone(),
-                table: TransmittanceTable::new(material.eta, lo.max(SMOOTH_ALPHA), hi),
-            })
+        let rough = boundary_table(material).map(|table| RoughBoundary {
+            roughness: material
+                .roughness
+                .clone()
+                .expect("a rough boundary has a roughness"),
+            table,
         });
         Ok(Self {
             coupling,

@@ -38,7 +38,7 @@ use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator};
 
-use crate::bsdf::{Frame, RoughDielectric, oren_nayar};
+use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
@@ -229,6 +229,8 @@ enum ObjectKind<'s> {
         bssrdf: Option<Box<BssrdfObject>>,
         /// The medium has the same coefficients in every channel.
         grey: bool,
+        /// The rough boundary's albedo and transmittance, when the boundary is rough.
+        boundary: Option<std::sync::Arc<TransmittanceTable>>,
     },
 }
 
@@ -602,6 +604,7 @@ impl<'s> PathIntegrator<'s> {
                         material,
                         bssrdf,
                         grey: t.medium.is_grey(),
+                        boundary: crate::integrator::bssrdf::boundary_table(t),
                     }
                 }
                 _ => ObjectKind::Opaque,
@@ -737,6 +740,7 @@ impl<'s> PathIntegrator<'s> {
                     material,
                     bssrdf,
                     grey,
+                    ..
                 } => match bssrdf {
                     None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
                     Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
@@ -1097,9 +1101,10 @@ impl<'s> PathIntegrator<'s> {
     /// A rough boundary met from outside at `hit` by a ray travelling along `dir`, about the
     /// macro-normal `n` (facing the ray), with roughness `alpha`: next-event estimation on the
     /// reflection lobe, MIS-weighted against the boundary's own sampling (pbrt-v4 §13.4 with
-    /// the rough dielectric of [`crate::bsdf::RoughDielectric`]: the highlights of lights on a
-    /// rough surface), then a sampled crossing. Returns the transmitted direction, or the step
-    /// taken when the path was reflected (on, with the sample's density for MIS) or lost.
+    /// the energy-conserving rough dielectric `f / E` of [`crate::bsdf::dielectric`]: the
+    /// highlights of lights on a rough surface), then a sampled crossing. Returns the
+    /// transmitted direction, or the step taken when the path was reflected (on, with the
+    /// sample's density for MIS) or lost.
     #[allow(clippy::too_many_arguments)]
     fn rough_boundary(
         &self,
@@ -1115,36 +1120,61 @@ impl<'s> PathIntegrator<'s> {
         let frame = Frame::new(n);
         let wo = frame.to_local(-dir);
         let bsdf = RoughDielectric::new(interface.eta, alpha);
-        let ld = self.direct(
-            hit.p,
-            |wi| hit.spawn_origin(wi),
-            |wi| {
-                let l = frame.to_local(wi);
-                if l.z <= 0.0 {
-                    return (0.0, 0.0); // the transmission lobe has no light to find inside
-                }
-                (bsdf.f(wo, l) * l.z, bsdf.pdf(wo, l))
-            },
-            st.medium,
-            rng,
-            counters,
-        );
-        if !ld.l.is_zero() {
-            self.settle(st, rng, counters);
+        // The single-scattering albedo seen from ω_o, which the conserving lobe divides by.
+        let albedo = match self.boundary_table(hit.object) {
+            Some(t) => t.albedo(wo.z, alpha),
+            None => 1.0,
+        };
+        let conserving_pdf = |l: DVec3, pdf: f64| {
+            let d = bsdf.distribution;
+            pdf * (d.g(wo, l) / d.g1(wo)) / albedo
+        };
+        if albedo > 0.0 {
+            let ld = self.direct(
+                hit.p,
+                |wi| hit.spawn_origin(wi),
+                |wi| {
+                    let l = frame.to_local(wi);
+                    if l.z <= 0.0 {
+                        return (0.0, 0.0); // the transmission lobe finds no light inside
+                    }
+                    (
+                        bsdf.f(wo, l) * l.z / albedo,
+                        conserving_pdf(l, bsdf.pdf(wo, l)),
+                    )
+                },
+                st.medium,
+                rng,
+                counters,
+            );
+            if !ld.l.is_zero() {
+                self.settle(st, rng, counters);
+            }
+            st.add(
+                st.beta * ld.l,
+                st.order,
+                st.entered || ld.through_medium,
+                self.options.scattering,
+            );
         }
-        st.add(
-            st.beta * ld.l,
-            st.order,
-            st.entered || ld.through_medium,
-            self.options.scattering,
-        );
         match interface.cross_rough(dir, n, alpha, rng) {
             (Crossing::Transmit(t), _) => Ok(t),
-            (Crossing::Reflect(r), pdf) => {
-                st.prev = Prev::Sampled { p: hit.p, pdf };
+            (Crossing::Reflect(r), Some(s)) => {
+                st.prev = Prev::Sampled {
+                    p: hit.p,
+                    pdf: conserving_pdf(s.wi, s.pdf),
+                };
                 Err(Step::Continue(hit.spawn_ray(r)))
             }
-            (Crossing::Lost, _) => Err(Step::Stop),
+            _ => Err(Step::Stop),
+        }
+    }
+
+    /// The rough boundary's table of `object` (a translucent object with a rough boundary).
+    fn boundary_table(&self, object: u32) -> Option<&TransmittanceTable> {
+        match self.objects.get(object as usize)? {
+            ObjectKind::Translucent { boundary, .. } => boundary.as_deref(),
+            ObjectKind::Opaque => None,
         }
     }
 

@@ -21,7 +21,7 @@
 use bssrdf_core::Rgb;
 use glam::DVec3;
 
-use crate::bsdf::{Frame, Lobe, RoughDielectric, alpha_from_roughness};
+use crate::bsdf::{DielectricSample, Frame, Lobe, RoughDielectric, alpha_from_roughness};
 use crate::field::Field;
 use crate::geometry::{Geometry, Hit, Ray};
 use crate::integrator::counters::PathCounters;
@@ -66,9 +66,9 @@ pub enum Crossing {
     Reflect(DVec3),
     /// Transmission into this direction (refracted when η ≠ 1).
     Transmit(DVec3),
-    /// Lost at a rough boundary: the sampled direction left to the wrong side, or Russian
-    /// roulette on the sample's weight `G/G1` ended the path (the light a single-scattering
-    /// microsurface drops, [`crate::bsdf::dielectric`]). The walk ends as if absorbed.
+    /// Lost at a rough boundary: no sample of the energy-conserving lobe was kept in
+    /// [`crate::bsdf::dielectric::MAX_TRIES`] draws (probability below 1e-14). The walk ends as
+    /// if absorbed.
     Lost,
 }
 
@@ -117,27 +117,31 @@ impl<'a> Interface<'a> {
     }
 
     /// Crosses a rough boundary of roughness `alpha` at a surface with outward normal `ng`
-    /// (from either side): a microfacet normal drawn from those visible from `−dir`, then
-    /// reflection or refraction through it ([`RoughDielectric::sample`]), kept with the
-    /// probability of its weight `G/G1` (Russian roulette, so that the walk stays analog).
-    /// Returns the crossing and the solid-angle density of its direction (0 when lost).
-    pub fn cross_rough(&self, dir: DVec3, ng: DVec3, alpha: f64, rng: &mut Rng) -> (Crossing, f64) {
+    /// (from either side): reflection or refraction through a microfacet normal drawn from
+    /// those visible from `−dir`, by the energy-conserving lobe
+    /// ([`RoughDielectric::sample_conserving`]), so that the walk stays analog and the boundary
+    /// loses no light. Returns the crossing and the single-scattering sample it kept (its
+    /// density and `G/G1`, from which a caller that knows the single-scattering albedo E forms
+    /// the conserving lobe's density `pdf · (G/G1) / E` for MIS); `Lost` in the 1e-14 case where
+    /// no sample was kept.
+    pub fn cross_rough(
+        &self,
+        dir: DVec3,
+        ng: DVec3,
+        alpha: f64,
+        rng: &mut Rng,
+    ) -> (Crossing, Option<DielectricSample>) {
         let frame = Frame::new(ng);
         let wo = frame.to_local(-dir);
-        let uc = rng.uniform();
-        let u = rng.uniform2();
-        let Some(s) = RoughDielectric::new(self.eta, alpha).sample(wo, uc, u) else {
-            return (Crossing::Lost, 0.0);
+        let Some(s) = RoughDielectric::new(self.eta, alpha).sample_conserving(wo, rng) else {
+            return (Crossing::Lost, None);
         };
-        if s.weight < 1.0 && rng.uniform() >= s.weight {
-            return (Crossing::Lost, 0.0);
-        }
         let w = frame.to_world(s.wi).normalize();
         let crossing = match s.lobe {
             Lobe::Reflection => Crossing::Reflect(w),
             Lobe::Transmission => Crossing::Transmit(w),
         };
-        (crossing, s.pdf)
+        (crossing, Some(s))
     }
 
     /// Crosses the interface at a surface with outward normal `ng`, for a ray travelling along

@@ -360,6 +360,42 @@ mod tests {
         }
     }
 
+    /// The irradiance of a half sky (radiance L above the horizon, 0 below; the horizon on a
+    /// texel edge) on a plane whose normal is at β from up, estimated with the map's sampler
+    /// and density as next-event estimation does: π L (1 + cos β)/2 within 4 SE + 0.05 % (the
+    /// bilinear blur of the horizon takes δ²/6 ≈ 0.04 % from β = 0, δ = half a texel row).
+    #[test]
+    fn half_sky_irradiance_by_sampling() {
+        let l = 2.0f32;
+        let texels = (0..64 * 32)
+            .map(|k| if k / 64 < 16 { [l; 3] } else { [0.0; 3] })
+            .collect();
+        let t = Texture::from_texels("half.exr", 64, 32, texels).unwrap();
+        let m = EnvironmentMap::new(Arc::new(t), Rgb::ONE, Axis::Z, 0.0).unwrap();
+        let mut rng = Rng::from_keys(1, &[]);
+        for beta in [0.0f64, 60.0, 120.0] {
+            let b = beta.to_radians();
+            let n = DVec3::new(0.0, b.sin(), b.cos());
+            let k = 1_000_000;
+            let (mut s, mut s2) = (0.0, 0.0);
+            for _ in 0..k {
+                let v = match m.sample(rng.uniform2()) {
+                    Some((w, p, radiance)) => radiance[0] * w.dot(n).max(0.0) / p,
+                    None => 0.0,
+                };
+                s += v;
+                s2 += v * v;
+            }
+            let mean = s / k as f64;
+            let se = ((s2 / k as f64 - mean * mean) / k as f64).sqrt();
+            let want = PI * f64::from(l) * (1.0 + b.cos()) / 2.0;
+            assert!(
+                (mean - want).abs() < 4.0 * se + 5e-4 * want,
+                "β {beta}: {mean} ± {se} against {want}"
+            );
+        }
+    }
+
     /// A constant map: radiance equal to the texel everywhere, mean equal to it, density close
     /// to uniform (exactly uniform in θ's cosine would be 1/4π; rows differ by sin θ's
     /// variation inside them).
