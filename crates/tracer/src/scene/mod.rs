@@ -22,9 +22,13 @@
 //!   artist parameters `subsurface_color` (field, in [0, 1]) and `subsurface_radius` (field,
 //!   mean free path per channel in file units), with optional `radius_scale` (RGB, default 1)
 //!   and `invert = "before" | "after"`; `anisotropy` is another name for `g`
-//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). Or `type =
-//!   "diffuse"` with `name`, `albedo`. Unused materials are validated but their textures are
-//!   not decoded.
+//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). A translucent
+//!   material's optional `roughness` (a grey field in [0, 1], default 0: smooth) makes its
+//!   boundary a GGX microfacet dielectric of α = roughness² ([`Translucent::roughness`]). Or
+//!   `type = "diffuse"` with `name`, `albedo` (a field in [0, 1]) and an optional Oren–Nayar
+//!   `roughness` (a grey field in [0, 1], default 0: Lambertian; [`Diffuse`]). Unused
+//!   materials are validated but their textures are not decoded
+//!   (`docs/lighting-and-surfaces.md`).
 //! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
 //!   `constant` (`value`); `stripe` (`width`, `angle` in degrees, `values = [v0, v1]`, `axis`,
 //!   `origin`); `check` (`width`, `values`, `axis`, `origin`); `image` (`texture`, `mapping =
@@ -32,8 +36,10 @@
 //!   `filter = "bilinear" | "nearest"`, `scale`). See [`crate::field`] for the projection.
 //! * `[[light]]`: `directional` (`direction` it travels, `irradiance`), `point` (`position`,
 //!   `intensity`), `quad` (`corner`, `edge_u`, `edge_v`, `radiance`; emits on the side of
-//!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`), `beam`
-//!   (`origin`, `direction`, `power`).
+//!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`, or an
+//!   equirectangular `.exr` or Radiance `.hdr` image `filename` with `scale` (RGB, default 1),
+//!   `rotation` (degrees about the map's up axis, default 0) and `up` (`"x" | "y" | "z"`,
+//!   default z): [`crate::light::EnvironmentMap`]), `beam` (`origin`, `direction`, `power`).
 //! * `[[shape]]`: `box` (`min`, `max`), `sphere` (`centre`, `radius`, `subdivisions`),
 //!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
 //!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
