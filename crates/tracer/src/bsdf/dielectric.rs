@@ -107,7 +107,7 @@ impl RoughDielectric {
     /// True when α is below [`SMOOTH_ALPHA`] (or η = 1, no boundary): the boundary acts as a
     /// smooth one.
     pub fn is_smooth(eta: f64, alpha: f64) -> bool {
-        eta == 1.0 || !(alpha >= SMOOTH_ALPHA)
+        eta == 1.0 || alpha.is_nan() || alpha < SMOOTH_ALPHA
     }
 
     /// The pair seen from `ω_o`'s side: both directions mirrored through the surface when

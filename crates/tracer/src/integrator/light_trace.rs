@@ -386,10 +386,10 @@ impl<'s> LightTracer<'s> {
             Emitter::Directional {
                 direction,
                 irradiance,
-            } => self.from_disk(direction, irradiance, v),
+            } => self.disk_ray(direction, irradiance, v),
             Emitter::Environment(e) => {
                 let (w, pdf, radiance) = e.sample(u)?;
-                self.from_disk(-w, radiance / pdf, v)
+                self.disk_ray(-w, radiance / pdf, v)
             }
         }
     }
@@ -397,7 +397,7 @@ impl<'s> LightTracer<'s> {
     /// A ray travelling along `dir` from a point of the emission disk drawn with `v`, and its
     /// flux weight: `per_direction` (irradiance, or radiance over the direction's density) times
     /// the disk's area.
-    fn from_disk(&self, dir: DVec3, per_direction: Rgb, v: [f64; 2]) -> Option<(Ray, Rgb)> {
+    fn disk_ray(&self, dir: DVec3, per_direction: Rgb, v: [f64; 2]) -> Option<(Ray, Rgb)> {
         let d = self.disk;
         if d.radius.is_nan() || d.radius <= 0.0 {
             return None;

@@ -513,6 +513,15 @@ fn carried(beta: Rgb, r_u: Rgb, q: Rgb) -> (Rgb, Rgb) {
     }
 }
 
+/// What a path did at a rough boundary met from outside
+/// ([`PathIntegrator::rough_boundary`]).
+enum Crossed {
+    /// Refracted into the medium along this direction.
+    Entered(DVec3),
+    /// Reflected (on with this step) or lost.
+    Stepped(Step),
+}
+
 /// The outcome of shading one surface interaction.
 enum Step {
     /// Trace this ray (outside any medium) next.
@@ -1064,8 +1073,8 @@ impl<'s> PathIntegrator<'s> {
             Some(alpha) => match self
                 .rough_boundary(hit, ray.dir, hit.ng, alpha, &interface, st, rng, counters)
             {
-                Ok(t) => t,
-                Err(step) => return step,
+                Crossed::Entered(t) => t,
+                Crossed::Stepped(step) => return step,
             },
             None => match interface.cross(ray.dir, hit.ng, rng) {
                 Crossing::Reflect(r) => {
@@ -1116,7 +1125,7 @@ impl<'s> PathIntegrator<'s> {
         st: &mut PathState,
         rng: &mut Rng,
         counters: &mut PathCounters,
-    ) -> Result<DVec3, Step> {
+    ) -> Crossed {
         let frame = Frame::new(n);
         let wo = frame.to_local(-dir);
         let bsdf = RoughDielectric::new(interface.eta, alpha);
@@ -1158,15 +1167,15 @@ impl<'s> PathIntegrator<'s> {
             );
         }
         match interface.cross_rough(dir, n, alpha, rng) {
-            (Crossing::Transmit(t), _) => Ok(t),
+            (Crossing::Transmit(t), _) => Crossed::Entered(t),
             (Crossing::Reflect(r), Some(s)) => {
                 st.prev = Prev::Sampled {
                     p: hit.p,
                     pdf: conserving_pdf(s.wi, s.pdf),
                 };
-                Err(Step::Continue(hit.spawn_ray(r)))
+                Crossed::Stepped(Step::Continue(hit.spawn_ray(r)))
             }
-            _ => Err(Step::Stop),
+            _ => Crossed::Stepped(Step::Stop),
         }
     }
 
@@ -1342,7 +1351,7 @@ impl<'s> PathIntegrator<'s> {
         match alpha_o {
             Some(alpha) => {
                 let interface = Interface::of(material);
-                if let Err(step) =
+                if let Crossed::Stepped(step) =
                     self.rough_boundary(hit, ray.dir, n_o, alpha, &interface, st, rng, counters)
                 {
                     return step;

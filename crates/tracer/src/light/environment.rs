@@ -161,7 +161,7 @@ impl EnvironmentMap {
 
     /// The world direction of `l` given in the map's frame.
     #[inline]
-    fn from_local(&self, l: DVec3) -> DVec3 {
+    fn to_world(&self, l: DVec3) -> DVec3 {
         match self.up {
             Axis::Z => l,
             Axis::Y => DVec3::new(l.y, l.z, l.x),
@@ -191,7 +191,7 @@ impl EnvironmentMap {
         let (sin_t, cos_t) = theta.sin_cos();
         let (sin_p, cos_p) = phi.sin_cos();
         (
-            self.from_local(DVec3::new(sin_t * cos_p, sin_t * sin_p, cos_t)),
+            self.to_world(DVec3::new(sin_t * cos_p, sin_t * sin_p, cos_t)),
             sin_t,
         )
     }
