@@ -1115,6 +1115,7 @@ impl<'s> PathIntegrator<'s> {
     /// transmitted direction, or the step taken when the path was reflected (on, with the
     /// sample's density for MIS) or lost.
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)] // out of the smooth boundaries' path
     fn rough_boundary(
         &self,
         hit: &Hit,

@@ -124,6 +124,7 @@ impl<'a> Interface<'a> {
     /// density and `G/G1`, from which a caller that knows the single-scattering albedo E forms
     /// the conserving lobe's density `pdf · (G/G1) / E` for MIS); `Lost` in the 1e-14 case where
     /// no sample was kept.
+    #[inline(never)] // out of the walk's loop for smooth boundaries
     pub fn cross_rough(
         &self,
         dir: DVec3,

@@ -217,7 +217,7 @@ impl EnvironmentMap {
     }
 
     /// The radiance arriving along `−d` (`d` unit: the direction looked toward).
-    #[inline]
+    #[inline(never)] // out of the light loop of scenes without a map
     pub fn radiance(&self, d: DVec3) -> Rgb {
         self.radiance_at(self.uv(d).0)
     }
@@ -225,7 +225,7 @@ impl EnvironmentMap {
     /// Samples a direction `ω` toward the environment with the uniforms `u ∈ [0, 1)²`:
     /// `(ω, p(ω), L(ω))`, the solid-angle density (module docs). `None` for the measure-zero
     /// samples at a pole, where the density is not defined.
-    #[inline]
+    #[inline(never)] // out of the light loop of scenes without a map
     pub fn sample(&self, u: [f64; 2]) -> Option<(DVec3, f64, Rgb)> {
         // The distribution picks the row (v) with the first number.
         let (uv, p_uv) = self.distribution.sample(u);
@@ -236,7 +236,7 @@ impl EnvironmentMap {
 
     /// The solid-angle density with which [`EnvironmentMap::sample`] produces the unit
     /// direction `d`.
-    #[inline]
+    #[inline(never)] // out of the light loop of scenes without a map
     pub fn pdf(&self, d: DVec3) -> f64 {
         let (uv, sin_t) = self.uv(d);
         if sin_t <= 0.0 {
