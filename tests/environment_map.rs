@@ -74,25 +74,33 @@ fn sphere_on_floor(light: Light) -> Scene {
 }
 
 /// A constant 8 × 4 map renders as the constant environment of the same radiance, with the
-/// path tracer and with Sone's BSSRDF (whose probes gather the environment's light at the
-/// incident points): image means per channel within 4 SE, the SE under 1.5 % of the mean.
-/// A map whose density forgot the sin θ of its rows, or read its rows upside down, fails.
+/// path tracer (MIS, and next-event estimation alone, where an error in the map's density
+/// cannot hide behind the MIS weights) and with Sone's BSSRDF (whose probes gather the
+/// environment's light at the incident points): image means per channel within 4 SE, the SE
+/// under 3 % of the mean.
 #[test]
 fn a_constant_map_renders_as_the_constant_environment() {
     let l = [0.7f32, 0.9, 1.2];
     let constant = sphere_on_floor(Light::environment(Rgb(l.map(f64::from))).unwrap());
     let mapped = sphere_on_floor(Light::environment_map(map(8, 4, Axis::Z, 30.0, |_, _| l)));
-    for method in ["pt", "sone"] {
+    for (method, strategy) in [
+        ("pt", LightStrategy::Mis),
+        ("pt", LightStrategy::LightOnly),
+        ("sone", LightStrategy::Mis),
+    ] {
         let method: Method = method.parse().unwrap();
         let mean = |scene: &Scene| {
-            let integrator = PathIntegrator::new(scene, method, OPTIONS).unwrap();
+            let integrator = PathIntegrator::new(scene, method, OPTIONS)
+                .unwrap()
+                .with_light_strategy(strategy);
             image_mean_and_se(&integrator, 8, 8)
         };
         let ((a, sa, _), (b, sb, _)) = (mean(&constant), mean(&mapped));
         for c in 0..3 {
             let z = (a[c] - b[c]) / (sa[c] * sa[c] + sb[c] * sb[c]).sqrt();
             eprintln!(
-                "{}: channel {c}: constant {:.4} ± {:.4}, map {:.4} ± {:.4}, z = {z:.2}",
+                "{} {strategy:?}: channel {c}: constant {:.4} ± {:.4}, map {:.4} ± {:.4}, z = \
+                 {z:.2}",
                 method.name(),
                 a[c],
                 sa[c],
@@ -100,7 +108,7 @@ fn a_constant_map_renders_as_the_constant_environment() {
                 sb[c]
             );
             assert!(z.abs() < 4.0, "{}: channel {c}: z = {z}", method.name());
-            assert!(sb[c] < 0.015 * b[c], "test too weak: {} ± {}", b[c], sb[c]);
+            assert!(sb[c] < 0.03 * b[c], "test too weak: {} ± {}", b[c], sb[c]);
         }
     }
 }
