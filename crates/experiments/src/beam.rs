@@ -317,7 +317,7 @@ pub fn trace_photons(
         object: entry.object,
         medium: &view,
         g: t.g,
-        interface: Interface { eta: 1.0 },
+        interface: Interface::smooth(1.0),
     };
     let n = setup.resolution as usize;
     let (e, delta) = (setup.extent, setup.pixel_size());

@@ -38,6 +38,7 @@ use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator};
 
+use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
@@ -49,7 +50,7 @@ use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
-use crate::scene::{Material, Scene, Translucent};
+use crate::scene::{Diffuse, Material, Scene, Translucent};
 use crate::spectral::{HeroTracking, SpectralView};
 use crate::volume::{ChannelView, FreeFlight, direction_about, transmittance};
 
@@ -228,6 +229,8 @@ enum ObjectKind<'s> {
         bssrdf: Option<Box<BssrdfObject>>,
         /// The medium has the same coefficients in every channel.
         grey: bool,
+        /// The rough boundary's albedo and transmittance, when the boundary is rough.
+        boundary: Option<std::sync::Arc<TransmittanceTable>>,
     },
 }
 
@@ -510,6 +513,15 @@ fn carried(beta: Rgb, r_u: Rgb, q: Rgb) -> (Rgb, Rgb) {
     }
 }
 
+/// What a path did at a rough boundary met from outside
+/// ([`PathIntegrator::rough_boundary`]).
+enum Crossed {
+    /// Refracted into the medium along this direction.
+    Entered(DVec3),
+    /// Reflected (on with this step) or lost.
+    Stepped(Step),
+}
+
 /// The outcome of shading one surface interaction.
 enum Step {
     /// Trace this ray (outside any medium) next.
@@ -601,6 +613,7 @@ impl<'s> PathIntegrator<'s> {
                         material,
                         bssrdf,
                         grey: t.medium.is_grey(),
+                        boundary: crate::integrator::bssrdf::boundary_table(t),
                     }
                 }
                 _ => ObjectKind::Opaque,
@@ -736,6 +749,7 @@ impl<'s> PathIntegrator<'s> {
                     material,
                     bssrdf,
                     grey,
+                    ..
                 } => match bssrdf {
                     None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
                     Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
@@ -749,9 +763,7 @@ impl<'s> PathIntegrator<'s> {
                         }
                         Step::Stop
                     }
-                    Material::Diffuse { albedo } => {
-                        self.diffuse(&hit, &ray, *albedo, &mut st, rng, counters)
-                    }
+                    Material::Diffuse(d) => self.diffuse(&hit, &ray, d, &mut st, rng, counters),
                     Material::Translucent(_) => unreachable!("translucent objects are prepared"),
                 },
             };
@@ -960,7 +972,7 @@ impl<'s> PathIntegrator<'s> {
         &self,
         hit: &Hit,
         ray: &Ray,
-        albedo: Rgb,
+        material: &Diffuse,
         st: &mut PathState,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -970,13 +982,24 @@ impl<'s> PathIntegrator<'s> {
         } else {
             -hit.ns
         };
+        let albedo = material.albedo_at(hit);
+        // π f / ρ: 1 (Lambert), or the Oren–Nayar factor of a rough surface.
+        let sigma = material.roughness_at(hit);
+        let shape = |wi: DVec3| {
+            if sigma > 0.0 {
+                oren_nayar(sigma, n, -ray.dir, wi)
+            } else {
+                1.0
+            }
+        };
         let ld = self.direct(
             hit.p,
             |wi| hit.spawn_origin(wi),
             |wi| {
                 let c = wi.dot(n);
                 if c > 0.0 {
-                    (c / std::f64::consts::PI, c / std::f64::consts::PI)
+                    let pdf = c / std::f64::consts::PI;
+                    (shape(wi) * pdf, pdf)
                 } else {
                     (0.0, 0.0)
                 }
@@ -999,7 +1022,7 @@ impl<'s> PathIntegrator<'s> {
         let Some((wi, cos)) = cosine_continuation(n, rng) else {
             return Step::Stop;
         };
-        st.beta *= albedo;
+        st.beta *= albedo * shape(wi);
         st.prev = Prev::Sampled {
             p: hit.p,
             pdf: cos / std::f64::consts::PI,
@@ -1041,17 +1064,26 @@ impl<'s> PathIntegrator<'s> {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Step {
-        let interface = Interface { eta: material.eta };
+        let interface = Interface::of(material);
         if ray.dir.dot(hit.ng) >= 0.0 {
             // Arrived from inside (a camera inside the object): pass the face.
             return Step::Continue(hit.spawn_ray(ray.dir));
         }
-        let dir = match interface.cross(ray.dir, hit.ng, rng) {
-            Crossing::Reflect(r) => {
-                st.prev = Prev::Specular;
-                return Step::Continue(hit.spawn_ray(r));
-            }
-            Crossing::Transmit(t) => t,
+        let dir = match interface.rough_alpha(hit) {
+            Some(alpha) => match self
+                .rough_boundary(hit, ray.dir, hit.ng, alpha, &interface, st, rng, counters)
+            {
+                Crossed::Entered(t) => t,
+                Crossed::Stepped(step) => return step,
+            },
+            None => match interface.cross(ray.dir, hit.ng, rng) {
+                Crossing::Reflect(r) => {
+                    st.prev = Prev::Specular;
+                    return Step::Continue(hit.spawn_ray(r));
+                }
+                Crossing::Transmit(t) => t,
+                Crossing::Lost => return Step::Stop,
+            },
         };
         st.entered = true;
         // Through an index-matched boundary the direction is unchanged: the vertex before the
@@ -1073,6 +1105,87 @@ impl<'s> PathIntegrator<'s> {
             rng,
             counters,
         )
+    }
+
+    /// A rough boundary met from outside at `hit` by a ray travelling along `dir`, about the
+    /// macro-normal `n` (facing the ray), with roughness `alpha`: next-event estimation on the
+    /// reflection lobe, MIS-weighted against the boundary's own sampling (pbrt-v4 §13.4 with
+    /// the energy-conserving rough dielectric `f / E` of [`crate::bsdf::dielectric`]: the
+    /// highlights of lights on a rough surface), then a sampled crossing. Returns the
+    /// transmitted direction, or the step taken when the path was reflected (on, with the
+    /// sample's density for MIS) or lost.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)] // out of the smooth boundaries' path
+    fn rough_boundary(
+        &self,
+        hit: &Hit,
+        dir: DVec3,
+        n: DVec3,
+        alpha: f64,
+        interface: &Interface<'_>,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Crossed {
+        let frame = Frame::new(n);
+        let wo = frame.to_local(-dir);
+        let bsdf = RoughDielectric::new(interface.eta, alpha);
+        // The single-scattering albedo seen from ω_o, which the conserving lobe divides by.
+        let albedo = match self.boundary_table(hit.object) {
+            Some(t) => t.albedo(wo.z, alpha),
+            None => 1.0,
+        };
+        let conserving_pdf = |l: DVec3, pdf: f64| {
+            let d = bsdf.distribution;
+            pdf * (d.g(wo, l) / d.g1(wo)) / albedo
+        };
+        if albedo > 0.0 {
+            let ld = self.direct(
+                hit.p,
+                |wi| hit.spawn_origin(wi),
+                |wi| {
+                    let l = frame.to_local(wi);
+                    if l.z <= 0.0 {
+                        return (0.0, 0.0); // the transmission lobe finds no light inside
+                    }
+                    (
+                        bsdf.f(wo, l) * l.z / albedo,
+                        conserving_pdf(l, bsdf.pdf(wo, l)),
+                    )
+                },
+                st.medium,
+                rng,
+                counters,
+            );
+            if !ld.l.is_zero() {
+                self.settle(st, rng, counters);
+            }
+            st.add(
+                st.beta * ld.l,
+                st.order,
+                st.entered || ld.through_medium,
+                self.options.scattering,
+            );
+        }
+        match interface.cross_rough(dir, n, alpha, rng) {
+            (Crossing::Transmit(t), _) => Crossed::Entered(t),
+            (Crossing::Reflect(r), Some(s)) => {
+                st.prev = Prev::Sampled {
+                    p: hit.p,
+                    pdf: conserving_pdf(s.wi, s.pdf),
+                };
+                Crossed::Stepped(Step::Continue(hit.spawn_ray(r)))
+            }
+            _ => Crossed::Stepped(Step::Stop),
+        }
+    }
+
+    /// The rough boundary's table of `object` (a translucent object with a rough boundary).
+    fn boundary_table(&self, object: u32) -> Option<&TransmittanceTable> {
+        match self.objects.get(object as usize)? {
+            ObjectKind::Translucent { boundary, .. } => boundary.as_deref(),
+            ObjectKind::Opaque => None,
+        }
     }
 
     /// The volumetric random walk in `object` from `start` along `dir` (see [`super::walk`]),
@@ -1099,7 +1212,7 @@ impl<'s> PathIntegrator<'s> {
             st.hero = Some(rng.below(3) as usize);
         }
         st.medium = Some(object);
-        let interface = Interface { eta: material.eta };
+        let interface = Interface::of(material);
         let nee = interface.is_index_matched() && !self.lights.is_empty();
         let filter = self.options.scattering;
         self.settle(st, rng, counters);
@@ -1202,7 +1315,7 @@ impl<'s> PathIntegrator<'s> {
             object,
             medium: flight,
             g: material.g,
-            interface: Interface { eta: material.eta },
+            interface: Interface::of(material),
         }
         .walk_carrying(start, dir, from, order, q, rng, counters, on_scatter)
     }
@@ -1231,15 +1344,32 @@ impl<'s> PathIntegrator<'s> {
         let Some(n_o) = facing_normal(hit, -ray.dir) else {
             return Step::Continue(hit.spawn_ray(ray.dir));
         };
-        if material.eta != 1.0 {
-            let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
-            if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
-                st.prev = Prev::Specular;
-                return Step::Continue(
-                    hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
-                );
+        // The exit through the boundary: Fresnel reflection of a smooth boundary with its
+        // probability; a rough one reflects off a sampled microfacet (light found by
+        // next-event estimation too) or transmits with the weight whose mean is T(μ_o; α), the
+        // rough transmittance S uses ([`BssrdfObject::transmission`]).
+        let alpha_o = b.rough_alpha(hit);
+        match alpha_o {
+            Some(alpha) => {
+                let interface = Interface::of(material);
+                if let Crossed::Stepped(step) =
+                    self.rough_boundary(hit, ray.dir, n_o, alpha, &interface, st, rng, counters)
+                {
+                    return step;
+                }
             }
+            None if material.eta != 1.0 => {
+                let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
+                if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
+                    st.prev = Prev::Specular;
+                    return Step::Continue(
+                        hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
+                    );
+                }
+            }
+            None => {}
         }
+        let alpha_o = alpha_o.unwrap_or(0.0);
         let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
         if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
             st.beta *= f_o; // the shape correction's exit factor
@@ -1263,6 +1393,7 @@ impl<'s> PathIntegrator<'s> {
         let carrier = rng.below(set.len() as u32) as usize;
         let mut next = None;
         for (k, &x_i) in set.iter().enumerate() {
+            let alpha_i = b.alpha_at(&x_i);
             let ld = self.direct(
                 x_i.p,
                 |wi| x_i.spawn_origin(wi),
@@ -1274,7 +1405,7 @@ impl<'s> PathIntegrator<'s> {
                     };
                     let cos = wi.dot(n);
                     let pdf = wi.dot(x_i.ns).max(0.0) / std::f64::consts::PI;
-                    (b.entry_lobe(cos) * cos, pdf)
+                    (b.entry_lobe(cos, alpha_i, alpha_o) * cos, pdf)
                 },
                 None,
                 rng,
@@ -1337,7 +1468,7 @@ impl<'s> PathIntegrator<'s> {
             return Step::Stop;
         }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
-        st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
+        st.beta *= b.entry_lobe(cos, b.alpha_at(&x_i), alpha_o) * std::f64::consts::PI;
         if let Some(f_i) = b.correction_along(&x_i, wi, x_i.ns) {
             st.beta *= f_i; // the shape correction's entry factor for the continuation
         }

@@ -46,7 +46,7 @@ fn scene(lights: &[Light], half: f64, material: Material) -> Scene {
     .unwrap();
     let mut b = SceneBuilder::new(RenderSettings::new(N, N, 1), camera);
     for l in lights {
-        b = b.light(*l);
+        b = b.light(l.clone());
     }
     b.object(
         "floor",
@@ -58,13 +58,7 @@ fn scene(lights: &[Light], half: f64, material: Material) -> Scene {
 }
 
 fn floor(lights: &[Light], half: f64) -> Scene {
-    scene(
-        lights,
-        half,
-        Material::Diffuse {
-            albedo: Rgb::splat(RHO),
-        },
-    )
+    scene(lights, half, Material::diffuse(Rgb::splat(RHO)))
 }
 
 fn half_space(lights: &[Light], half: f64, eta: f64) -> Scene {
@@ -200,7 +194,10 @@ fn light_sampling_and_direction_sampling_agree_with_mis_and_the_closed_form() {
     // A quad and a dim environment together: each strategy alone reaches both.
     let light = quad(4.0, 3.0, 1.0);
     let l_env = 0.2;
-    let lights = [light, Light::environment(Rgb::splat(l_env)).unwrap()];
+    let lights = [
+        light.clone(),
+        Light::environment(Rgb::splat(l_env)).unwrap(),
+    ];
     let half = 2.0;
     let verts = vertices(&light);
     // The quad hides part of the environment's sky: E_env = π L_env − L_env · E_quad(L = 1).
