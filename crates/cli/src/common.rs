@@ -82,8 +82,10 @@ pub fn claim_outputs(exr: &Path, inputs: &[&Path]) -> anyhow::Result<OutputLock>
     Ok(lock)
 }
 
-/// One line per rare event that happened, so that no cap or fallback is silent.
-pub fn warn_counters(c: &PathCounters) {
+/// One line per rare event that happened, so that no cap or fallback is silent. The estimators'
+/// averaging counts, and fallbacks below 1 % of the estimates, only with `verbose` (the sidecar's
+/// `counters` always has them).
+pub fn warn_counters(c: &PathCounters, verbose: bool) {
     if c.capped > 0 {
         say!(
             "warning: {} of {} paths ({:.3} %) hit the collision cap of {} collisions and were cut \
@@ -106,13 +108,13 @@ pub fn warn_counters(c: &PathCounters) {
             c.profile_failures
         );
     }
-    if c.estimator_fallbacks > 0 {
+    if c.estimator_fallbacks > 0 && (verbose || c.estimator_fallbacks * 100 > c.estimates) {
         say!(
             "note: {} estimates fell back to the endpoint average (every projection missed)",
             c.estimator_fallbacks
         );
     }
-    if c.prefiltered + c.prefilter_fallbacks + c.lifted > 0 {
+    if verbose && c.prefiltered + c.prefilter_fallbacks + c.lifted > 0 {
         let charts = if c.chart_fallbacks > 0 {
             format!(
                 " ({} of them where the texture coordinates were not one affine map)",

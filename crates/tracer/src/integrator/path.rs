@@ -375,7 +375,7 @@ pub struct PathIntegrator<'s> {
     options: PathOptions,
     objects: Vec<ObjectKind<'s>>,
     lights: LightSet,
-    warnings: Vec<String>,
+    warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
     defer_weights: bool,
@@ -639,24 +639,42 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Things about the scene that make this method's image misleading (printed by the CLI).
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[crate::integrator::warnings::Warning] {
         &self.warnings
     }
 
     /// What preparing the render did that a user may want to know: one line per object a
-    /// BSSRDF method path-traces (`--method auto`), and one per object whose shape correction
+    /// BSSRDF method path-traces (clear media; small objects under `--method auto`), and one per object whose shape correction
     /// was measured (points, spacing, wall time).
     pub fn notes(&self) -> Vec<String> {
-        let traced = self
-            .object_plans()
+        let plans = self.object_plans();
+        let traced = |clear: bool| -> Vec<String> {
+            plans
+                .iter()
+                .filter(|(_, p)| {
+                    p.path_traced
+                        && p.clear == clear
+                        && matches!(self.method, Method::Bssrdf { .. })
+                })
+                .map(|(name, _)| format!("`{name}`"))
+                .collect()
+        };
+        let groups = [
+            (
+                traced(true),
+                "its medium does not scatter (a clear absorbing dielectric, which no BSSRDF \
+                 describes)",
+            ),
+            (
+                traced(false),
+                "too small for a half-space profile (`--method auto`; `--method sone` renders \
+                 it with the BSSRDF)",
+            ),
+        ];
+        let traced = groups
             .into_iter()
-            .filter(|(_, p)| p.path_traced && matches!(self.method, Method::Bssrdf { .. }))
-            .map(|(name, _)| {
-                format!(
-                    "`{name}` is path traced: it is too small for a half-space profile \
-                     (`--method auto`; `--method sone` renders it with the BSSRDF)"
-                )
-            });
+            .filter(|(names, _)| !names.is_empty())
+            .map(|(names, why)| format!("path traced, {why}: {}", names.join(", ")));
         let corrections = self.scene.objects().iter().zip(&self.objects).filter_map(
             |(object, kind)| match kind {
                 ObjectKind::Translucent {

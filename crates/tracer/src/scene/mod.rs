@@ -162,15 +162,21 @@ impl Translucent {
         scattering: Scattering,
         estimator: Estimator,
     ) -> Result<(ProfileFamily, PreparedEstimator), (&'static str, ParamError)> {
-        let model = model
-            .or(self.profile)
-            .unwrap_or(ProfileModel::default_for(self.eta));
+        let model = self.profile_model(model);
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
         let prepared = estimator
             .prepare(self.g, self.eta)
             .map_err(|e| ("estimator", e))?;
         Ok((family, prepared))
+    }
+
+    /// The profile a BSSRDF renders this material with: `model` (the command line's), else the
+    /// material's own `profile`, else [`ProfileModel::default_for`] its η.
+    pub fn profile_model(&self, model: Option<ProfileModel>) -> ProfileModel {
+        model
+            .or(self.profile)
+            .unwrap_or(ProfileModel::default_for(self.eta))
     }
 
     /// A translucent material with no profile and unit scale 1 (validated when the scene is
@@ -254,14 +260,31 @@ pub struct Scene {
     source_path: Option<PathBuf>,
     display_name: String,
     inputs: Vec<PathBuf>,
-    notes: Vec<String>,
+    notes: Vec<LoadNote>,
+}
+
+/// Something the loader read but could not honour (for example a part of a glTF material that
+/// is not read, `docs/gltf.md`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoadNote {
+    /// The file it is about (a glTF model).
+    pub file: String,
+    /// What in that file (`material `jade``).
+    pub subject: String,
+    /// One sentence.
+    pub text: String,
+}
+
+impl std::fmt::Display for LoadNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.subject, self.text)
+    }
 }
 
 impl Scene {
-    /// What the loader read but could not honour, one sentence each (for example the parts of
-    /// a glTF material that are not read, `docs/gltf.md`). Renders list them among their
-    /// warnings.
-    pub fn load_notes(&self) -> &[String] {
+    /// What the loader read but could not honour, one sentence each. Renders list them among
+    /// their warnings, one warning per file.
+    pub fn load_notes(&self) -> &[LoadNote] {
         &self.notes
     }
 
