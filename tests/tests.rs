@@ -9,6 +9,7 @@ mod integrators;
 mod precision;
 mod readme;
 mod reciprocity;
+mod scene_format;
 mod shapes;
 mod slab_table;
 mod spectral;

@@ -354,6 +354,10 @@ impl Transmission {
 enum Prev {
     /// Camera or a specular event: emission counts fully.
     Specular,
+    /// A smooth dielectric's mirror reflection whose directly seen emission was added when the
+    /// reflection was chosen ([`PathIntegrator::mirror_emission`]): emission reached next
+    /// counts zero, so that it is not counted twice.
+    MirrorCounted,
     /// A vertex where light sampling was also done: direction pdf (solid angle).
     Sampled { p: DVec3, pdf: f64 },
 }
@@ -363,7 +367,7 @@ impl Prev {
     fn sampled(self) -> Option<(DVec3, f64)> {
         match self {
             Prev::Sampled { p, pdf } => Some((p, pdf)),
-            Prev::Specular => None,
+            Prev::Specular | Prev::MirrorCounted => None,
         }
     }
 }
@@ -379,6 +383,9 @@ pub struct PathIntegrator<'s> {
     strategy: LightStrategy,
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
     defer_weights: bool,
+    /// Trace smooth dielectrics' mirror directions to the emitters they see
+    /// ([`PathIntegrator::mirror_emission`]): the scene has a quad or environment light.
+    mirror_nee: bool,
 }
 
 /// How light sources are found: the two strategies of multiple importance sampling (Veach
@@ -616,6 +623,10 @@ impl<'s> PathIntegrator<'s> {
             warnings,
             strategy: LightStrategy::Mis,
             defer_weights: true,
+            mirror_nee: scene
+                .lights()
+                .iter()
+                .any(|l| matches!(l, Light::Quad(_) | Light::Environment(_))),
         })
     }
 
@@ -796,6 +807,7 @@ impl<'s> PathIntegrator<'s> {
             if let Light::Environment(_) = light {
                 let w = match prev {
                     Prev::Specular => 1.0,
+                    Prev::MirrorCounted => 0.0,
                     Prev::Sampled { p, pdf } => {
                         let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
                         self.strategy.hit_weight(pdf, pl)
@@ -816,11 +828,52 @@ impl<'s> PathIntegrator<'s> {
         let le = light.emitted(hit, -ray.dir);
         match prev {
             Prev::Specular => le,
+            Prev::MirrorCounted => Rgb::ZERO,
             Prev::Sampled { p, pdf } => {
                 let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
                 le * self.strategy.hit_weight(pdf, pl)
             }
         }
+    }
+
+    /// Next-event estimation for a smooth dielectric's mirror reflection at `hit` toward `dir`
+    /// with reflectance `r`: the emission that direction sees directly (an emitter, or the
+    /// environment when the ray leaves the scene), times `r`, added to the path now; the path
+    /// then chooses reflection or transmission as before, and a reflection marks its next
+    /// vertex [`Prev::MirrorCounted`], where emission counts zero. A delta BSDF has one
+    /// direction, so tracing it is its light sample, with MIS weight 1 and 0 for the random
+    /// hit. pbrt-v4 (§13.1.1) skips light sampling at delta BSDFs and leaves lights to the
+    /// random choice, which shows a small bright light in a smooth dielectric (reflectance a few
+    /// per cent at normal incidence) as speckles; here it is smooth at any spp, for one ray per
+    /// reflection off a translucent object. Skipped without emitters to see, and under
+    /// [`LightStrategy::DirectionOnly`] (which counts lights hit by chance only).
+    fn mirror_emission(
+        &self,
+        hit: &Hit,
+        dir: DVec3,
+        r: f64,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> bool {
+        if !self.mirror_nee || self.strategy == LightStrategy::DirectionOnly || r <= 0.0 {
+            return false;
+        }
+        let ray = hit.spawn_ray(dir);
+        let le = match self.scene.geometry().intersect(&ray) {
+            Some(h) => self.emitted(&h, &ray, Prev::Specular),
+            None => self.escaped(&ray, Prev::Specular),
+        };
+        if !le.is_zero() {
+            self.settle(st, rng, counters);
+            st.add(
+                st.beta * le * r,
+                st.order,
+                st.entered,
+                self.options.scattering,
+            );
+        }
+        true
     }
 
     fn light_pdf(&self, i: usize) -> f64 {
@@ -1064,9 +1117,19 @@ impl<'s> PathIntegrator<'s> {
             // Arrived from inside (a camera inside the object): pass the face.
             return Step::Continue(hit.spawn_ray(ray.dir));
         }
+        let counted = !interface.is_index_matched() && {
+            let cos_i = (-ray.dir.dot(hit.ng)).clamp(0.0, 1.0);
+            let r = bssrdf_core::fresnel::dielectric(cos_i, material.eta);
+            let mirror = crate::integrator::walk::reflect(ray.dir, hit.ng);
+            self.mirror_emission(hit, mirror, r, st, rng, counters)
+        };
         let dir = match interface.cross(ray.dir, hit.ng, rng) {
             Crossing::Reflect(r) => {
-                st.prev = Prev::Specular;
+                st.prev = if counted {
+                    Prev::MirrorCounted
+                } else {
+                    Prev::Specular
+                };
                 return Step::Continue(hit.spawn_ray(r));
             }
             Crossing::Transmit(t) => t,
@@ -1251,11 +1314,16 @@ impl<'s> PathIntegrator<'s> {
         };
         if material.eta != 1.0 {
             let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
-            if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
-                st.prev = Prev::Specular;
-                return Step::Continue(
-                    hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
-                );
+            let r = bssrdf_core::fresnel::dielectric(cos_o, material.eta);
+            let mirror = crate::integrator::walk::reflect(ray.dir, n_o);
+            let counted = self.mirror_emission(hit, mirror, r, st, rng, counters);
+            if rng.uniform() < r {
+                st.prev = if counted {
+                    Prev::MirrorCounted
+                } else {
+                    Prev::Specular
+                };
+                return Step::Continue(hit.spawn_ray(mirror));
             }
         }
         let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
