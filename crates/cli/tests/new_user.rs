@@ -576,7 +576,7 @@ fn small_translucent_objects_warn_with_bssrdf_methods() {
     );
 }
 
-/// Every example scene the README points at loads and renders with the path tracer and with
+/// Every example scene (the README points at them) loads and renders with the path tracer and with
 /// Sone (1 spp), to a finite image that is not black. A scene whose mesh is downloaded by a
 /// script (`if_missing`: the bunny) fails, while the mesh is missing, with an error that names
 /// the script; it is then rendered with the shared assets' copy of the mesh beside the

@@ -3,6 +3,7 @@
 #![deny(missing_docs)]
 
 pub mod beam;
+pub mod commentary;
 pub mod converge;
 pub mod error;
 pub mod ledger;
