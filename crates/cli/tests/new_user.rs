@@ -616,30 +616,9 @@ fn example_scenes_render() {
             text = text.replace("../models/bunny.obj", shared.to_str().unwrap());
             path = s.write("bunny-shared.toml", &text);
         }
-        // A scene whose texture exists on the surface only (UV mapping) says so; the path
-        // tracer must then refuse it with a message naming the reason.
-        let methods: &[&str] = if text.contains("# pt: refused") {
-            let r = s.run(&[
-                "render",
-                path.to_str().unwrap(),
-                "--method",
-                "pt",
-                "--spp",
-                "1",
-                "--out",
-                "refused.exr",
-            ]);
-            assert_ne!(r.code, Some(0), "{}: pt was not refused", path.display());
-            assert!(
-                r.stderr.contains("UV-mapped"),
-                "{}: {}",
-                path.display(),
-                r.stderr
-            );
-            &["sone"]
-        } else {
-            &["pt", "sone"]
-        };
+        // Every scene, the UV-painted ones included: the path tracer reads a UV-mapped medium
+        // inside the body at the nearest surface point.
+        let methods: &[&str] = &["pt", "sone"];
         for &method in methods {
             let out = format!(
                 "{}-{method}.exr",

@@ -5,10 +5,11 @@
 //! Units are explicit: lengths in scene units, angles in degrees, coefficients in 1/scene-unit
 //! (after `unit_scale`), colours as a number (grey) or `[r, g, b]` (linear). Unknown keys are
 //! errors; every error names the file, the key path (`material[1].sigma_a.width`) and the line.
+//! Every key, with its type, default, units and an example, is in `docs/scene-format.md`.
 //!
 //! * `[render]`: `width`, `height`, `spp` (all ≥ 1), `seed` (default 0), optional `max_depth`,
 //!   `estimator` (a name the renderer parses), `averaging` (`prefiltered | monte-carlo`),
-//!   `scattering` (`multiple | single | all`).
+//!   `scattering` (`multiple | single | all`; a render counts `all` when it is not given).
 //! * `[camera]`: `type = "perspective"` with `eye`, `target`, `up`, `fov_y` (degrees, full
 //!   vertical), or `type = "orthographic"` with `centre`, `direction` (view direction; rays start
 //!   on the plane through `centre`), `up`, `width`, `height` (of the view rectangle).
@@ -35,9 +36,11 @@
 //!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`), `beam`
 //!   (`origin`, `direction`, `power`).
 //! * `[[shape]]`: `box` (`min`, `max`), `sphere` (`centre`, `radius`, `subdivisions`),
-//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
-//!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
-//!   degrees }, translate }`.
+//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj`, `gltf`, `ply`
+//!   (`path`, and `if_missing`: what to tell the user when the file does not exist; glTF also
+//!   `allow_outside_assets`, `shape_correction`, `shape_correction_seed`); each with
+//!   `material`, optional `name` and `transform = { scale, rotate = { axis, degrees },
+//!   translate }`.
 //!
 //! Translucent objects must not overlap one another (one inside the other, or crossing): the
 //! path tracer has no nested media, so such scenes are refused when built, naming both objects
