@@ -304,9 +304,9 @@ pub fn reproduce(
         let _ = writeln!(
             report,
             "### {preset}\n\nEvery map of this preset is drawn over the reference's colour range \
-             ({} to {} per unit area), so that equal colours are equal exitances.\n\n{}\n",
-            format!("{:.1e}", range.min),
-            format!("{:.1e}", range.max),
+             ({:.1e} to {:.1e} per unit area), so that equal colours are equal exitances.\n\n{}\n",
+            range.min,
+            range.max,
             images.join(" ")
         );
         if preset == "stripe" {
