@@ -354,9 +354,9 @@ impl Transmission {
 enum Prev {
     /// Camera or a specular event: emission counts fully.
     Specular,
-    /// A smooth dielectric's mirror reflection whose directly seen emission was added when the
-    /// reflection was chosen ([`PathIntegrator::mirror_emission`]): emission reached next
-    /// counts zero, so that it is not counted twice.
+    /// A smooth dielectric's mirror reflection whose directly seen emitter (a quad light) was
+    /// added when the reflection was chosen ([`PathIntegrator::mirror_emission`]): an emitter
+    /// reached next counts zero, so that it is not counted twice; the environment counts fully.
     MirrorCounted,
     /// A vertex where light sampling was also done: direction pdf (solid angle).
     Sampled { p: DVec3, pdf: f64 },
@@ -384,7 +384,7 @@ pub struct PathIntegrator<'s> {
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
     defer_weights: bool,
     /// Trace smooth dielectrics' mirror directions to the emitters they see
-    /// ([`PathIntegrator::mirror_emission`]): the scene has a quad or environment light.
+    /// ([`PathIntegrator::mirror_emission`]): the scene has a quad light.
     mirror_nee: bool,
 }
 
@@ -623,10 +623,7 @@ impl<'s> PathIntegrator<'s> {
             warnings,
             strategy: LightStrategy::Mis,
             defer_weights: true,
-            mirror_nee: scene
-                .lights()
-                .iter()
-                .any(|l| matches!(l, Light::Quad(_) | Light::Environment(_))),
+            mirror_nee: scene.lights().iter().any(|l| matches!(l, Light::Quad(_))),
         })
     }
 
@@ -806,8 +803,7 @@ impl<'s> PathIntegrator<'s> {
         for (i, light) in self.scene.lights().iter().enumerate() {
             if let Light::Environment(_) = light {
                 let w = match prev {
-                    Prev::Specular => 1.0,
-                    Prev::MirrorCounted => 0.0,
+                    Prev::Specular | Prev::MirrorCounted => 1.0,
                     Prev::Sampled { p, pdf } => {
                         let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
                         self.strategy.hit_weight(pdf, pl)
@@ -837,16 +833,18 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Next-event estimation for a smooth dielectric's mirror reflection at `hit` toward `dir`
-    /// with reflectance `r`: the emission that direction sees directly (an emitter, or the
-    /// environment when the ray leaves the scene), times `r`, added to the path now; the path
-    /// then chooses reflection or transmission as before, and a reflection marks its next
-    /// vertex [`Prev::MirrorCounted`], where emission counts zero. A delta BSDF has one
-    /// direction, so tracing it is its light sample, with MIS weight 1 and 0 for the random
-    /// hit. pbrt-v4 (§13.1.1) skips light sampling at delta BSDFs and leaves lights to the
-    /// random choice, which shows a small bright light in a smooth dielectric (reflectance a few
-    /// per cent at normal incidence) as speckles; here it is smooth at any spp, for one ray per
-    /// reflection off a translucent object. Skipped without emitters to see, and under
-    /// [`LightStrategy::DirectionOnly`] (which counts lights hit by chance only).
+    /// with reflectance `r`: the emitter (a quad light) that direction sees directly, times
+    /// `r`, added to the path now; the path then chooses reflection or transmission as
+    /// before, and a reflection marks its next vertex [`Prev::MirrorCounted`], where an emitter
+    /// counts zero. A delta BSDF has one direction, so tracing it is its light sample, with
+    /// MIS weight 1 and 0 for the random hit. pbrt-v4 (§13.1.1) skips light sampling at delta
+    /// BSDFs and leaves lights to the random choice, which shows a small bright light in a
+    /// smooth dielectric (reflectance a few per cent at normal incidence) as speckles; here it
+    /// is smooth at any spp, for one ray per reflection off a translucent object. The
+    /// environment is left to the random choice: it is seen by every path that escapes, and a
+    /// uniform one then gives every path the same value (the white furnaces stay exact).
+    /// Skipped without quad lights, and under [`LightStrategy::DirectionOnly`] (which counts
+    /// lights hit by chance only).
     fn mirror_emission(
         &self,
         hit: &Hit,
@@ -860,18 +858,17 @@ impl<'s> PathIntegrator<'s> {
             return false;
         }
         let ray = hit.spawn_ray(dir);
-        let le = match self.scene.geometry().intersect(&ray) {
-            Some(h) => self.emitted(&h, &ray, Prev::Specular),
-            None => self.escaped(&ray, Prev::Specular),
-        };
-        if !le.is_zero() {
-            self.settle(st, rng, counters);
-            st.add(
-                st.beta * le * r,
-                st.order,
-                st.entered,
-                self.options.scattering,
-            );
+        if let Some(h) = self.scene.geometry().intersect(&ray) {
+            let le = self.emitted(&h, &ray, Prev::Specular);
+            if !le.is_zero() {
+                self.settle(st, rng, counters);
+                st.add(
+                    st.beta * le * r,
+                    st.order,
+                    st.entered,
+                    self.options.scattering,
+                );
+            }
         }
         true
     }
