@@ -123,7 +123,7 @@ fn renders_are_identical_whatever_the_thread_count() {
 /// Prefiltered averaging (the default) renders the checker slab as Monte Carlo averaging
 /// does: at 32 × 32 pixels, 2 spp, seed 9 and 64 estimator samples per stage, the two images
 /// (same seed, so the same paths and probes) are within 3 % relative L2 of each other; at 256
-/// samples the CLI measures 0.4 % (README). The counters show both paths ran: prefiltered
+/// samples the CLI measures 0.4 % (docs/results.md). The counters show both paths ran: prefiltered
 /// estimates on the top face, sampled fallbacks where probes reach the sides (normals 90°
 /// apart), and no prefiltering at all under Monte Carlo averaging.
 #[test]

@@ -11,6 +11,7 @@ mod precision;
 mod readme;
 mod reciprocity;
 mod rough_surfaces;
+mod scene_format;
 mod separable;
 mod shapes;
 mod slab_table;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use bssrdf_core::Scattering;
+use bssrdf_core::{ProfileModel, Scattering};
 use serde_json::json;
 
 use tracer::error::OutputError;
@@ -18,6 +18,12 @@ use tracer::scene::Scene;
 
 /// Default most surface interactions per camera path.
 pub const DEFAULT_MAX_DEPTH: u32 = 8;
+
+/// The scattering orders a scene counts when its `[render]` section does not say: all of
+/// them, the light a picture shows. The artist parameters' colour inversion assumes every
+/// order too (`docs/artist-parameters.md`). The paper's experiments exclude single
+/// scattering, and their scenes say `scattering = "multiple"` themselves.
+pub const DEFAULT_SCATTERING: Scattering = Scattering::All;
 
 /// What a render needs besides the scene.
 #[derive(Debug, Clone)]
@@ -40,13 +46,14 @@ pub struct RenderJob {
 }
 
 impl RenderJob {
-    /// The scene's own settings (spp, seed, max depth, scattering) with `method`.
+    /// The scene's own settings (spp, seed, max depth, scattering) with `method`. A scene
+    /// without `[render] scattering` counts every order ([`DEFAULT_SCATTERING`]).
     pub fn from_scene(scene: &Scene, method: Method) -> Self {
         Self {
             method,
             budget: Budget::Samples(scene.settings().spp),
             seed: scene.settings().seed,
-            scattering: scene.settings().scattering.unwrap_or_default(),
+            scattering: scene.settings().scattering.unwrap_or(DEFAULT_SCATTERING),
             max_depth: scene.settings().max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             progress: false,
             shard: None,
@@ -82,8 +89,9 @@ pub struct RenderOutcome {
     pub counters: PathCounters,
     /// The method's name.
     pub method: String,
-    /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
-    pub warnings: Vec<String>,
+    /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]): one line
+    /// each for the terminal, the full text for the sidecar.
+    pub warnings: Vec<tracer::integrator::warnings::Warning>,
     /// What the preparation did that a user may want to know (see [`PathIntegrator::notes`]).
     pub notes: Vec<String>,
     /// How each translucent object was rendered (see [`PathIntegrator::object_plans`]).
@@ -317,6 +325,43 @@ pub fn render_attributes(
     ]
 }
 
+/// The profile of each translucent object a BSSRDF renders under `method` (by name, in the
+/// scene's order): the method's own `--profile`, else the material's, else the default for
+/// its η ([`tracer::scene::Translucent::profile_model`]). Objects the path tracer renders
+/// have none.
+pub fn object_profiles(scene: &Scene, method: Method) -> Vec<(String, ProfileModel)> {
+    let Method::Bssrdf { profile, .. } = method else {
+        return Vec::new();
+    };
+    let plans = tracer::integrator::plan::plan(scene, method);
+    scene
+        .translucent_objects()
+        .filter(|(i, _)| plans[*i as usize].is_some_and(|p| !p.path_traced))
+        .map(|(i, t)| {
+            (
+                scene.objects()[i as usize].name.clone(),
+                t.profile_model(profile),
+            )
+        })
+        .collect()
+}
+
+/// What a render's sidecar and EXR header record as its `profile`: the one profile every
+/// BSSRDF-rendered object used (`tabulated`), or each object's (`` `a`: tabulated, `b`: pbd ``)
+/// when they differ; `None` when no object is rendered by a BSSRDF.
+pub fn profile_summary(profiles: &[(String, ProfileModel)]) -> Option<String> {
+    let first = profiles.first()?.1;
+    Some(if profiles.iter().all(|(_, m)| *m == first) {
+        first.name().to_string()
+    } else {
+        profiles
+            .iter()
+            .map(|(n, m)| format!("`{n}`: {}", m.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    })
+}
+
 /// Writes the EXR, the PNG preview (exposure in stops) and the JSON sidecar of a render.
 /// The preview and the sidecar's `mean_rgb` are made from the values the EXR holds (`f32`,
 /// [`Film::as_stored`]), so that an image assembled from files (a merge of shards) writes the
@@ -329,14 +374,8 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    let profile = match job.method {
-        Method::Bssrdf { profile, .. } => Some(
-            profile
-                .map(|p| p.name().to_string())
-                .unwrap_or_else(|| "per material".to_string()),
-        ),
-        Method::PathTraced => None,
-    };
+    let profiles = object_profiles(scene, job.method);
+    let profile = profile_summary(&profiles);
     let estimator = match job.method {
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
@@ -387,14 +426,16 @@ pub fn write_render(
                     Method::Bssrdf { estimator, .. } if !p.path_traced => estimator.name(),
                     _ => "pt",
                 },
+                "profile": profiles.iter().find(|(n, _)| n == name).map(|(_, m)| m.name()),
                 "shape_correction": p.corrected,
+                "clear_medium": p.clear,
                 "optically_small": p.small,
             }))
             .collect::<Vec<_>>(),
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,
-        "warnings": outcome.warnings,
+        "warnings": outcome.warnings.iter().map(|w| w.detail.as_str()).collect::<Vec<_>>(),
         "mean_rgb": film.mean().0,
         "pixel_checksum": checksum,
         "interrupted": outcome.interrupted,

@@ -224,7 +224,7 @@ impl<'s> LightTracer<'s> {
 
     /// Things about the scene that make this method's image misleading (as the camera
     /// tracer's).
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[crate::integrator::warnings::Warning] {
         self.camera_side.warnings()
     }
 

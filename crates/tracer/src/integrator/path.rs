@@ -357,6 +357,10 @@ impl Transmission {
 enum Prev {
     /// Camera or a specular event: emission counts fully.
     Specular,
+    /// A smooth dielectric's mirror reflection whose directly seen emitter (a quad light) was
+    /// added when the reflection was chosen ([`PathIntegrator::mirror_emission`]): an emitter
+    /// reached next counts zero, so that it is not counted twice; the environment counts fully.
+    MirrorCounted,
     /// A vertex where light sampling was also done: direction pdf (solid angle).
     Sampled { p: DVec3, pdf: f64 },
 }
@@ -366,7 +370,7 @@ impl Prev {
     fn sampled(self) -> Option<(DVec3, f64)> {
         match self {
             Prev::Sampled { p, pdf } => Some((p, pdf)),
-            Prev::Specular => None,
+            Prev::Specular | Prev::MirrorCounted => None,
         }
     }
 }
@@ -378,10 +382,13 @@ pub struct PathIntegrator<'s> {
     options: PathOptions,
     objects: Vec<ObjectKind<'s>>,
     lights: LightSet,
-    warnings: Vec<String>,
+    warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
     defer_weights: bool,
+    /// Trace smooth dielectrics' mirror directions to the emitters they see
+    /// ([`PathIntegrator::mirror_emission`]): the scene has a quad light.
+    mirror_nee: bool,
 }
 
 /// How light sources are found: the two strategies of multiple importance sampling (Veach
@@ -629,6 +636,7 @@ impl<'s> PathIntegrator<'s> {
             warnings,
             strategy: LightStrategy::Mis,
             defer_weights: true,
+            mirror_nee: scene.lights().iter().any(|l| matches!(l, Light::Quad(_))),
         })
     }
 
@@ -652,24 +660,42 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Things about the scene that make this method's image misleading (printed by the CLI).
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[crate::integrator::warnings::Warning] {
         &self.warnings
     }
 
     /// What preparing the render did that a user may want to know: one line per object a
-    /// BSSRDF method path-traces (`--method auto`), and one per object whose shape correction
+    /// BSSRDF method path-traces (clear media; small objects under `--method auto`), and one per object whose shape correction
     /// was measured (points, spacing, wall time).
     pub fn notes(&self) -> Vec<String> {
-        let traced = self
-            .object_plans()
+        let plans = self.object_plans();
+        let traced = |clear: bool| -> Vec<String> {
+            plans
+                .iter()
+                .filter(|(_, p)| {
+                    p.path_traced
+                        && p.clear == clear
+                        && matches!(self.method, Method::Bssrdf { .. })
+                })
+                .map(|(name, _)| format!("`{name}`"))
+                .collect()
+        };
+        let groups = [
+            (
+                traced(true),
+                "its medium does not scatter (a clear absorbing dielectric, which no BSSRDF \
+                 describes)",
+            ),
+            (
+                traced(false),
+                "too small for a half-space profile (`--method auto`; `--method sone` renders \
+                 it with the BSSRDF)",
+            ),
+        ];
+        let traced = groups
             .into_iter()
-            .filter(|(_, p)| p.path_traced && matches!(self.method, Method::Bssrdf { .. }))
-            .map(|(name, _)| {
-                format!(
-                    "`{name}` is path traced: it is too small for a half-space profile \
-                     (`--method auto`; `--method sone` renders it with the BSSRDF)"
-                )
-            });
+            .filter(|(names, _)| !names.is_empty())
+            .map(|(names, why)| format!("path traced, {why}: {}", names.join(", ")));
         let corrections = self.scene.objects().iter().zip(&self.objects).filter_map(
             |(object, kind)| match kind {
                 ObjectKind::Translucent {
@@ -789,7 +815,7 @@ impl<'s> PathIntegrator<'s> {
         for (i, light) in self.scene.lights().iter().enumerate() {
             if let Light::Environment(_) = light {
                 let w = match prev {
-                    Prev::Specular => 1.0,
+                    Prev::Specular | Prev::MirrorCounted => 1.0,
                     Prev::Sampled { p, pdf } => {
                         let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
                         self.strategy.hit_weight(pdf, pl)
@@ -810,11 +836,53 @@ impl<'s> PathIntegrator<'s> {
         let le = light.emitted(hit, -ray.dir);
         match prev {
             Prev::Specular => le,
+            Prev::MirrorCounted => Rgb::ZERO,
             Prev::Sampled { p, pdf } => {
                 let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
                 le * self.strategy.hit_weight(pdf, pl)
             }
         }
+    }
+
+    /// Next-event estimation for a smooth dielectric's mirror reflection at `hit` toward `dir`
+    /// with reflectance `r`: the emitter (a quad light) that direction sees directly, times
+    /// `r`, added to the path now; the path then chooses reflection or transmission as
+    /// before, and a reflection marks its next vertex [`Prev::MirrorCounted`], where an emitter
+    /// counts zero. A delta BSDF has one direction, so tracing it is its light sample, with
+    /// MIS weight 1 and 0 for the random hit. pbrt-v4 (§13.1.1) skips light sampling at delta
+    /// BSDFs and leaves lights to the random choice, which shows a small bright light in a
+    /// smooth dielectric (reflectance a few per cent at normal incidence) as speckles; here it
+    /// is smooth at any spp, for one ray per reflection off a translucent object. The
+    /// environment is left to the random choice: it is seen by every path that escapes, and a
+    /// uniform one then gives every path the same value (the white furnaces stay exact).
+    /// Skipped without quad lights, and under [`LightStrategy::DirectionOnly`] (which counts
+    /// lights hit by chance only).
+    fn mirror_emission(
+        &self,
+        hit: &Hit,
+        dir: DVec3,
+        r: f64,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> bool {
+        if !self.mirror_nee || self.strategy == LightStrategy::DirectionOnly || r <= 0.0 {
+            return false;
+        }
+        let ray = hit.spawn_ray(dir);
+        if let Some(h) = self.scene.geometry().intersect(&ray) {
+            let le = self.emitted(&h, &ray, Prev::Specular);
+            if !le.is_zero() {
+                self.settle(st, rng, counters);
+                st.add(
+                    st.beta * le * r,
+                    st.order,
+                    st.entered,
+                    self.options.scattering,
+                );
+            }
+        }
+        true
     }
 
     fn light_pdf(&self, i: usize) -> f64 {
@@ -1076,14 +1144,29 @@ impl<'s> PathIntegrator<'s> {
                 Crossed::Entered(t) => t,
                 Crossed::Stepped(step) => return step,
             },
-            None => match interface.cross(ray.dir, hit.ng, rng) {
-                Crossing::Reflect(r) => {
-                    st.prev = Prev::Specular;
-                    return Step::Continue(hit.spawn_ray(r));
+            None => {
+                // A light seen in the mirror direction is found by next-event estimation
+                // (weighed by MIS against this reflection), so the reflection does not count
+                // it again when it hits the light ([`Prev::MirrorCounted`]).
+                let counted = !interface.is_index_matched() && {
+                    let cos_i = (-ray.dir.dot(hit.ng)).clamp(0.0, 1.0);
+                    let r = bssrdf_core::fresnel::dielectric(cos_i, material.eta);
+                    let mirror = crate::integrator::walk::reflect(ray.dir, hit.ng);
+                    self.mirror_emission(hit, mirror, r, st, rng, counters)
+                };
+                match interface.cross(ray.dir, hit.ng, rng) {
+                    Crossing::Reflect(r) => {
+                        st.prev = if counted {
+                            Prev::MirrorCounted
+                        } else {
+                            Prev::Specular
+                        };
+                        return Step::Continue(hit.spawn_ray(r));
+                    }
+                    Crossing::Transmit(t) => t,
+                    Crossing::Lost => return Step::Stop,
                 }
-                Crossing::Transmit(t) => t,
-                Crossing::Lost => return Step::Stop,
-            },
+            }
         };
         st.entered = true;
         // Through an index-matched boundary the direction is unchanged: the vertex before the
@@ -1345,9 +1428,10 @@ impl<'s> PathIntegrator<'s> {
             return Step::Continue(hit.spawn_ray(ray.dir));
         };
         // The exit through the boundary: Fresnel reflection of a smooth boundary with its
-        // probability; a rough one reflects off a sampled microfacet (light found by
-        // next-event estimation too) or transmits with the weight whose mean is T(μ_o; α), the
-        // rough transmittance S uses ([`BssrdfObject::transmission`]).
+        // probability (a light in the mirror direction found by next-event estimation); a
+        // rough one reflects off a sampled microfacet (light found by next-event estimation
+        // too) or transmits with the weight whose mean is T(μ_o; α), the rough transmittance S
+        // uses ([`BssrdfObject::transmission`]).
         let alpha_o = b.rough_alpha(hit);
         match alpha_o {
             Some(alpha) => {
@@ -1360,11 +1444,16 @@ impl<'s> PathIntegrator<'s> {
             }
             None if material.eta != 1.0 => {
                 let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
-                if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
-                    st.prev = Prev::Specular;
-                    return Step::Continue(
-                        hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
-                    );
+                let r = bssrdf_core::fresnel::dielectric(cos_o, material.eta);
+                let mirror = crate::integrator::walk::reflect(ray.dir, n_o);
+                let counted = self.mirror_emission(hit, mirror, r, st, rng, counters);
+                if rng.uniform() < r {
+                    st.prev = if counted {
+                        Prev::MirrorCounted
+                    } else {
+                        Prev::Specular
+                    };
+                    return Step::Continue(hit.spawn_ray(mirror));
                 }
             }
             None => {}

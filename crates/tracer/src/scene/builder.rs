@@ -155,7 +155,7 @@ pub(crate) struct AssemblyInfo<'a> {
     pub locator: &'a Locator,
     pub inputs: Vec<PathBuf>,
     /// What the loader read but could not honour (glTF material notes), for the warnings.
-    pub notes: Vec<String>,
+    pub notes: Vec<super::LoadNote>,
 }
 
 /// Checks `[render]` values; `Err((key, message))`.

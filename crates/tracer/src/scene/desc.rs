@@ -545,6 +545,9 @@ shape_desc!(
     MeshFileDesc {
         /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
+        /// How to get the mesh when `path` does not exist (for a scene shipped without its
+        /// model, e.g. "run `sh scripts/fetch-bunny.sh`"): printed in the error.
+        if_missing: Option<String>,
         /// A glTF shape without `material` only: the `shape_correction` of every translucent
         /// material the file creates (as the material key; unset, the render decides).
         shape_correction: Option<bool>,

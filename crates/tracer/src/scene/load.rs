@@ -121,7 +121,7 @@ struct Cx {
     /// Every mesh and texture file found readable, in the order they were checked.
     inputs: std::cell::RefCell<Vec<PathBuf>>,
     /// What was read but cannot be honoured (glTF material notes).
-    notes: std::cell::RefCell<Vec<String>>,
+    notes: std::cell::RefCell<Vec<super::LoadNote>>,
     options: LoadOptions,
 }
 
@@ -1186,6 +1186,14 @@ impl Cx {
                     };
                     let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
+                    if let Some(hint) = &d.if_missing
+                        && !path.exists()
+                    {
+                        return Err(self.invalid(
+                            &k("path"),
+                            format!("the mesh `{}` does not exist: {hint}", path.display()),
+                        ));
+                    }
                     self.check_readable(&k("path"), &path)?;
                     let mesh_error = |source| SceneError::Mesh {
                         file: self.file.clone(),
@@ -1298,10 +1306,12 @@ impl Cx {
         use crate::geometry::gltf_material::GltfInterpretation as I;
         let (interpretation, notes) = m.interpret();
         let file = model.file().display().to_string();
-        for n in notes {
-            self.notes
-                .borrow_mut()
-                .push(format!("{file}: material `{}`: {n}", m.name));
+        for text in notes {
+            self.notes.borrow_mut().push(super::LoadNote {
+                file: file.clone(),
+                subject: format!("material `{}`", m.name),
+                text,
+            });
         }
         let field_key = format!("{key}.path");
         let invalid =

@@ -5,10 +5,11 @@
 //! Units are explicit: lengths in scene units, angles in degrees, coefficients in 1/scene-unit
 //! (after `unit_scale`), colours as a number (grey) or `[r, g, b]` (linear). Unknown keys are
 //! errors; every error names the file, the key path (`material[1].sigma_a.width`) and the line.
+//! Every key, with its type, default, units and an example, is in `docs/scene-format.md`.
 //!
 //! * `[render]`: `width`, `height`, `spp` (all ≥ 1), `seed` (default 0), optional `max_depth`,
 //!   `estimator` (a name the renderer parses), `averaging` (`prefiltered | monte-carlo`),
-//!   `scattering` (`multiple | single | all`).
+//!   `scattering` (`multiple | single | all`; a render counts `all` when it is not given).
 //! * `[camera]`: `type = "perspective"` with `eye`, `target`, `up`, `fov_y` (degrees, full
 //!   vertical), or `type = "orthographic"` with `centre`, `direction` (view direction; rays start
 //!   on the plane through `centre`), `up`, `width`, `height` (of the view rectangle).
@@ -41,9 +42,11 @@
 //!   `rotation` (degrees about the map's up axis, default 0) and `up` (`"x" | "y" | "z"`,
 //!   default z): [`crate::light::EnvironmentMap`]), `beam` (`origin`, `direction`, `power`).
 //! * `[[shape]]`: `box` (`min`, `max`), `sphere` (`centre`, `radius`, `subdivisions`),
-//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
-//!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
-//!   degrees }, translate }`.
+//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj`, `gltf`, `ply`
+//!   (`path`, and `if_missing`: what to tell the user when the file does not exist; glTF also
+//!   `allow_outside_assets`, `shape_correction`, `shape_correction_seed`); each with
+//!   `material`, optional `name` and `transform = { scale, rotate = { axis, degrees },
+//!   translate }`.
 //!
 //! Translucent objects must not overlap one another (one inside the other, or crossing): the
 //! path tracer has no nested media, so such scenes are refused when built, naming both objects
@@ -174,15 +177,21 @@ impl Translucent {
         scattering: Scattering,
         estimator: Estimator,
     ) -> Result<(ProfileFamily, PreparedEstimator), (&'static str, ParamError)> {
-        let model = model
-            .or(self.profile)
-            .unwrap_or(ProfileModel::default_for(self.eta));
+        let model = self.profile_model(model);
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
         let prepared = estimator
             .prepare(self.g, self.eta)
             .map_err(|e| ("estimator", e))?;
         Ok((family, prepared))
+    }
+
+    /// The profile a BSSRDF renders this material with: `model` (the command line's), else the
+    /// material's own `profile`, else [`ProfileModel::default_for`] its η.
+    pub fn profile_model(&self, model: Option<ProfileModel>) -> ProfileModel {
+        model
+            .or(self.profile)
+            .unwrap_or(ProfileModel::default_for(self.eta))
     }
 
     /// A translucent material with no profile and unit scale 1 (validated when the scene is
@@ -318,14 +327,31 @@ pub struct Scene {
     source_path: Option<PathBuf>,
     display_name: String,
     inputs: Vec<PathBuf>,
-    notes: Vec<String>,
+    notes: Vec<LoadNote>,
+}
+
+/// Something the loader read but could not honour (for example a part of a glTF material that
+/// is not read, `docs/gltf.md`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoadNote {
+    /// The file it is about (a glTF model).
+    pub file: String,
+    /// What in that file (`material `jade``).
+    pub subject: String,
+    /// One sentence.
+    pub text: String,
+}
+
+impl std::fmt::Display for LoadNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.subject, self.text)
+    }
 }
 
 impl Scene {
-    /// What the loader read but could not honour, one sentence each (for example the parts of
-    /// a glTF material that are not read, `docs/gltf.md`). Renders list them among their
-    /// warnings.
-    pub fn load_notes(&self) -> &[String] {
+    /// What the loader read but could not honour, one sentence each. Renders list them among
+    /// their warnings, one warning per file.
+    pub fn load_notes(&self) -> &[LoadNote] {
         &self.notes
     }
 
