@@ -66,7 +66,7 @@ pub fn plane_albedo(albedo: f64, g: f64, eta: f64) -> f64 {
         0.0
     };
     let g = if g.is_finite() {
-        g.clamp(-crate::family::G_MAX, crate::family::G_MAX)
+        g.clamp(-crate::error::G_MAX, crate::error::G_MAX)
     } else {
         0.0
     };
@@ -168,7 +168,7 @@ impl AnisotropicTotals {
         let all = plane_albedos(&albedos, g, eta);
         let eta_c = if eta.is_finite() { eta.max(1.0) } else { 1.0 };
         let g_c = if g.is_finite() {
-            g.clamp(-crate::family::G_MAX, crate::family::G_MAX)
+            g.clamp(-crate::error::G_MAX, crate::error::G_MAX)
         } else {
             0.0
         };

@@ -25,6 +25,7 @@
 mod bvh;
 pub mod closest;
 mod curvature;
+mod cwbvh;
 #[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod gltf_assets;
