@@ -81,7 +81,7 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
         Command::Profile(args) => profile::run(args),
         Command::Render(args) => render::run(args),
         Command::Merge(args) => merge::run(args),
-        Command::Beam(args) => beam::run(args, &given),
+        Command::Beam(args) => beam::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Converge(args) => converge::run(args, &given),
         Command::Reproduce(args) => reproduce::run(args),

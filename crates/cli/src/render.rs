@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{Context, bail};
-use bssrdf_core::{ProfileModel, Scattering};
+use bssrdf_core::Scattering;
 use experiments::run::{
     RenderJob, RenderOutcome, render_scene_observed, sidecar_paths, write_render,
 };
@@ -21,7 +21,7 @@ use crate::common::{
     check_image_memory, check_writable, claim_outputs, note_triangles, parse_exr_out,
     parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{RegionFlags, check_method_flags};
+use crate::flags::EstimatorFlags;
 use crate::interrupt;
 
 /// Which way paths are traced.
@@ -53,17 +53,8 @@ pub struct Args {
     /// `shape_correction = false`; `on` corrects every one, `off` none.
     #[arg(long, value_parser = crate::choices::correction())]
     shape_correction: Option<tracer::integrator::Correction>,
-    /// Profile model for BSSRDF methods (default: each material's, else the tabulated exact
-    /// profile where it applies (η ≤ 1.6), else photon beam diffusion).
-    #[arg(long, value_parser = crate::choices::profile())]
-    profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
-    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
-    /// at most 1024).
-    #[arg(long, value_parser = parse_positive)]
-    estimator_samples: Option<u64>,
     #[command(flatten)]
-    region: RegionFlags,
+    estimator: EstimatorFlags,
     /// Where the estimators invert artist materials' colours and radii: `before` averaging
     /// (per point) or `after` (default: each material's `invert`; see
     /// docs/artist-parameters.md).
@@ -142,19 +133,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(c) => method.with_correction(c),
         None => method,
     };
-    check_method_flags(
-        &[method],
-        args.profile.is_some(),
-        args.estimator_samples.is_some(),
-    )?;
-    args.region.check(&[method])?;
-    let method = args.region.apply(
-        method.with_profile(args.profile).with_estimator_samples(
-            args.estimator_samples
-                .map(|n| n.min(u32::MAX as u64) as u32),
-        ),
-        scene.settings().averaging,
-    );
+    args.estimator.check(&[method])?;
+    let method = args.estimator.apply(method, scene.settings().averaging);
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);

@@ -78,7 +78,7 @@ pub use bssrdf_core::Rgb;
 pub use budget::{MissPolicy, SampleBudget};
 pub use ellipse::PlanarEllipse;
 pub use estimate::{Diagnostics, Estimate, Region};
-pub use estimator::{Estimator, PreparedEstimator};
+pub use estimator::{Estimator, EstimatorOptions, PreparedEstimator};
 pub use field::{CoefficientField, Coefficients, FieldBounds};
 /// The vector types of the public traits (`glam::DVec3`), re-exported so that implementors
 /// use the same glam version as this crate.
