@@ -194,7 +194,7 @@ pub fn run_method(
     show_progress: bool,
 ) -> anyhow::Result<BeamMap> {
     let bar = if !show_progress {
-        experiments::progress::ProgressBar::hidden()
+        pipeline::progress::ProgressBar::hidden()
     } else if method == Method::PathTraced {
         let len = match photons {
             PhotonBudget::Count(n) => {
@@ -202,9 +202,9 @@ pub fn run_method(
             }
             PhotonBudget::Time(_) => 0,
         };
-        experiments::progress::bar(len, "pt", "photons")
+        pipeline::progress::bar(len, "pt", "photons")
     } else {
-        experiments::progress::bar(setup.resolution as u64, method.name(), "rows")
+        pipeline::progress::bar(setup.resolution as u64, method.name(), "rows")
     };
     let map =
         experiments::beam::run_method(setup, method, profile, photons, subsamples, seed, &|k| {

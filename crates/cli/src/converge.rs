@@ -10,11 +10,12 @@ use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
 use experiments::beam::{PhotonBudget, write_beam_map};
 use experiments::converge::{MethodSummary, check_dir, summarize_with_reference, write_outputs};
-use experiments::run::{RenderJob, write_render};
 use experiments::study::{
     BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
     reference_key, scene_reference, scene_study,
 };
+use pipeline::files::write_render;
+use pipeline::job::RenderJob;
 use tracer::integrator::Method;
 use tracer::output::read_exr;
 use tracer::scene::Scene;
@@ -203,7 +204,7 @@ fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
         return out.to_path_buf();
     };
     let usable = std::fs::create_dir_all(&dir).is_ok()
-        && experiments::run::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
+        && pipeline::files::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
     if usable {
         dir
     } else {
@@ -263,7 +264,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
         .iter()
         .map(|m| args.estimator.apply(*m, scene.settings().averaging))
         .collect();
-    let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
+    let bar = pipeline::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
     let mut finals = Vec::new();
     let mut log = RunLog::new(out);
     let runs = scene_study(
@@ -410,7 +411,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
             }
         })
         .sum();
-    let bar = experiments::progress::bar(runs_total as u64, "converge", "runs");
+    let bar = pipeline::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
     let mut log = RunLog::new(out);
     let methods: Vec<Method> = args

@@ -1,5 +1,5 @@
 //! `het-bssrdf merge`: assemble the shards written by `render --tile I/N` into the whole
-//! image (EXR, PNG preview and JSON sidecar); see `experiments::shard` for the partition, the
+//! image (EXR, PNG preview and JSON sidecar); see `pipeline::sharding` and `pipeline::shard_merge` for the partition, the
 //! checks and what a merge guarantees.
 
 use crate::diag::say;
@@ -27,7 +27,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sidecars: Vec<PathBuf> = args
         .shards
         .iter()
-        .map(|p| experiments::run::sidecar_paths(p).1)
+        .map(|p| pipeline::files::sidecar_paths(p).1)
         .collect();
     let inputs: Vec<&Path> = args
         .shards
@@ -37,7 +37,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .collect();
     let _lock = claim_outputs(&args.out, &inputs)?;
     interrupt::install(interrupt::Mode::Quit)?;
-    let summary = experiments::shard::merge(&args.shards, &args.out, args.exposure)?;
+    let summary = pipeline::shard_merge::merge(&args.shards, &args.out, args.exposure)?;
     let (png, json) = &summary.sidecars;
     let spp = if summary.spp.0 == summary.spp.1 {
         format!("{} spp", summary.spp.0)

@@ -7,10 +7,9 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use bssrdf_core::Scattering;
-use experiments::run::{
-    RenderJob, RenderOutcome, render_scene_observed, sidecar_paths, write_render,
-};
 use het_estimate::{Estimator, SoneParams};
+use pipeline::files::{sidecar_paths, write_render};
+use pipeline::job::{RenderJob, RenderOutcome, render_scene_observed};
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters};
 use tracer::render::{Budget, Partial};
@@ -154,7 +153,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     job.progress = true;
     if let Some(shard) = args.tile {
         job.shard = Some(
-            experiments::shard::ShardJob::new(shard, &scene)
+            pipeline::sharding::ShardJob::new(shard, &scene)
                 .with_context(|| format!("cannot hash the scene `{}`", args.scene.display()))?,
         );
     }
@@ -221,7 +220,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Ok(())
     };
     let observer = Checkpoints::new(
-        experiments::progress::RenderBar::new(
+        pipeline::progress::RenderBar::new(
             method.name(),
             width,
             args.tile.map_or(height, |t| t.rows(height)),

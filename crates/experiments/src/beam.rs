@@ -593,7 +593,7 @@ pub fn write_beam_map(
     let json = exr.with_extension("json");
     set.add(
         &json,
-        tracer::output::json_bytes(&crate::provenance::stamped(value), &json)?,
+        tracer::output::json_bytes(&pipeline::provenance::stamped(value), &json)?,
     );
     #[cfg(feature = "plot")]
     set.add(&exr.with_extension("png"), png_bytes);

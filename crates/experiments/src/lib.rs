@@ -12,11 +12,7 @@ pub mod ledger;
 pub mod metrics;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod progress;
-pub mod provenance;
 pub mod reproduce;
-pub mod run;
 pub mod scenes;
-pub mod shard;
 pub mod study;
 pub mod time_to_error;
