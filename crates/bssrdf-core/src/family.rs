@@ -90,7 +90,7 @@ impl ProfileFamily {
     ) -> Result<Self, ParamError> {
         check_g(g)?;
         check_eta(eta)?;
-        if model == ProfileModel::Tabulated && eta > crate::tabulated::profile::ETA_MAX {
+        if model == ProfileModel::Tabulated && eta > crate::tabulated::half_space::ETA_MAX {
             return Err(ParamError::OutOfRange {
                 name: "eta",
                 range: "[1, 1.6] (the tabulated profile's table)",

@@ -42,7 +42,7 @@ use crate::profile::RadialProfile;
 use crate::quadrature::{gl12, integrate_nodes};
 use crate::single_scattering::SingleScattering;
 use crate::tabulated::grid::{N_ALBEDO, albedo_of_row};
-use crate::tabulated::profile::{RowTotals, totals_between_rows};
+use crate::tabulated::half_space::{RowTotals, totals_between_rows};
 
 /// Gauss–Legendre nodes on each side of the critical cosine.
 pub const SUB_NODES: usize = 12;

@@ -36,7 +36,7 @@ impl ProfileModel {
     /// material's relative refractive index; a NaN gives the tabulated model, whose
     /// construction then reports the invalid η.
     pub fn default_for(eta: f64) -> ProfileModel {
-        if eta > crate::tabulated::profile::ETA_MAX {
+        if eta > crate::tabulated::half_space::ETA_MAX {
             ProfileModel::Pbd
         } else {
             ProfileModel::Tabulated

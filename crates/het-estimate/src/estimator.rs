@@ -6,7 +6,7 @@ use std::sync::Arc;
 use bssrdf_core::ParamError;
 
 use crate::budget::SampleBudget;
-use crate::estimate::{Estimate, Region};
+use crate::estimator_output::{Estimate, Region};
 use crate::field::CoefficientField;
 use crate::kernel::{self, KernelParams};
 use crate::kernel_table::KernelTable;

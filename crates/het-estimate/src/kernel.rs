@@ -50,7 +50,7 @@ use bssrdf_core::ParamError;
 use glam::{DVec2, DVec3};
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
 use crate::known::Known;

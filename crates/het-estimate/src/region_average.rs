@@ -5,7 +5,7 @@ use bssrdf_core::Rgb;
 use glam::DVec3;
 
 use crate::budget::{REPLICATES, SampleBudget};
-use crate::estimate::Diagnostics;
+use crate::estimator_output::Diagnostics;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::sanitise;
 use crate::local_surface::{Curvature, End, LocalSurface};
@@ -342,7 +342,7 @@ where
                 Some(chord)
             }
             None => {
-                self.diag.region = crate::estimate::Region::Endpoints;
+                self.diag.region = crate::estimator_output::Region::Endpoints;
                 None
             }
         }

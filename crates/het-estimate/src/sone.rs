@@ -48,7 +48,7 @@ use std::num::NonZeroU32;
 use bssrdf_core::Rgb;
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};

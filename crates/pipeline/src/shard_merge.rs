@@ -10,7 +10,7 @@
 //! sidecars and in the headers) and that each index `0..N` is there exactly once, and copies
 //! each shard's rows into the image. With a sample budget the merged EXR and PNG are byte for byte those of the whole
 //! render with the same seed: pixels are copied as stored (`f32`), the header is rebuilt by
-//! [`crate::run::render_attributes`] as a whole render's, and the preview is made from the
+//! [`crate::files::render_attributes`] as a whole render's, and the preview is made from the
 //! stored values by both. The merged sidecar sums the shards' counters and rays, gives
 //! `wall_seconds` as the longest shard's, and lists every shard under `merged`
 //! (`wall_seconds_sum`, a CPU-time-like total, and per-shard spp, time, rays and threads).
@@ -606,11 +606,11 @@ pub fn merge(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tracer::scene::Scene;
     use crate::files::write_render;
     use crate::job::{RenderJob, render_scene};
     use crate::sharding::ShardJob;
     use tracer::render::Budget;
+    use tracer::scene::Scene;
 
     /// A checkpoint's EXR copied over a finished shard's (same spp, seed, pixels: only its
     /// state differs) was merged; its header's `state` now refuses it.

@@ -28,7 +28,7 @@
 
 use std::sync::OnceLock;
 
-use super::profile::{
+use super::half_space::{
     Corner, POOL_REL_SE, RowTotals, TabulatedTerm, conserve_bin_masses, eta_weights, radial_value,
     row_position, totals_between_rows,
 };

@@ -21,7 +21,7 @@ use crate::common::{
     parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
 use crate::flags::EstimatorFlags;
-use crate::interrupt;
+use crate::signals;
 
 /// Which way paths are traced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -202,7 +202,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return run_light_traced(&scene, &job, &out, args.exposure);
     }
     set_collision_cap(args.max_collisions);
-    interrupt::install(interrupt::Mode::Finish)?;
+    signals::install(signals::Mode::Finish)?;
     let rays_before = scene.geometry().rays_traced();
     let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {
         let mut film = Film::new(partial.width, partial.height);
@@ -233,7 +233,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     observer.finish();
     let outcome = outcome.with_context(|| format!("cannot render `{}`", args.scene.display()))?;
     if outcome.interrupted {
-        let signal = interrupt::received().map_or("interrupt", interrupt::name);
+        let signal = signals::received().map_or("interrupt", signals::name);
         if outcome.spp == 0 {
             bail!("{signal} before the first pass completed; nothing written");
         }

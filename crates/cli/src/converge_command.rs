@@ -20,7 +20,7 @@ use tracer::integrator::Method;
 use tracer::output::read_exr;
 use tracer::scene::Scene;
 
-use crate::beam::{SetupArgs, run_method};
+use crate::beam_command::{SetupArgs, run_method};
 use crate::common::parse_positive;
 use crate::flags::{EstimatorFlags, Given};
 

@@ -16,7 +16,7 @@ use crate::common::{
     check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
 use crate::flags::EstimatorFlags;
-use crate::interrupt;
+use crate::signals;
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -263,10 +263,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     )
     .context("--resolution")?;
     set_collision_cap(args.max_collisions);
-    interrupt::install(interrupt::Mode::Finish)?;
+    signals::install(signals::Mode::Finish)?;
     let method = args.estimator.apply_options(args.method, None);
     let map = run_method(&setup, method, profile, photons, sub, args.seed, true)?;
-    let interrupted = interrupt::received().map(interrupt::name);
+    let interrupted = signals::received().map(signals::name);
     if let Some(signal) = interrupted
         && map.samples == 0
     {

@@ -6,7 +6,7 @@ use crate::diag::say;
 use std::path::{Path, PathBuf};
 
 use crate::common::{claim_outputs, parse_exr_out};
-use crate::interrupt;
+use crate::signals;
 
 /// Arguments of `het-bssrdf merge`.
 #[derive(Debug, clap::Args)]
@@ -36,7 +36,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(PathBuf::as_path)
         .collect();
     let _lock = claim_outputs(&args.out, &inputs)?;
-    interrupt::install(interrupt::Mode::Quit)?;
+    signals::install(signals::Mode::Quit)?;
     let summary = pipeline::shard_merge::merge(&args.shards, &args.out, args.exposure)?;
     let (png, json) = &summary.sidecars;
     let spp = if summary.spp.0 == summary.spp.1 {
