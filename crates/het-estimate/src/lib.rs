@@ -79,7 +79,7 @@ pub use budget::{MissPolicy, SampleBudget};
 pub use ellipse::PlanarEllipse;
 pub use estimator::{Estimator, EstimatorOptions, PreparedEstimator};
 pub use estimator_output::{Diagnostics, Estimate, Region};
-pub use field::{CoefficientField, Coefficients, FieldBounds};
+pub use field::{CoefficientField, Coefficients, FieldBounds, FieldCapabilities};
 /// The vector types of the public traits (`glam::DVec3`), re-exported so that implementors
 /// use the same glam version as this crate.
 pub use glam;
