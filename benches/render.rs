@@ -5,6 +5,10 @@
 //!
 //! Run: `cargo bench --bench render`. Ids are `render/<method>`; criterion reports the time
 //! per 1024 camera samples and the throughput in samples/s. Compare methods as ratios.
+//!
+//! `render/sone eta=1.3` and `render/sone eta=1.3 roughness=0.3` render the same slab with a
+//! refractive boundary, smooth and rough (docs/lighting-and-surfaces.md): their ratio is the
+//! cost of the rough boundary per BSSRDF sample.
 
 use std::time::Duration;
 
@@ -32,6 +36,33 @@ fn renders(c: &mut Criterion) {
         .sample_size(20);
     for name in ["pt", "jensen-out", "endpoints", "segment", "sone"] {
         let method: Method = name.parse().expect("built-in method");
+        let integrator = PathIntegrator::new(
+            &scene,
+            method,
+            PathOptions {
+                scattering: Scattering::Multiple,
+                max_depth: 8,
+            },
+        )
+        .expect("renderable");
+        let mut seed = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                seed += 1;
+                pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))
+            })
+        });
+    }
+    for (name, boundary) in [
+        ("sone eta=1.3", "eta = 1.3"),
+        ("sone eta=1.3 roughness=0.3", "eta = 1.3\nroughness = 0.3"),
+    ] {
+        let text = CHECKER_SLAB.replace("eta = 1.0", boundary);
+        let scene = Scene::from_toml_str(&text, std::path::Path::new("."), "checker-slab")
+            .expect("built-in scene")
+            .with_resolution(32, 32)
+            .expect("positive");
+        let method: Method = "sone".parse().expect("built-in method");
         let integrator = PathIntegrator::new(
             &scene,
             method,

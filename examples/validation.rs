@@ -1,5 +1,5 @@
 //! Prints the reference path tracer's results next to exact transport results, with standard
-//! errors, so that the README's "Validation" figures can be re-measured:
+//! errors, so that the "Validation" figures of docs/results.md can be re-measured:
 //!
 //!     cargo run --release --example validation
 //!

@@ -124,7 +124,7 @@ fn prefiltered_vs_monte_carlo(filter: Filter, read: Read, samples: u32, seed: u6
 }
 
 /// At 64 samples per stage the Monte Carlo image's own noise dominates the distance; the
-/// 256-sample variant (ignored: slow) measures the README's number. The UV-mapped image is
+/// 256-sample variant (ignored: slow) measures the number in docs/results.md. The UV-mapped image is
 /// compared with Monte Carlo averaging of the UV field itself (every point projected onto the
 /// mesh and read at its interpolated coordinates).
 #[test]

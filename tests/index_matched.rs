@@ -49,9 +49,7 @@ fn floor_and_sphere(sigma_a: f64, sigma_s: f64, albedo: f64) -> Scene {
                 DVec3::new(2.0 * big, 0.0, 0.0),
                 DVec3::new(0.0, 2.0 * big, 0.0),
             ),
-            Material::Diffuse {
-                albedo: Rgb::splat(albedo),
-            },
+            Material::diffuse(Rgb::splat(albedo)),
         )
         .object(
             "sphere",

@@ -2,6 +2,7 @@
 
 mod artist;
 mod common;
+mod environment_map;
 mod fuzz_regressions;
 mod image_prefilter;
 mod index_matched;
@@ -9,6 +10,8 @@ mod integrators;
 mod precision;
 mod readme;
 mod reciprocity;
+mod rough_surfaces;
+mod scene_format;
 mod separable;
 mod shapes;
 mod slab_table;

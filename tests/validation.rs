@@ -91,7 +91,7 @@ fn diffuse_transfer(
         object: 0,
         medium: &view,
         g: t.g,
-        interface: Interface { eta: 1.0 },
+        interface: Interface::smooth(1.0),
     };
     let mut counters = PathCounters::default();
     let mut hits = 0;

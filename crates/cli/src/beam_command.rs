@@ -303,6 +303,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let rate = map.samples as f64 / map.seconds.max(1e-9) / rayon::current_num_threads() as f64;
         say!("  total reflectance {a:.5} ± {se:.5}; {rate:.3e} photons/s/core");
     }
-    warn_counters(&map.counters);
+    warn_counters(&map.counters, false);
     Ok(())
 }

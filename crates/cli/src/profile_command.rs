@@ -22,7 +22,8 @@ pub enum SingleScattering {
 /// Arguments of `het-bssrdf profile`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Profile model: dipole, pbd or better-dipole.
+    /// Profile model: dipole, pbd, better-dipole or tabulated (the exact half-space profile,
+    /// η ≤ 1.6; `render`'s default there).
     #[arg(long, value_parser = crate::choices::profile())]
     model: ProfileModel,
     /// Absorption coefficient σa (1/length, ≥ 0).

@@ -47,9 +47,10 @@ pub struct Args {
     /// BSSRDF on every object.
     #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
-    /// Shape correction of BSSRDF objects (docs/shapes.md): `auto` (default) corrects the
-    /// objects too small for a half-space profile, unless their material says
-    /// `shape_correction = false`; `on` corrects every one, `off` none.
+    /// Shape correction of BSSRDF objects (docs/shapes.md): `auto` corrects the objects too
+    /// small for a half-space profile, unless their material says `shape_correction = false`;
+    /// `on` corrects every one, `off` none. Default: `auto` with `--method auto`; with an
+    /// estimator named, each material's own `shape_correction` (off where it sets none).
     #[arg(long, value_parser = crate::choices::correction())]
     shape_correction: Option<tracer::integrator::Correction>,
     #[command(flatten)]
@@ -68,8 +69,8 @@ pub struct Args {
     /// Seed (default: the scene's `render.seed`).
     #[arg(long, allow_hyphen_values = true)]
     seed: Option<u64>,
-    /// Scattering orders inside media: multiple, single or all (default: the scene's, else
-    /// multiple, as in the paper).
+    /// Scattering orders inside media: multiple, single or all (default: the scene's
+    /// `render.scattering`, else all; the paper's experiments use multiple).
     #[arg(long, value_parser = crate::choices::scattering())]
     scattering: Option<Scattering>,
     /// Most surface interactions per path (default: the scene's, else 8).
@@ -104,6 +105,10 @@ pub struct Args {
     /// traces spp × width × height light paths; it takes no --time, --tile or --checkpoint.
     #[arg(long, value_enum, default_value_t = Trace::Camera)]
     trace: Trace,
+    /// Print each warning's full text (what was measured, why it matters) instead of its one
+    /// line, and the estimators' averaging counts; the sidecar always holds the full text.
+    #[arg(short, long)]
+    verbose: bool,
 }
 
 /// Runs the subcommand.
@@ -199,7 +204,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if args.time.is_some() || args.tile.is_some() || args.checkpoint.is_some() {
             bail!("--trace light takes a sample count (--spp), not --time, --tile or --checkpoint");
         }
-        return run_light_traced(&scene, &job, &out, args.exposure);
+        return run_light_traced(&scene, &job, &out, args.exposure, args.verbose);
     }
     set_collision_cap(args.max_collisions);
     signals::install(signals::Mode::Finish)?;
@@ -299,14 +304,34 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         mean[1],
         mean[2]
     );
-    for w in &outcome.warnings {
-        say!("warning: {w}");
-    }
     for n in &outcome.notes {
         say!("note: {n}");
     }
-    warn_counters(&outcome.counters);
+    print_warnings(&outcome.warnings, &json, args.verbose);
+    warn_counters(&outcome.counters, args.verbose);
     Ok(())
+}
+
+/// Each warning as one line, or (`verbose`) as its full text; without `verbose`, one line
+/// more says where the full texts are.
+fn print_warnings(
+    warnings: &[tracer::integrator::warnings::Warning],
+    sidecar: &std::path::Path,
+    verbose: bool,
+) {
+    for w in warnings {
+        if verbose {
+            say!("warning: {}", w.detail);
+        } else {
+            say!("warning: {}", w.summary);
+        }
+    }
+    if !verbose && warnings.iter().any(|w| w.summary != w.detail) {
+        say!(
+            "(the full text of each warning is in {}, or run with --verbose)",
+            sidecar.display()
+        );
+    }
 }
 
 /// True when `out` holds a finished render: its EXR exists and its sidecar says neither
@@ -341,6 +366,7 @@ fn run_light_traced(
     job: &RenderJob,
     out: &std::path::Path,
     exposure: f64,
+    verbose: bool,
 ) -> anyhow::Result<()> {
     use tracer::integrator::{LightTraceOptions, LightTracer, PathOptions};
     let Budget::Samples(spp) = job.budget else {
@@ -388,9 +414,7 @@ fn run_light_traced(
         mean[1],
         mean[2]
     );
-    for w in &outcome.warnings {
-        say!("warning: {w}");
-    }
-    warn_counters(&outcome.counters);
+    print_warnings(&outcome.warnings, &json, verbose);
+    warn_counters(&outcome.counters, verbose);
     Ok(())
 }

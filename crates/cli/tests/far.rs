@@ -90,6 +90,7 @@ fn the_path_tracer_is_invariant_to_translation_up_to_1e6() {
             "pt",
             "--seed",
             "11",
+            "--verbose",
             "--out",
             &format!("{name}.exr"),
         ]);

@@ -1,6 +1,6 @@
 //! `het-bssrdf reproduce --scale tiny` through the built binary: every file the report refers
 //! to exists, every number in the tables parses and is finite, the report agrees with
-//! `errors.csv`, the README's headline claims hold at this scale (fixed seed), and an unusable
+//! `errors.csv`, the headline claims (README, docs/results.md) hold at this scale (fixed seed), and an unusable
 //! `--out` fails cleanly.
 
 mod common;

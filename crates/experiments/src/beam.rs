@@ -317,7 +317,7 @@ pub fn trace_photons(
         object: entry.object,
         medium: &view,
         g: t.g,
-        interface: Interface { eta: 1.0 },
+        interface: Interface::smooth(1.0),
     };
     let n = setup.resolution as usize;
     let (e, delta) = (setup.extent, setup.pixel_size());
@@ -540,14 +540,73 @@ pub fn write_variant_maps(example: &str, variants: impl IntoIterator<Item = Vari
     }
 }
 
+/// The log colour range of a beam map's PNG, from `min` (bottom of the colour bar) to `max`
+/// (top). The maps of one figure share one, so that equal colours are equal exitances.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColourRange {
+    /// Exitance at the bottom of the colour bar (> 0).
+    pub min: f64,
+    /// Exitance at the top.
+    pub max: f64,
+}
+
+impl ColourRange {
+    /// Decades shown below a map's largest value.
+    pub const DECADES: f64 = 6.0;
+
+    /// The range of `values`: their largest value and [`Self::DECADES`] below it (or their
+    /// smallest positive value, if higher).
+    pub fn of(values: &[f64]) -> ColourRange {
+        Self::spanning(values, Self::DECADES)
+    }
+
+    /// The range from the largest finite value of `values` down `decades` (or to their
+    /// smallest positive value, if higher); 1 and 0.1 when no value is positive.
+    pub fn spanning(values: &[f64], decades: f64) -> ColourRange {
+        let max = values
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max);
+        let max = if max > 0.0 { max } else { 1.0 };
+        let min_pos = values
+            .iter()
+            .copied()
+            .filter(|&v| v > 0.0 && v.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        let min = min_pos.max(max * 10f64.powf(-decades));
+        ColourRange {
+            min: if min.is_finite() && min < max {
+                min
+            } else {
+                max / 10.0
+            },
+            max,
+        }
+    }
+}
+
 /// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar
 /// beside it (feature `plot`), and a JSON sidecar with the set-up, the method, timings and
-/// counters (`extra` is merged in).
+/// counters (`extra` is merged in). The colour bar spans the map's own range
+/// ([`ColourRange::of`]); [`write_beam_map_in`] takes a range shared by a figure.
 pub fn write_beam_map(
     map: &BeamMap,
     setup: &BeamSetup,
     exr: &std::path::Path,
     extra: serde_json::Value,
+) -> Result<(), crate::error::WriteError> {
+    write_beam_map_in(map, setup, exr, extra, ColourRange::of(&map.values))
+}
+
+/// [`write_beam_map`] with the PNG's colours over `range` (values outside it take the bar's
+/// end colours).
+pub fn write_beam_map_in(
+    map: &BeamMap,
+    setup: &BeamSetup,
+    exr: &std::path::Path,
+    extra: serde_json::Value,
+    range: ColourRange,
 ) -> Result<(), crate::error::WriteError> {
     let n = map.resolution;
     // Small files first, images last, renamed into place together or not at all.
@@ -568,7 +627,10 @@ pub fn write_beam_map(
                 width: n,
                 height: n,
                 extent: [-e, e, -e, e],
-                scale: MapScale::log_for(&map.values, 6.0),
+                scale: MapScale::Log {
+                    min: range.min,
+                    max: range.max,
+                },
                 title: &title,
                 label: "exitance per unit power (1/area)",
             },

@@ -6,6 +6,7 @@
 /// re-exported so that callers build them with the same version.
 pub use serde_json;
 pub mod beam;
+pub mod commentary;
 pub mod converge;
 pub mod error;
 pub mod ledger;

@@ -7,6 +7,7 @@
 use std::path::Path;
 use std::sync::Once;
 
+use plotters::coord::combinators::BindKeyPoints;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 
@@ -71,25 +72,10 @@ pub enum MapScale {
 impl MapScale {
     /// A log scale spanning the positive values of `values`, clipped to `decades` below the max.
     pub fn log_for(values: &[f64], decades: f64) -> MapScale {
-        let max = values
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, f64::max);
-        let max = if max > 0.0 { max } else { 1.0 };
-        let min_pos = values
-            .iter()
-            .copied()
-            .filter(|&v| v > 0.0 && v.is_finite())
-            .fold(f64::INFINITY, f64::min);
-        let min = min_pos.max(max * 10f64.powf(-decades));
+        let r = crate::beam::ColourRange::spanning(values, decades);
         MapScale::Log {
-            min: if min.is_finite() && min < max {
-                min
-            } else {
-                max / 10.0
-            },
-            max,
+            min: r.min,
+            max: r.max,
         }
     }
 
@@ -209,7 +195,7 @@ pub fn map_png_bytes(path: &Path, map: &MapPlot<'_>) -> Result<Vec<u8>, PlotErro
     register_fonts();
     let cell = (480 / width.max(height)).max(1);
     let (pw, ph) = (width * cell, height * cell);
-    let (w, h) = (pw + 230, ph + 110);
+    let (w, h) = (pw + 90 + BAR_LABEL_AREA + 80, ph + 110);
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -253,6 +239,11 @@ pub fn map_png_bytes(path: &Path, map: &MapPlot<'_>) -> Result<Vec<u8>, PlotErro
 
 /// Font size (pixels) of tick labels and axis titles: legible at the PNGs' size.
 const LABEL_SIZE: u32 = 15;
+
+/// Width (pixels) left of a colour bar for its tick labels and its rotated title: the widest
+/// tick label (`2.5×10⁻⁶`, about 65 pixels at [`LABEL_SIZE`]) plus the title's line, so that
+/// the two do not overlap.
+const BAR_LABEL_AREA: u32 = 110;
 
 /// A tick label as people write numbers: `0.1`, `1`, `10`, `2.5`, `1500`; outside
 /// `[0.001, 10⁵)` a power of ten (`10⁻⁶`) or a mantissa and one (`2.5×10⁻⁶`).
@@ -307,6 +298,52 @@ fn superscript(n: i32) -> String {
     s
 }
 
+/// Tick positions for a logarithmic axis over `[lo, hi]` (0 < lo < hi): whole decades when
+/// the range spans at least three, else 1-2-5 steps, else every mantissa 1…9, else tenths
+/// of a decade's first digit, whichever first gives at least three ticks; at most twelve (every
+/// second or fifth one kept beyond). A log axis then carries several labelled ticks however
+/// narrow its range, where plotters' own key points on a range within one decade can be a
+/// single `1`.
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Vec::new();
+    }
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (e0, e1) = (lo.log10().floor() as i32 - 1, hi.log10().ceil() as i32 + 1);
+        (e0..=e1)
+            .flat_map(|e| mantissas.iter().map(move |m| m * 10f64.powi(e)))
+            .filter(|v| *v >= lo * (1.0 - 1e-12) && *v <= hi * (1.0 + 1e-12))
+            .collect()
+    };
+    let fine: Vec<f64> = (10..100).map(|k| k as f64 / 10.0).collect();
+    let candidates: [&[f64]; 4] = [
+        &[1.0],
+        &[1.0, 2.0, 5.0],
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
+        &fine,
+    ];
+    for m in candidates {
+        let ticks = within(m);
+        if ticks.len() >= 3 {
+            return thinned(ticks, 12);
+        }
+    }
+    vec![lo, (lo * hi).sqrt(), hi]
+}
+
+/// Every k-th of `ticks` (k = 2 or 5, then larger) so that at most `most` remain.
+fn thinned(ticks: Vec<f64>, most: usize) -> Vec<f64> {
+    let mut k = 1;
+    while ticks.len().div_ceil(k) > most {
+        k = match k {
+            1 => 2,
+            2 => 5,
+            _ => k * 2,
+        };
+    }
+    ticks.into_iter().step_by(k).collect()
+}
+
 fn colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     scale: MapScale,
@@ -321,13 +358,14 @@ fn colour_bar<DB: DrawingBackend>(
         .margin_top(40)
         .margin_bottom(45)
         .margin_right(10)
-        .y_label_area_size(70)
+        .y_label_area_size(BAR_LABEL_AREA)
         .build_cartesian_2d(0.0..1.0, lo..hi)?;
     chart
         .configure_mesh()
         .disable_mesh()
         .disable_x_axis()
         .y_desc(label)
+        .y_labels(6)
         .y_label_formatter(&|v| {
             if log {
                 decade_label(*v)
@@ -444,7 +482,10 @@ fn draw_loglog<DB: DrawingBackend>(
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+        .build_cartesian_2d(
+            (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+            (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+        )?;
     chart
         .configure_mesh()
         .x_desc(x_label)
@@ -555,5 +596,43 @@ mod tests {
         );
         assert_eq!(s.position(1.0), Some(1.0));
         assert_eq!(s.position(0.0), None);
+    }
+
+    /// Every log axis carries at least three labelled ticks and at most twelve, inside its
+    /// range and increasing, from a factor of 1.3 (the convergence plot that showed one tick,
+    /// `1`) to twelve decades; a curve plot's SVG shows them.
+    #[test]
+    fn log_axes_carry_several_ticks() {
+        for (lo, hi) in [
+            (0.77, 1.3),
+            (0.19, 1.3),
+            (0.4, 2.0),
+            (1.0, 1.3),
+            (0.05, 0.08),
+            (1e-3, 10.0),
+            (3e-7, 2e5),
+        ] {
+            let t = log_ticks(lo, hi);
+            assert!((3..=12).contains(&t.len()), "[{lo}, {hi}]: {t:?}");
+            assert!(t.windows(2).all(|w| w[0] < w[1]), "{t:?}");
+            assert!(
+                t.iter().all(|&v| v >= lo * 0.999 && v <= hi * 1.001),
+                "{t:?}"
+            );
+        }
+        assert_eq!(log_ticks(0.77, 1.3), vec![0.8, 0.9, 1.0]);
+        assert!(log_ticks(-1.0, 1.0).is_empty());
+        let dir = tempfile::tempdir().unwrap();
+        let q = dir.path().join("narrow.png");
+        let s = vec![Series {
+            label: "a".into(),
+            points: vec![(1.0, 0.9), (2.0, 0.7), (4.0, 0.6)],
+        }];
+        loglog_png(&q, "err", "seconds", "rel. L2", &s).unwrap();
+        let svg = std::fs::read_to_string(q.with_extension("svg")).unwrap();
+        for label in ["0.5", "0.6", "0.8", "1"] {
+            let text = format!(">\n{label}\n</text>");
+            assert!(svg.contains(&text), "no tick {label} in the SVG: {svg}");
+        }
     }
 }

@@ -10,7 +10,10 @@ use std::time::Instant;
 use bssrdf_core::{ProfileModel, Scattering};
 use serde::{Deserialize, Serialize};
 
-use crate::beam::{BeamSetup, BeamTexture, PhotonBudget, run_method, write_beam_map};
+use crate::beam::{
+    BeamSetup, BeamTexture, ColourRange, PhotonBudget, run_method, write_beam_map,
+    write_beam_map_in,
+};
 use crate::converge::{MethodSummary, summarize, write_outputs};
 use crate::error::WriteError;
 use crate::ledger::{Ledger, LedgerError};
@@ -202,6 +205,7 @@ pub fn reproduce(
         scale.expected,
         rayon::current_num_threads()
     );
+    let _ = writeln!(report, "{}", crate::commentary::METHODS_AND_METRICS);
 
     // 1. The beam maps (Figure 4).
     let mut stripe_reference: Option<(BeamSetup, Vec<f64>)> = None;
@@ -211,8 +215,8 @@ pub fn reproduce(
          scattering only; σa = 0.005 / 0.1 (stripes at 45° or checks, width 4). Maps cover \
          [−15, 15]², {n} × {n} pixels; the reference is light tracing with {p} photons. Errors \
          ignore pixels within 1 unit of the beam (the singular peak). These are one seed's \
-         numbers: differences between estimators smaller than the seed-to-seed spread (the \
-         README's Figure 4 tables give it over 4 seeds) mean nothing.\n",
+         numbers: differences between estimators smaller than the seed-to-seed spread \
+         (docs/results.md gives it over 4 seeds) mean nothing.\n",
         n = scale.beam_resolution,
         p = scale.beam_photons
     );
@@ -251,6 +255,8 @@ pub fn reproduce(
             as_written(&mut values);
             values
         };
+        // Every map of the preset in the reference's colour range, so that panels compare.
+        let range = ColourRange::of(&pt_values);
         let n = setup.resolution as usize;
         let keep = |i: usize| {
             let (x, y) = (i % n, i / n);
@@ -277,7 +283,13 @@ pub fn reproduce(
                         seed,
                         &|_| {},
                     )?;
-                    write_beam_map(&map, &setup, &path, serde_json::json!({"seed": seed}))?;
+                    write_beam_map_in(
+                        &map,
+                        &setup,
+                        &path,
+                        serde_json::json!({"seed": seed}),
+                        range,
+                    )?;
                     let metrics =
                         compare(&map.values, &pt_values, 1, keep).map_err(StudyError::from)?;
                     Ok::<_, ReproduceError>(ErrorRow {
@@ -290,7 +302,14 @@ pub fn reproduce(
                 rows.push(row);
             }
         }
-        let _ = writeln!(report, "### {preset}\n\n{}\n", images.join(" "));
+        let _ = writeln!(
+            report,
+            "### {preset}\n\nEvery map of this preset is drawn over the reference's colour range \
+             ({:.1e} to {:.1e} per unit area), so that equal colours are equal exitances.\n\n{}\n",
+            range.min,
+            range.max,
+            images.join(" ")
+        );
         if preset == "stripe" {
             stripe_reference = Some((setup, pt_values));
         }
@@ -300,6 +319,12 @@ pub fn reproduce(
         "{}",
         error_table(rows.iter().filter(|r| r.experiment.starts_with("beam")))
     );
+    for preset in ["stripe", "check"] {
+        let experiment = format!("beam {preset}");
+        let of: Vec<&ErrorRow> = rows.iter().filter(|r| r.experiment == experiment).collect();
+        let _ = write!(report, "{}", crate::commentary::beam_comment(preset, &of));
+    }
+    let _ = writeln!(report);
 
     // 2. The checker slab (Figure 5).
     let slab_dir = out.join("slab");
@@ -378,6 +403,11 @@ pub fn reproduce(
         slab_images.join(" "),
         error_table(rows.iter().filter(|r| r.experiment == "checker slab"))
     );
+    let sone_mean = tracer::output::read_exr(&slab_dir.join("sone.exr"))?.mean();
+    let reference_mean = reference_film.mean();
+    if let Some(c) = crate::commentary::slab_comment(sone_mean.0[0] / reference_mean.0[0]) {
+        let _ = writeln!(report, "{c}\n");
+    }
 
     // 3. Convergence studies.
     let methods: Vec<Method> = CONVERGE_METHODS.iter().map(|m| method(m)).collect();
@@ -450,10 +480,12 @@ pub fn reproduce(
          (full data: `convergence.csv`). *Converged error*: relative L2 at the largest budget; \
          *time*: first budget within 10 % of it; *PT time*: what path tracing needs for the same \
          error (interpolated log–log, or extrapolated along t^(−1/2), marked \\*).\n\n### Checker slab\n\n\
-         ![convergence](converge-slab/convergence.png)\n\n{}\n### Beam, stripe preset (dipole)\n\n\
-         ![convergence](converge-beam-stripe/convergence.png)\n\n{}",
+         ![convergence](converge-slab/convergence.png)\n\n{}\n{}\n### Beam, stripe preset (dipole)\n\n\
+         ![convergence](converge-beam-stripe/convergence.png)\n\n{}\n{}",
         summary_table(&slab_summary),
-        summary_table(&beam_summary)
+        crate::commentary::speedup_comment("checker slab", &slab_summary),
+        summary_table(&beam_summary),
+        crate::commentary::speedup_comment("stripe beam map", &beam_summary)
     );
     let (reused, steps) = ledger.reused();
     let resumed = if reused > 0 {

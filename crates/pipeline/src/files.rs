@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use bssrdf_core::ProfileModel;
 use serde_json::json;
 
 use tracer::error::OutputError;
@@ -98,6 +99,43 @@ pub fn render_attributes(
     ]
 }
 
+/// The profile of each translucent object a BSSRDF renders under `method` (by name, in the
+/// scene's order): the method's own `--profile`, else the material's, else the default for
+/// its η ([`tracer::scene::Translucent::profile_model`]). Objects the path tracer renders
+/// have none.
+pub fn object_profiles(scene: &Scene, method: Method) -> Vec<(String, ProfileModel)> {
+    let Method::Bssrdf { profile, .. } = method else {
+        return Vec::new();
+    };
+    let plans = tracer::integrator::plan::plan(scene, method);
+    scene
+        .translucent_objects()
+        .filter(|(i, _)| plans[*i as usize].is_some_and(|p| !p.path_traced))
+        .map(|(i, t)| {
+            (
+                scene.objects()[i as usize].name.clone(),
+                t.profile_model(profile),
+            )
+        })
+        .collect()
+}
+
+/// What a render's sidecar and EXR header record as its `profile`: the one profile every
+/// BSSRDF-rendered object used (`tabulated`), or each object's (`` `a`: tabulated, `b`: pbd ``)
+/// when they differ; `None` when no object is rendered by a BSSRDF.
+pub fn profile_summary(profiles: &[(String, ProfileModel)]) -> Option<String> {
+    let first = profiles.first()?.1;
+    Some(if profiles.iter().all(|(_, m)| *m == first) {
+        first.name().to_string()
+    } else {
+        profiles
+            .iter()
+            .map(|(n, m)| format!("`{n}`: {}", m.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    })
+}
+
 /// Writes the EXR, the PNG preview (exposure in stops) and the JSON sidecar of a render.
 /// The preview and the sidecar's `mean_rgb` are made from the values the EXR holds (`f32`,
 /// [`Film::as_stored`]), so that an image assembled from files (a merge of shards) writes the
@@ -110,14 +148,8 @@ pub fn write_render(
     exr: &Path,
     exposure: f64,
 ) -> Result<(), OutputError> {
-    let profile = match job.method {
-        Method::Bssrdf { profile, .. } => Some(
-            profile
-                .map(|p| p.name().to_string())
-                .unwrap_or_else(|| "per material".to_string()),
-        ),
-        Method::PathTraced => None,
-    };
+    let profiles = object_profiles(scene, job.method);
+    let profile = profile_summary(&profiles);
     let estimator = match job.method {
         Method::Bssrdf { estimator, .. } => Some(format!("{estimator:?}")),
         Method::PathTraced => None,
@@ -168,14 +200,16 @@ pub fn write_render(
                     Method::Bssrdf { estimator, .. } if !p.path_traced => estimator.name(),
                     _ => "pt",
                 },
+                "profile": profiles.iter().find(|(n, _)| n == name).map(|(_, m)| m.name()),
                 "shape_correction": p.corrected,
+                "clear_medium": p.clear,
                 "optically_small": p.small,
             }))
             .collect::<Vec<_>>(),
         "rays_traced": outcome.rays,
         "threads": rayon::current_num_threads(),
         "counters": outcome.counters,
-        "warnings": outcome.warnings,
+        "warnings": outcome.warnings.iter().map(|w| w.detail.as_str()).collect::<Vec<_>>(),
         "mean_rgb": film.mean().0,
         "pixel_checksum": checksum,
         "interrupted": outcome.interrupted,

@@ -12,6 +12,12 @@ use tracer::scene::Scene;
 /// Default most surface interactions per camera path.
 pub const DEFAULT_MAX_DEPTH: u32 = 8;
 
+/// The scattering orders a scene counts when its `[render]` section does not say: all of
+/// them, the light a picture shows. The artist parameters' colour inversion assumes every
+/// order too (`docs/artist-parameters.md`). The paper's experiments exclude single
+/// scattering, and their scenes say `scattering = "multiple"` themselves.
+pub const DEFAULT_SCATTERING: Scattering = Scattering::All;
+
 /// What a render needs besides the scene.
 #[derive(Debug, Clone)]
 pub struct RenderJob {
@@ -33,13 +39,14 @@ pub struct RenderJob {
 }
 
 impl RenderJob {
-    /// The scene's own settings (spp, seed, max depth, scattering) with `method`.
+    /// The scene's own settings (spp, seed, max depth, scattering) with `method`. A scene
+    /// without `[render] scattering` counts every order ([`DEFAULT_SCATTERING`]).
     pub fn from_scene(scene: &Scene, method: Method) -> Self {
         Self {
             method,
             budget: Budget::Samples(scene.settings().spp),
             seed: scene.settings().seed,
-            scattering: scene.settings().scattering.unwrap_or_default(),
+            scattering: scene.settings().scattering.unwrap_or(DEFAULT_SCATTERING),
             max_depth: scene.settings().max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             progress: false,
             shard: None,
@@ -75,8 +82,9 @@ pub struct RenderOutcome {
     pub counters: PathCounters,
     /// The method's name.
     pub method: String,
-    /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]).
-    pub warnings: Vec<String>,
+    /// Warnings about the scene for this method (see [`PathIntegrator::warnings`]): one line
+    /// each for the terminal, the full text for the sidecar.
+    pub warnings: Vec<tracer::integrator::warnings::Warning>,
     /// What the preparation did that a user may want to know (see [`PathIntegrator::notes`]).
     pub notes: Vec<String>,
     /// How each translucent object was rendered (see [`PathIntegrator::object_plans`]).

@@ -8,7 +8,9 @@
 /// The thread pool renders run on (`rayon`), re-exported so that a caller sizing it
 /// (`rayon::ThreadPoolBuilder`) uses the same version.
 pub use rayon;
+pub mod bsdf;
 pub mod camera;
+pub mod distribution;
 pub mod error;
 pub mod field;
 pub mod film;

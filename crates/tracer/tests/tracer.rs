@@ -25,6 +25,8 @@ mod output;
 mod ply;
 #[path = "tracer/scene.rs"]
 mod scene;
+#[path = "tracer/surfaces.rs"]
+mod surfaces;
 #[path = "tracer/textures.rs"]
 mod textures;
 #[path = "tracer/uv_interior.rs"]

@@ -113,10 +113,21 @@ impl Texture {
     }
 
     /// Decodes an image file: `.exr` (linear) through `exr`, anything else through `image`
-    /// (PNG; 8/16-bit decoded from sRGB unless `linear`, float images linear). The decoded
-    /// size is checked before any pixel is decoded ([`check_decoded_size`]).
+    /// (PNG; 8/16-bit decoded from sRGB unless `linear`, float images such as Radiance `.hdr`
+    /// linear). The decoded size is checked before any pixel is decoded
+    /// ([`check_decoded_size`]).
     pub fn load(path: &Path, linear: bool) -> Result<Texture, TextureError> {
         let file = path.display().to_string();
+        #[cfg(not(feature = "hdr"))]
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("hdr"))
+        {
+            return Err(TextureError::Unsupported {
+                file,
+                message: "Radiance HDR images need the `hdr` feature of het-bssrdf-tracer".into(),
+            });
+        }
         let is_exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
@@ -154,7 +165,7 @@ impl Texture {
     /// `linear`, float images linear; grey images give equal channels, alpha is dropped. The
     /// image's size is read from its header and checked ([`check_decoded_size`]) before any
     /// pixel is decoded. `file` names the texture in errors.
-    #[cfg(feature = "png")]
+    #[cfg(any(feature = "png", feature = "hdr"))]
     pub fn from_encoded(file: &str, bytes: &[u8], linear: bool) -> Result<Texture, TextureError> {
         use image::{DynamicImage, ImageDecoder};
         let decode_error = |message: String| TextureError::Decode {
@@ -218,8 +229,8 @@ impl Texture {
         Texture::from_texels(file, w, h, texels)
     }
 
-    /// Without the `png` feature no encoded image can be decoded.
-    #[cfg(not(feature = "png"))]
+    /// Without the `png` and `hdr` features no encoded image can be decoded.
+    #[cfg(not(any(feature = "png", feature = "hdr")))]
     pub fn from_encoded(file: &str, _bytes: &[u8], _linear: bool) -> Result<Texture, TextureError> {
         Err(TextureError::Unsupported {
             file: file.to_string(),
@@ -302,7 +313,7 @@ impl Texture {
 
 /// Linear RGB texels from interleaved samples with `channels` per pixel (1 or 2: grey, read
 /// from the first; 3 or 4: RGB, alpha dropped), each converted by `f`.
-#[cfg_attr(not(feature = "png"), allow(dead_code))]
+#[cfg_attr(not(any(feature = "png", feature = "hdr")), allow(dead_code))]
 fn spread<S: Copy>(raw: &[S], channels: usize, f: impl Fn(S) -> f32) -> Vec<[f32; 3]> {
     raw.chunks_exact(channels)
         .map(|px| {

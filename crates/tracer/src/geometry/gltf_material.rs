@@ -12,6 +12,8 @@
 //! * `KHR_materials_diffuse_transmission`: `diffuseTransmissionFactor`,
 //!   `diffuseTransmissionColorFactor`;
 //! * `KHR_materials_ior`: `ior`;
+//! * `KHR_materials_transmission`: `transmissionFactor` (specular transmission through the
+//!   surface: with a volume, the volume's boundary is a clear dielectric);
 //! * the two Khronos drafts for scattering volumes: `KHR_materials_volume_scatter`
 //!   (`multiscatterColor`, `scatterAnisotropy`) and its successor `KHR_materials_scatter`
 //!   (`multiscatterColorFactor`, `scatterStrengthFactor`, `scatterAnisotropy`).
@@ -84,6 +86,9 @@ pub struct GltfMaterial {
     pub diffuse_transmission: Option<DiffuseTransmissionExt>,
     /// `KHR_materials_volume_scatter` or `KHR_materials_scatter`, if present.
     pub volume_scatter: Option<VolumeScatterExt>,
+    /// `KHR_materials_transmission.transmissionFactor`, if the extension is present (default
+    /// 0 inside it).
+    pub transmission: Option<f64>,
     /// What the material holds that is not read (`"normalTexture"`,
     /// `"KHR_materials_clearcoat"`, …).
     pub ignored: Vec<String>,
@@ -114,6 +119,7 @@ impl GltfMaterial {
             volume: None,
             diffuse_transmission: None,
             volume_scatter: None,
+            transmission: None,
             ignored: Vec::new(),
         }
     }
@@ -167,6 +173,7 @@ impl GltfMaterial {
             volume: None,
             diffuse_transmission: None,
             volume_scatter: None,
+            transmission: None,
             ignored,
         };
         let Some(ext) = m.extensions() else {
@@ -209,6 +216,14 @@ impl GltfMaterial {
                         &mut out.ignored,
                     );
                     out.diffuse_transmission = Some(DiffuseTransmissionExt { factor, color });
+                }
+                "KHR_materials_transmission" => {
+                    let factor = number(v, "transmissionFactor", 0.0, &path)?;
+                    if !(0.0..=1.0).contains(&factor) {
+                        return Err(bad(path("transmissionFactor"), "must be in [0, 1]"));
+                    }
+                    ignore_textures(v, &["transmissionTexture"], name, &mut out.ignored);
+                    out.transmission = Some(factor);
                 }
                 "KHR_materials_ior" => {
                     let ior = number(v, "ior", GLTF_DEFAULT_IOR, &path)?;
@@ -399,7 +414,9 @@ impl GltfMaterial {
     ///   extinction follows the scattering drafts: σt = −ln(attenuationColor)/d per channel,
     ///   so the mean free path is d / −ln(attenuationColor).
     /// * A volume without either is a clear absorbing dielectric: σa = −ln(attenuationColor)/d,
-    ///   σs = 0 (the path tracer renders it; BSSRDF methods see no subsurface light).
+    ///   σs = 0. Every method path-traces it (a BSSRDF sees no subsurface light in it:
+    ///   [`crate::integrator::plan::is_clear`]). With `KHR_materials_transmission` and no
+    ///   finite `attenuationDistance` it is clear glass, σa = 0.
     /// * Anything else, thin-walled volumes included, is an opaque diffuse surface of the base
     ///   colour factor.
     pub fn interpret(&self) -> (GltfInterpretation, Vec<String>) {
@@ -409,6 +426,31 @@ impl GltfMaterial {
             .map(|s| format!("`{s}` is not read"))
             .collect();
         let eta = self.ior;
+        let transmits = self.transmission.is_some_and(|t| t > 0.0);
+        let scatters = self.volume_scatter.is_some()
+            || self.diffuse_transmission.is_some_and(|t| t.factor > 0.0);
+        if let (Some(v), true, false) = (self.volume, transmits, scatters)
+            && v.thickness > 0.0
+            && !v.attenuation_distance.is_finite()
+        {
+            // Clear glass: KHR_materials_volume's default attenuation is none.
+            return (
+                GltfInterpretation::Absorbing {
+                    sigma_a: [0.0; 3],
+                    eta: self.ior,
+                },
+                notes,
+            );
+        }
+        if transmits && self.volume.is_none_or(|v| v.thickness <= 0.0) {
+            notes.push(
+                "KHR_materials_transmission without a volume (thin-walled transmission) is not \
+                 rendered: an opaque diffuse surface of the base colour; give it \
+                 KHR_materials_volume with thicknessFactor > 0 to render it as a clear \
+                 dielectric"
+                    .to_string(),
+            );
+        }
         let volume = self
             .volume
             .filter(|v| v.thickness > 0.0 && v.attenuation_distance.is_finite());

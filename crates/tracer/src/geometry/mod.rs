@@ -31,6 +31,7 @@ pub mod gltf;
 pub mod gltf_assets;
 #[cfg(feature = "gltf")]
 pub mod gltf_material;
+pub mod holes;
 pub mod mesh;
 #[cfg(feature = "obj")]
 pub mod obj;

@@ -14,6 +14,14 @@
 //! estimator gives for the pair (x_i, x_o). The directions ω_i (toward the light) and ω_o
 //! (toward the viewer) point out of the medium.
 //!
+//! Rough boundary (a material with `roughness`, η ≠ 1; `crate::bsdf::transmittance`): both
+//! Fresnel transmittances 1 − F_r(cos θ) become the fraction T(cos θ; α) that the
+//! energy-conserving rough dielectric lets through at the point's α, and c becomes
+//! √(c(α_i) c(α_o)) with c(α) = 2 ∫₀¹ T(μ; α) μ dμ (c(α) for a constant roughness; the
+//! geometric mean keeps S symmetric when the roughness is textured). The camera path realises
+//! the exit's T by sampling the boundary (it refracts with probability T), the light tracer
+//! evaluates it. Both tend to the smooth terms as α → 0.
+//!
 //! Reciprocity: written as R · (1 − F_r(cos θ_i))(1 − F_r(cos θ_o)) / (c π), S is symmetric
 //! under (x_i, ω_i) ↔ (x_o, ω_o) whenever the estimate is (every averaging estimator;
 //! not the point lookups `jensen-in`/`jensen-out`, see docs/reciprocity.md). Both cosines use
@@ -38,11 +46,15 @@
 //! half-space profile. Every choice is symmetric in the two points, so reciprocity holds as
 //! above.
 
+use std::f64::consts::PI;
+use std::sync::Arc;
+
 use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SeparableBssrdf, SlabFace};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
 
-use crate::field::MediumField;
+use crate::bsdf::{SMOOTH_ALPHA, TransmittanceTable, alpha_from_roughness};
+use crate::field::{Field, MediumField};
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::probe::ProbeSampler;
@@ -70,6 +82,28 @@ pub(crate) struct BssrdfObject {
     /// The shape correction c (module docs of [`super::shape_correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
     pub correction: Option<super::shape_correction::ShapeCorrection>,
+    /// The rough boundary, when the material has one (module docs).
+    rough: Option<RoughBoundary>,
+}
+
+/// A rough boundary's roughness and its transmittance table.
+struct RoughBoundary {
+    /// r (α = r²) over the surface.
+    roughness: Field,
+    /// T(μ; α) and c(α) over the material's range of α.
+    table: Arc<TransmittanceTable>,
+}
+
+/// The table of `material`'s rough boundary over its range of α ([`TransmittanceTable`],
+/// shared); `None` for a smooth or index-matched boundary.
+pub(crate) fn boundary_table(material: &Translucent) -> Option<Arc<TransmittanceTable>> {
+    let r = material.roughness.as_ref()?;
+    let (lo, hi) = (
+        alpha_from_roughness(r.min()[0]),
+        alpha_from_roughness(r.max()[0]),
+    );
+    (material.eta != 1.0 && hi >= SMOOTH_ALPHA)
+        .then(|| TransmittanceTable::shared(material.eta, lo.max(SMOOTH_ALPHA), hi))
 }
 
 /// The profile weight of one pair, with what the angular coupling needs to finish it
@@ -104,8 +138,16 @@ impl BssrdfObject {
         // (`angular_coupling = false`).
         let bssrdf =
             SeparableBssrdf::from_family(family).with_angular_coupling(material.angular_coupling);
+        let rough = boundary_table(material).map(|table| RoughBoundary {
+            roughness: material
+                .roughness
+                .clone()
+                .expect("a rough boundary has a roughness"),
+            table,
+        });
         Ok(Self {
             bssrdf,
+            rough,
             thickness_aware,
             sampler: ProbeSampler::new(family, &material.medium),
             family,
@@ -148,10 +190,57 @@ impl BssrdfObject {
             .probe_points_into(points, chords, x_o, coeffs, self.extent, rng)
     }
 
-    /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π).
+    /// The boundary's roughness α at `hit` where it acts as a rough one (α ≥
+    /// [`SMOOTH_ALPHA`]); `None` where it is smooth (and for every point of a smooth
+    /// material). The rule of [`crate::integrator::walk::Interface::rough_alpha`].
     #[inline]
-    pub fn entry_lobe(&self, cos: f64) -> f64 {
-        self.bssrdf.entry_lobe(cos)
+    pub fn rough_alpha(&self, hit: &Hit) -> Option<f64> {
+        let r = self.rough.as_ref()?;
+        let alpha = alpha_from_roughness(r.roughness.eval(hit.p, hit.uv)[0]);
+        (alpha >= SMOOTH_ALPHA).then_some(alpha)
+    }
+
+    /// [`BssrdfObject::rough_alpha`], 0 where the boundary is smooth.
+    #[inline]
+    pub fn alpha_at(&self, hit: &Hit) -> f64 {
+        self.rough_alpha(hit).unwrap_or(0.0)
+    }
+
+    /// The fraction of light crossing the boundary at incidence cosine `cos` (unitless): 1 −
+    /// F_r(cos θ) for a smooth boundary (`alpha` = 0; 1 for η = 1), the rough transmittance
+    /// T(cos; α) otherwise (module docs).
+    #[inline]
+    pub fn transmission(&self, cos: f64, alpha: f64) -> f64 {
+        match &self.rough {
+            Some(r) if alpha > 0.0 => r.table.transmittance(cos, alpha),
+            _ => self.bssrdf.transmission(cos),
+        }
+    }
+
+    /// The normalisation of S_w for a pair whose boundary roughness is `alpha_i` at x_i and
+    /// `alpha_o` at x_o: c, or √(c(α_i) c(α_o)) through a rough boundary (module docs).
+    #[inline]
+    fn pair_norm(&self, alpha_i: f64, alpha_o: f64) -> f64 {
+        match &self.rough {
+            Some(r) if alpha_i > 0.0 || alpha_o > 0.0 => {
+                let c = |a: f64| {
+                    if a > 0.0 {
+                        r.table.norm(a)
+                    } else {
+                        self.bssrdf.normalisation()
+                    }
+                };
+                (c(alpha_i) * c(alpha_o)).sqrt()
+            }
+            _ => self.bssrdf.normalisation(),
+        }
+    }
+
+    /// S_w at incidence cosine `cos` (1/sr): (1 − F_r(cos)) / (c π), or through a rough
+    /// boundary T(cos; α_i) / (√(c(α_i) c(α_o)) π).
+    #[inline]
+    pub fn entry_lobe(&self, cos: f64, alpha_i: f64, alpha_o: f64) -> f64 {
+        self.transmission(cos, alpha_i) / (self.pair_norm(alpha_i, alpha_o) * PI)
     }
 
     /// R(|x_i − x_o|) (1/length², per channel) at the coefficients the estimator gives for
@@ -250,10 +339,15 @@ impl BssrdfObject {
             return Rgb::ZERO;
         };
         let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
+        let (alpha_i, alpha_o) = (self.alpha_at(x_i), self.alpha_at(x_o));
         let w = self.profile(surface, medium, x_i, x_o, rng, counters);
-        let s = self
-            .bssrdf
-            .combine(w.rd, self.coupling(&w, cos_i, cos_o), cos_i, cos_o);
+        let t = self.coupling(&w, cos_i, cos_o);
+        let s = if self.rough.is_some() && (alpha_i > 0.0 || alpha_o > 0.0) {
+            let fresnel = self.transmission(cos_i, alpha_i) * self.transmission(cos_o, alpha_o);
+            w.rd * (fresnel / (self.pair_norm(alpha_i, alpha_o) * PI)) * t
+        } else {
+            self.bssrdf.combine(w.rd, t, cos_i, cos_o)
+        };
         match (
             self.correction_along(x_i, w_i, n_i),
             self.correction_along(x_o, w_o, n_o),

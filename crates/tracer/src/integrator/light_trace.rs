@@ -28,8 +28,10 @@
 //! * point: a uniform direction, Φ = I · 4π;
 //! * directional (bounded scene): a uniform point on the disk, perpendicular to the light,
 //!   that covers the bounding sphere of the BSSRDF objects, Φ = E · π R²;
-//! * environment (uniform radiance, bounded scene): a uniform direction, then a point on the
-//!   disk as for directional light, Φ = L · 4π · π R².
+//! * environment (bounded scene): a direction ω toward the sky drawn as next-event estimation
+//!   draws it (uniform for a constant environment, in proportion to an image,
+//!   [`crate::light::EnvironmentMap`]), the ray travelling along −ω from a point on the disk
+//!   as for directional light, Φ = L(ω) / p(ω) · π R² (L · 4π · π R² for a constant one).
 //!
 //! Beams are refused (the camera tracer does not see them). The light tracer renders only
 //! light that leaves a light, enters a translucent object once and leaves it toward the
@@ -137,15 +139,16 @@ pub struct LightTraced {
 
 /// An emitter, with what sampling it needs.
 #[derive(Debug, Clone, Copy)]
-enum Emitter {
+enum Emitter<'s> {
     Quad(crate::light::QuadLight),
     Point(crate::light::PointLight),
-    /// Light arriving from infinity: one direction (travelling along it) with irradiance, or
-    /// every direction with constant radiance.
-    Distant {
-        direction: Option<DVec3>,
-        value: Rgb,
+    /// Parallel light from infinity, travelling along `direction`.
+    Directional {
+        direction: DVec3,
+        irradiance: Rgb,
     },
+    /// Light from every direction at infinity.
+    Environment(&'s crate::light::EnvironmentLight),
 }
 
 /// The disk that a light from infinity is emitted from: centre and radius of the bounding
@@ -161,7 +164,7 @@ struct Disk {
 /// The light tracer over a scene and a BSSRDF method (see the module docs).
 pub struct LightTracer<'s> {
     camera_side: PathIntegrator<'s>,
-    emitters: Vec<Emitter>,
+    emitters: Vec<Emitter<'s>>,
     disk: Disk,
     roles: Roles,
 }
@@ -187,17 +190,14 @@ impl<'s> LightTracer<'s> {
         }
         let mut emitters = Vec::with_capacity(scene.lights().len());
         for (index, light) in scene.lights().iter().enumerate() {
-            emitters.push(match *light {
-                Light::Quad(q) => Emitter::Quad(q),
-                Light::Point(p) => Emitter::Point(p),
-                Light::Directional(d) => Emitter::Distant {
-                    direction: Some(d.direction),
-                    value: d.irradiance,
+            emitters.push(match light {
+                Light::Quad(q) => Emitter::Quad(*q),
+                Light::Point(p) => Emitter::Point(*p),
+                Light::Directional(d) => Emitter::Directional {
+                    direction: d.direction,
+                    irradiance: d.irradiance,
                 },
-                Light::Environment(e) => Emitter::Distant {
-                    direction: None,
-                    value: e.radiance,
-                },
+                Light::Environment(e) => Emitter::Environment(e),
                 Light::Beam(_) => {
                     return Err(LightTraceError::UnsupportedLight {
                         index,
@@ -224,7 +224,7 @@ impl<'s> LightTracer<'s> {
 
     /// Things about the scene that make this method's image misleading (as the camera
     /// tracer's).
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[crate::integrator::warnings::Warning] {
         self.camera_side.warnings()
     }
 
@@ -365,7 +365,7 @@ impl<'s> LightTracer<'s> {
     }
 
     /// An emitted ray and its flux weight (emitted power per unit pdf, see the module docs).
-    fn emit(&self, emitter: Emitter, rng: &mut Rng) -> Option<(Ray, Rgb)> {
+    fn emit(&self, emitter: Emitter<'_>, rng: &mut Rng) -> Option<(Ray, Rgb)> {
         let u = rng.uniform2();
         let v = rng.uniform2();
         match emitter {
@@ -383,25 +383,33 @@ impl<'s> LightTracer<'s> {
                 Ray::new(p.position, uniform_sphere(u)),
                 p.intensity * (4.0 * PI),
             )),
-            Emitter::Distant { direction, value } => {
-                let (dir, per_direction) = match direction {
-                    Some(d) => (d, 1.0),
-                    None => (-uniform_sphere(u), 4.0 * PI),
-                };
-                let d = self.disk;
-                if d.radius.is_nan() || d.radius <= 0.0 {
-                    return None;
-                }
-                let (t, b) = het_estimate::frame::orthonormal_basis(dir);
-                let r = d.radius * v[0].sqrt();
-                let phi = 2.0 * PI * v[1];
-                let origin = d.centre - d.back * dir + r * (phi.cos() * t + phi.sin() * b);
-                Some((
-                    Ray::new(origin, dir),
-                    value * (per_direction * PI * d.radius * d.radius),
-                ))
+            Emitter::Directional {
+                direction,
+                irradiance,
+            } => self.disk_ray(direction, irradiance, v),
+            Emitter::Environment(e) => {
+                let (w, pdf, radiance) = e.sample(u)?;
+                self.disk_ray(-w, radiance / pdf, v)
             }
         }
+    }
+
+    /// A ray travelling along `dir` from a point of the emission disk drawn with `v`, and its
+    /// flux weight: `per_direction` (irradiance, or radiance over the direction's density) times
+    /// the disk's area.
+    fn disk_ray(&self, dir: DVec3, per_direction: Rgb, v: [f64; 2]) -> Option<(Ray, Rgb)> {
+        let d = self.disk;
+        if d.radius.is_nan() || d.radius <= 0.0 {
+            return None;
+        }
+        let (t, b) = het_estimate::frame::orthonormal_basis(dir);
+        let r = d.radius * v[0].sqrt();
+        let phi = 2.0 * PI * v[1];
+        let origin = d.centre - d.back * dir + r * (phi.cos() * t + phi.sin() * b);
+        Some((
+            Ray::new(origin, dir),
+            per_direction * (PI * d.radius * d.radius),
+        ))
     }
 }
 

@@ -38,6 +38,7 @@ use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator};
 
+use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
@@ -49,7 +50,7 @@ use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
-use crate::scene::{Material, Scene, Translucent};
+use crate::scene::{Diffuse, Material, Scene, Translucent};
 use crate::spectral::{HeroTracking, SpectralView};
 use crate::volume::{ChannelView, FreeFlight, direction_about, transmittance};
 
@@ -228,6 +229,8 @@ enum ObjectKind<'s> {
         bssrdf: Option<Box<BssrdfObject>>,
         /// The medium has the same coefficients in every channel.
         grey: bool,
+        /// The rough boundary's albedo and transmittance, when the boundary is rough.
+        boundary: Option<std::sync::Arc<TransmittanceTable>>,
     },
 }
 
@@ -354,6 +357,10 @@ impl Transmission {
 enum Prev {
     /// Camera or a specular event: emission counts fully.
     Specular,
+    /// A smooth dielectric's mirror reflection whose directly seen emitter (a quad light) was
+    /// added when the reflection was chosen ([`PathIntegrator::mirror_emission`]): an emitter
+    /// reached next counts zero, so that it is not counted twice; the environment counts fully.
+    MirrorCounted,
     /// A vertex where light sampling was also done: direction pdf (solid angle).
     Sampled { p: DVec3, pdf: f64 },
 }
@@ -363,7 +370,7 @@ impl Prev {
     fn sampled(self) -> Option<(DVec3, f64)> {
         match self {
             Prev::Sampled { p, pdf } => Some((p, pdf)),
-            Prev::Specular => None,
+            Prev::Specular | Prev::MirrorCounted => None,
         }
     }
 }
@@ -375,10 +382,13 @@ pub struct PathIntegrator<'s> {
     options: PathOptions,
     objects: Vec<ObjectKind<'s>>,
     lights: LightSet,
-    warnings: Vec<String>,
+    warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
     defer_weights: bool,
+    /// Trace smooth dielectrics' mirror directions to the emitters they see
+    /// ([`PathIntegrator::mirror_emission`]): the scene has a quad light.
+    mirror_nee: bool,
 }
 
 /// How light sources are found: the two strategies of multiple importance sampling (Veach
@@ -510,6 +520,15 @@ fn carried(beta: Rgb, r_u: Rgb, q: Rgb) -> (Rgb, Rgb) {
     }
 }
 
+/// What a path did at a rough boundary met from outside
+/// ([`PathIntegrator::rough_boundary`]).
+enum Crossed {
+    /// Refracted into the medium along this direction.
+    Entered(DVec3),
+    /// Reflected (on with this step) or lost.
+    Stepped(Step),
+}
+
 /// The outcome of shading one surface interaction.
 enum Step {
     /// Trace this ray (outside any medium) next.
@@ -601,6 +620,7 @@ impl<'s> PathIntegrator<'s> {
                         material,
                         bssrdf,
                         grey: t.medium.is_grey(),
+                        boundary: crate::integrator::bssrdf::boundary_table(t),
                     }
                 }
                 _ => ObjectKind::Opaque,
@@ -616,6 +636,7 @@ impl<'s> PathIntegrator<'s> {
             warnings,
             strategy: LightStrategy::Mis,
             defer_weights: true,
+            mirror_nee: scene.lights().iter().any(|l| matches!(l, Light::Quad(_))),
         })
     }
 
@@ -639,24 +660,42 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Things about the scene that make this method's image misleading (printed by the CLI).
-    pub fn warnings(&self) -> &[String] {
+    pub fn warnings(&self) -> &[crate::integrator::warnings::Warning] {
         &self.warnings
     }
 
     /// What preparing the render did that a user may want to know: one line per object a
-    /// BSSRDF method path-traces (`--method auto`), and one per object whose shape correction
+    /// BSSRDF method path-traces (clear media; small objects under `--method auto`), and one per object whose shape correction
     /// was measured (points, spacing, wall time).
     pub fn notes(&self) -> Vec<String> {
-        let traced = self
-            .object_plans()
+        let plans = self.object_plans();
+        let traced = |clear: bool| -> Vec<String> {
+            plans
+                .iter()
+                .filter(|(_, p)| {
+                    p.path_traced
+                        && p.clear == clear
+                        && matches!(self.method, Method::Bssrdf { .. })
+                })
+                .map(|(name, _)| format!("`{name}`"))
+                .collect()
+        };
+        let groups = [
+            (
+                traced(true),
+                "its medium does not scatter (a clear absorbing dielectric, which no BSSRDF \
+                 describes)",
+            ),
+            (
+                traced(false),
+                "too small for a half-space profile (`--method auto`; `--method sone` renders \
+                 it with the BSSRDF)",
+            ),
+        ];
+        let traced = groups
             .into_iter()
-            .filter(|(_, p)| p.path_traced && matches!(self.method, Method::Bssrdf { .. }))
-            .map(|(name, _)| {
-                format!(
-                    "`{name}` is path traced: it is too small for a half-space profile \
-                     (`--method auto`; `--method sone` renders it with the BSSRDF)"
-                )
-            });
+            .filter(|(names, _)| !names.is_empty())
+            .map(|(names, why)| format!("path traced, {why}: {}", names.join(", ")));
         let corrections = self.scene.objects().iter().zip(&self.objects).filter_map(
             |(object, kind)| match kind {
                 ObjectKind::Translucent {
@@ -736,6 +775,7 @@ impl<'s> PathIntegrator<'s> {
                     material,
                     bssrdf,
                     grey,
+                    ..
                 } => match bssrdf {
                     None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
                     Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
@@ -749,9 +789,7 @@ impl<'s> PathIntegrator<'s> {
                         }
                         Step::Stop
                     }
-                    Material::Diffuse { albedo } => {
-                        self.diffuse(&hit, &ray, *albedo, &mut st, rng, counters)
-                    }
+                    Material::Diffuse(d) => self.diffuse(&hit, &ray, d, &mut st, rng, counters),
                     Material::Translucent(_) => unreachable!("translucent objects are prepared"),
                 },
             };
@@ -777,7 +815,7 @@ impl<'s> PathIntegrator<'s> {
         for (i, light) in self.scene.lights().iter().enumerate() {
             if let Light::Environment(_) = light {
                 let w = match prev {
-                    Prev::Specular => 1.0,
+                    Prev::Specular | Prev::MirrorCounted => 1.0,
                     Prev::Sampled { p, pdf } => {
                         let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
                         self.strategy.hit_weight(pdf, pl)
@@ -798,11 +836,53 @@ impl<'s> PathIntegrator<'s> {
         let le = light.emitted(hit, -ray.dir);
         match prev {
             Prev::Specular => le,
+            Prev::MirrorCounted => Rgb::ZERO,
             Prev::Sampled { p, pdf } => {
                 let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
                 le * self.strategy.hit_weight(pdf, pl)
             }
         }
+    }
+
+    /// Next-event estimation for a smooth dielectric's mirror reflection at `hit` toward `dir`
+    /// with reflectance `r`: the emitter (a quad light) that direction sees directly, times
+    /// `r`, added to the path now; the path then chooses reflection or transmission as
+    /// before, and a reflection marks its next vertex [`Prev::MirrorCounted`], where an emitter
+    /// counts zero. A delta BSDF has one direction, so tracing it is its light sample, with
+    /// MIS weight 1 and 0 for the random hit. pbrt-v4 (§13.1.1) skips light sampling at delta
+    /// BSDFs and leaves lights to the random choice, which shows a small bright light in a
+    /// smooth dielectric (reflectance a few per cent at normal incidence) as speckles; here it
+    /// is smooth at any spp, for one ray per reflection off a translucent object. The
+    /// environment is left to the random choice: it is seen by every path that escapes, and a
+    /// uniform one then gives every path the same value (the white furnaces stay exact).
+    /// Skipped without quad lights, and under [`LightStrategy::DirectionOnly`] (which counts
+    /// lights hit by chance only).
+    fn mirror_emission(
+        &self,
+        hit: &Hit,
+        dir: DVec3,
+        r: f64,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> bool {
+        if !self.mirror_nee || self.strategy == LightStrategy::DirectionOnly || r <= 0.0 {
+            return false;
+        }
+        let ray = hit.spawn_ray(dir);
+        if let Some(h) = self.scene.geometry().intersect(&ray) {
+            let le = self.emitted(&h, &ray, Prev::Specular);
+            if !le.is_zero() {
+                self.settle(st, rng, counters);
+                st.add(
+                    st.beta * le * r,
+                    st.order,
+                    st.entered,
+                    self.options.scattering,
+                );
+            }
+        }
+        true
     }
 
     fn light_pdf(&self, i: usize) -> f64 {
@@ -960,7 +1040,7 @@ impl<'s> PathIntegrator<'s> {
         &self,
         hit: &Hit,
         ray: &Ray,
-        albedo: Rgb,
+        material: &Diffuse,
         st: &mut PathState,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -970,13 +1050,24 @@ impl<'s> PathIntegrator<'s> {
         } else {
             -hit.ns
         };
+        let albedo = material.albedo_at(hit);
+        // π f / ρ: 1 (Lambert), or the Oren–Nayar factor of a rough surface.
+        let sigma = material.roughness_at(hit);
+        let shape = |wi: DVec3| {
+            if sigma > 0.0 {
+                oren_nayar(sigma, n, -ray.dir, wi)
+            } else {
+                1.0
+            }
+        };
         let ld = self.direct(
             hit.p,
             |wi| hit.spawn_origin(wi),
             |wi| {
                 let c = wi.dot(n);
                 if c > 0.0 {
-                    (c / std::f64::consts::PI, c / std::f64::consts::PI)
+                    let pdf = c / std::f64::consts::PI;
+                    (shape(wi) * pdf, pdf)
                 } else {
                     (0.0, 0.0)
                 }
@@ -999,7 +1090,7 @@ impl<'s> PathIntegrator<'s> {
         let Some((wi, cos)) = cosine_continuation(n, rng) else {
             return Step::Stop;
         };
-        st.beta *= albedo;
+        st.beta *= albedo * shape(wi);
         st.prev = Prev::Sampled {
             p: hit.p,
             pdf: cos / std::f64::consts::PI,
@@ -1041,17 +1132,41 @@ impl<'s> PathIntegrator<'s> {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Step {
-        let interface = Interface { eta: material.eta };
+        let interface = Interface::of(material);
         if ray.dir.dot(hit.ng) >= 0.0 {
             // Arrived from inside (a camera inside the object): pass the face.
             return Step::Continue(hit.spawn_ray(ray.dir));
         }
-        let dir = match interface.cross(ray.dir, hit.ng, rng) {
-            Crossing::Reflect(r) => {
-                st.prev = Prev::Specular;
-                return Step::Continue(hit.spawn_ray(r));
+        let dir = match interface.rough_alpha(hit) {
+            Some(alpha) => match self
+                .rough_boundary(hit, ray.dir, hit.ng, alpha, &interface, st, rng, counters)
+            {
+                Crossed::Entered(t) => t,
+                Crossed::Stepped(step) => return step,
+            },
+            None => {
+                // A light seen in the mirror direction is found by next-event estimation
+                // (weighed by MIS against this reflection), so the reflection does not count
+                // it again when it hits the light ([`Prev::MirrorCounted`]).
+                let counted = !interface.is_index_matched() && {
+                    let cos_i = (-ray.dir.dot(hit.ng)).clamp(0.0, 1.0);
+                    let r = bssrdf_core::fresnel::dielectric(cos_i, material.eta);
+                    let mirror = crate::integrator::walk::reflect(ray.dir, hit.ng);
+                    self.mirror_emission(hit, mirror, r, st, rng, counters)
+                };
+                match interface.cross(ray.dir, hit.ng, rng) {
+                    Crossing::Reflect(r) => {
+                        st.prev = if counted {
+                            Prev::MirrorCounted
+                        } else {
+                            Prev::Specular
+                        };
+                        return Step::Continue(hit.spawn_ray(r));
+                    }
+                    Crossing::Transmit(t) => t,
+                    Crossing::Lost => return Step::Stop,
+                }
             }
-            Crossing::Transmit(t) => t,
         };
         st.entered = true;
         // Through an index-matched boundary the direction is unchanged: the vertex before the
@@ -1073,6 +1188,87 @@ impl<'s> PathIntegrator<'s> {
             rng,
             counters,
         )
+    }
+
+    /// A rough boundary met from outside at `hit` by a ray travelling along `dir`, about the
+    /// macro-normal `n` (facing the ray), with roughness `alpha`: next-event estimation on the
+    /// reflection lobe, MIS-weighted against the boundary's own sampling (pbrt-v4 §13.4 with
+    /// the energy-conserving rough dielectric `f / E` of [`crate::bsdf::dielectric`]: the
+    /// highlights of lights on a rough surface), then a sampled crossing. Returns the
+    /// transmitted direction, or the step taken when the path was reflected (on, with the
+    /// sample's density for MIS) or lost.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)] // out of the smooth boundaries' path
+    fn rough_boundary(
+        &self,
+        hit: &Hit,
+        dir: DVec3,
+        n: DVec3,
+        alpha: f64,
+        interface: &Interface<'_>,
+        st: &mut PathState,
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Crossed {
+        let frame = Frame::new(n);
+        let wo = frame.to_local(-dir);
+        let bsdf = RoughDielectric::new(interface.eta, alpha);
+        // The single-scattering albedo seen from ω_o, which the conserving lobe divides by.
+        let albedo = match self.boundary_table(hit.object) {
+            Some(t) => t.albedo(wo.z, alpha),
+            None => 1.0,
+        };
+        let conserving_pdf = |l: DVec3, pdf: f64| {
+            let d = bsdf.distribution;
+            pdf * (d.g(wo, l) / d.g1(wo)) / albedo
+        };
+        if albedo > 0.0 {
+            let ld = self.direct(
+                hit.p,
+                |wi| hit.spawn_origin(wi),
+                |wi| {
+                    let l = frame.to_local(wi);
+                    if l.z <= 0.0 {
+                        return (0.0, 0.0); // the transmission lobe finds no light inside
+                    }
+                    (
+                        bsdf.f(wo, l) * l.z / albedo,
+                        conserving_pdf(l, bsdf.pdf(wo, l)),
+                    )
+                },
+                st.medium,
+                rng,
+                counters,
+            );
+            if !ld.l.is_zero() {
+                self.settle(st, rng, counters);
+            }
+            st.add(
+                st.beta * ld.l,
+                st.order,
+                st.entered || ld.through_medium,
+                self.options.scattering,
+            );
+        }
+        match interface.cross_rough(dir, n, alpha, rng) {
+            (Crossing::Transmit(t), _) => Crossed::Entered(t),
+            (Crossing::Reflect(r), Some(s)) => {
+                st.prev = Prev::Sampled {
+                    p: hit.p,
+                    pdf: conserving_pdf(s.wi, s.pdf),
+                };
+                Crossed::Stepped(Step::Continue(hit.spawn_ray(r)))
+            }
+            _ => Crossed::Stepped(Step::Stop),
+        }
+    }
+
+    /// The rough boundary's table of `object` (a translucent object with a rough boundary).
+    fn boundary_table(&self, object: u32) -> Option<&TransmittanceTable> {
+        match self.objects.get(object as usize)? {
+            ObjectKind::Translucent { boundary, .. } => boundary.as_deref(),
+            ObjectKind::Opaque => None,
+        }
     }
 
     /// The volumetric random walk in `object` from `start` along `dir` (see [`super::walk`]),
@@ -1099,7 +1295,7 @@ impl<'s> PathIntegrator<'s> {
             st.hero = Some(rng.below(3) as usize);
         }
         st.medium = Some(object);
-        let interface = Interface { eta: material.eta };
+        let interface = Interface::of(material);
         let nee = interface.is_index_matched() && !self.lights.is_empty();
         let filter = self.options.scattering;
         self.settle(st, rng, counters);
@@ -1202,7 +1398,7 @@ impl<'s> PathIntegrator<'s> {
             object,
             medium: flight,
             g: material.g,
-            interface: Interface { eta: material.eta },
+            interface: Interface::of(material),
         }
         .walk_carrying(start, dir, from, order, q, rng, counters, on_scatter)
     }
@@ -1231,15 +1427,38 @@ impl<'s> PathIntegrator<'s> {
         let Some(n_o) = facing_normal(hit, -ray.dir) else {
             return Step::Continue(hit.spawn_ray(ray.dir));
         };
-        if material.eta != 1.0 {
-            let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
-            if rng.uniform() < bssrdf_core::fresnel::dielectric(cos_o, material.eta) {
-                st.prev = Prev::Specular;
-                return Step::Continue(
-                    hit.spawn_ray(crate::integrator::walk::reflect(ray.dir, n_o)),
-                );
+        // The exit through the boundary: Fresnel reflection of a smooth boundary with its
+        // probability (a light in the mirror direction found by next-event estimation); a
+        // rough one reflects off a sampled microfacet (light found by next-event estimation
+        // too) or transmits with the weight whose mean is T(μ_o; α), the rough transmittance S
+        // uses ([`BssrdfObject::transmission`]).
+        let alpha_o = b.rough_alpha(hit);
+        match alpha_o {
+            Some(alpha) => {
+                let interface = Interface::of(material);
+                if let Crossed::Stepped(step) =
+                    self.rough_boundary(hit, ray.dir, n_o, alpha, &interface, st, rng, counters)
+                {
+                    return step;
+                }
             }
+            None if material.eta != 1.0 => {
+                let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
+                let r = bssrdf_core::fresnel::dielectric(cos_o, material.eta);
+                let mirror = crate::integrator::walk::reflect(ray.dir, n_o);
+                let counted = self.mirror_emission(hit, mirror, r, st, rng, counters);
+                if rng.uniform() < r {
+                    st.prev = if counted {
+                        Prev::MirrorCounted
+                    } else {
+                        Prev::Specular
+                    };
+                    return Step::Continue(hit.spawn_ray(mirror));
+                }
+            }
+            None => {}
         }
+        let alpha_o = alpha_o.unwrap_or(0.0);
         let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
         if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
             st.beta *= f_o; // the shape correction's exit factor
@@ -1263,6 +1482,7 @@ impl<'s> PathIntegrator<'s> {
         let carrier = rng.below(set.len() as u32) as usize;
         let mut next = None;
         for (k, &x_i) in set.iter().enumerate() {
+            let alpha_i = b.alpha_at(&x_i);
             let ld = self.direct(
                 x_i.p,
                 |wi| x_i.spawn_origin(wi),
@@ -1274,7 +1494,7 @@ impl<'s> PathIntegrator<'s> {
                     };
                     let cos = wi.dot(n);
                     let pdf = wi.dot(x_i.ns).max(0.0) / std::f64::consts::PI;
-                    (b.entry_lobe(cos) * cos, pdf)
+                    (b.entry_lobe(cos, alpha_i, alpha_o) * cos, pdf)
                 },
                 None,
                 rng,
@@ -1337,7 +1557,7 @@ impl<'s> PathIntegrator<'s> {
             return Step::Stop;
         }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
-        st.beta *= b.entry_lobe(cos) * std::f64::consts::PI;
+        st.beta *= b.entry_lobe(cos, b.alpha_at(&x_i), alpha_o) * std::f64::consts::PI;
         if let Some(f_i) = b.correction_along(&x_i, wi, x_i.ns) {
             st.beta *= f_i; // the shape correction's entry factor for the continuation
         }

@@ -2,8 +2,8 @@
 //! collision or the boundary, Henyey–Greenstein scattering, and the boundary itself
 //! (index-matched: pass straight through; smooth dielectric η > 1: Fresnel reflection,
 //! refraction or total internal reflection, chosen stochastically with their probabilities,
-//! pbrt-v4 §9.5). Shared by the camera path tracer and the light tracer of the beam
-//! experiment.
+//! pbrt-v4 §9.5; rough dielectric: a GGX microsurface, [`crate::bsdf::RoughDielectric`]).
+//! Shared by the camera path tracer and the light tracer of the beam experiment.
 //!
 //! Other objects inside or crossing the medium: the walk intersects the whole scene, and a
 //! surface of another object met before the boundary ends the walk ([`WalkEnd::Surface`]); the
@@ -21,9 +21,12 @@
 use bssrdf_core::Rgb;
 use glam::DVec3;
 
+use crate::bsdf::{DielectricSample, Frame, Lobe, RoughDielectric, alpha_from_roughness};
+use crate::field::Field;
 use crate::geometry::{Geometry, Hit, Ray};
 use crate::integrator::counters::PathCounters;
 use crate::rng::Rng;
+use crate::scene::Translucent;
 use crate::volume::{FreeFlight, Interaction, TrackingCounters, sample_hg};
 
 /// Collisions allowed in one walk before it is stopped and counted as capped, by default.
@@ -47,24 +50,99 @@ pub fn collision_cap() -> u64 {
 
 /// The boundary interface of a translucent object.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Interface {
+pub struct Interface<'a> {
     /// Relative index η = n_inside / n_outside (≥ 1).
     pub eta: f64,
+    /// The boundary's roughness field (r, α = r²; [`crate::scene::Translucent::roughness`]),
+    /// `None` for a smooth boundary.
+    pub roughness: Option<&'a Field>,
 }
 
 /// What happens to a ray meeting an interface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Crossing {
-    /// Specular reflection (Fresnel or total internal reflection) into this direction.
+    /// Reflection (Fresnel or total internal reflection; specular, or off a microfacet) into
+    /// this direction.
     Reflect(DVec3),
     /// Transmission into this direction (refracted when η ≠ 1).
     Transmit(DVec3),
+    /// Lost at a rough boundary: no sample of the energy-conserving lobe was kept in
+    /// [`crate::bsdf::dielectric::MAX_TRIES`] draws (probability below 1e-14). The walk ends as
+    /// if absorbed.
+    Lost,
 }
 
-impl Interface {
+impl Interface<'static> {
+    /// A smooth boundary of relative index `eta`.
+    pub const fn smooth(eta: f64) -> Self {
+        Interface {
+            eta,
+            roughness: None,
+        }
+    }
+}
+
+impl<'a> Interface<'a> {
+    /// The boundary of `material`.
+    pub fn of(material: &'a Translucent) -> Self {
+        Interface {
+            eta: material.eta,
+            roughness: material.roughness.as_ref(),
+        }
+    }
+
     /// True for an index-matched boundary.
     pub fn is_index_matched(&self) -> bool {
         self.eta == 1.0
+    }
+
+    /// The microfacet roughness α at the boundary point `hit` when the boundary acts as a
+    /// rough one there (η ≠ 1 and α ≥ [`crate::bsdf::SMOOTH_ALPHA`]); `None` where it is
+    /// smooth.
+    #[inline]
+    pub fn rough_alpha(&self, hit: &Hit) -> Option<f64> {
+        let r = self.roughness?;
+        let alpha = alpha_from_roughness(r.eval(hit.p, hit.uv)[0]);
+        (!RoughDielectric::is_smooth(self.eta, alpha)).then_some(alpha)
+    }
+
+    /// Crosses the interface at the boundary point `hit` (outward normal `hit.ng`), smooth or
+    /// rough there ([`Interface::cross`], [`Interface::cross_rough`]).
+    #[inline]
+    pub fn cross_at(&self, dir: DVec3, hit: &Hit, rng: &mut Rng) -> Crossing {
+        match self.rough_alpha(hit) {
+            Some(alpha) => self.cross_rough(dir, hit.ng, alpha, rng).0,
+            None => self.cross(dir, hit.ng, rng),
+        }
+    }
+
+    /// Crosses a rough boundary of roughness `alpha` at a surface with outward normal `ng`
+    /// (from either side): reflection or refraction through a microfacet normal drawn from
+    /// those visible from `−dir`, by the energy-conserving lobe
+    /// ([`RoughDielectric::sample_conserving`]), so that the walk stays analog and the boundary
+    /// loses no light. Returns the crossing and the single-scattering sample it kept (its
+    /// density and `G/G1`, from which a caller that knows the single-scattering albedo E forms
+    /// the conserving lobe's density `pdf · (G/G1) / E` for MIS); `Lost` in the 1e-14 case where
+    /// no sample was kept.
+    #[inline(never)] // out of the walk's loop for smooth boundaries
+    pub fn cross_rough(
+        &self,
+        dir: DVec3,
+        ng: DVec3,
+        alpha: f64,
+        rng: &mut Rng,
+    ) -> (Crossing, Option<DielectricSample>) {
+        let frame = Frame::new(ng);
+        let wo = frame.to_local(-dir);
+        let Some(s) = RoughDielectric::new(self.eta, alpha).sample_conserving(wo, rng) else {
+            return (Crossing::Lost, None);
+        };
+        let w = frame.to_world(s.wi).normalize();
+        let crossing = match s.lobe {
+            Lobe::Reflection => Crossing::Reflect(w),
+            Lobe::Transmission => Crossing::Transmit(w),
+        };
+        (crossing, Some(s))
     }
 
     /// Crosses the interface at a surface with outward normal `ng`, for a ray travelling along
@@ -154,7 +232,7 @@ pub struct WalkMedium<'a, M: FreeFlight> {
     /// HG mean cosine.
     pub g: f64,
     /// The boundary.
-    pub interface: Interface,
+    pub interface: Interface<'a>,
 }
 
 impl<M: FreeFlight> WalkMedium<'_, M> {
@@ -260,7 +338,7 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
                         origin = boundary.spawn_origin(d);
                         continue;
                     }
-                    match self.interface.cross(d, boundary.ng, rng) {
+                    match self.interface.cross_at(d, &boundary, rng) {
                         Crossing::Transmit(out) => {
                             break WalkEnd::Exited {
                                 hit: boundary,
@@ -273,6 +351,7 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
                             origin = boundary.spawn_origin(r);
                             d = r;
                         }
+                        Crossing::Lost => break WalkEnd::Absorbed,
                     }
                 }
             }
@@ -407,9 +486,7 @@ mod tests {
             .object(
                 "core",
                 primitives::cuboid(DVec3::splat(-0.3), DVec3::splat(0.3)),
-                Material::Diffuse {
-                    albedo: Rgb::splat(0.5),
-                },
+                Material::diffuse(Rgb::splat(0.5)),
             )
             .build()
             .unwrap()
@@ -453,7 +530,7 @@ mod tests {
                         origin = b.spawn_origin(d);
                         continue;
                     }
-                    match walk.interface.cross(d, b.ng, rng) {
+                    match walk.interface.cross_at(d, &b, rng) {
                         Crossing::Transmit(out) => {
                             return WalkEnd::Exited {
                                 hit: b,
@@ -466,6 +543,7 @@ mod tests {
                             origin = b.spawn_origin(r);
                             d = r;
                         }
+                        Crossing::Lost => return WalkEnd::Absorbed,
                     }
                 }
             }
@@ -493,7 +571,7 @@ mod tests {
                 object: 0,
                 medium: &flight,
                 g: t.g,
-                interface: Interface { eta: t.eta },
+                interface: Interface::of(t),
             };
             let entry = scene
                 .geometry()
@@ -541,7 +619,7 @@ mod tests {
 
     #[test]
     fn fresnel_crossing_frequency_matches_reflectance() {
-        let iface = Interface { eta: 1.5 };
+        let iface = Interface::smooth(1.5);
         let dir = DVec3::new(0.6, 0.0, -0.8);
         let f = bssrdf_core::fresnel::dielectric(0.8, 1.5);
         let mut rng = Rng::from_keys(3, &[]);

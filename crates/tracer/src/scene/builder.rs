@@ -155,7 +155,7 @@ pub(crate) struct AssemblyInfo<'a> {
     pub locator: &'a Locator,
     pub inputs: Vec<PathBuf>,
     /// What the loader read but could not honour (glTF material notes), for the warnings.
-    pub notes: Vec<String>,
+    pub notes: Vec<super::LoadNote>,
 }
 
 /// Checks `[render]` values; `Err((key, message))`.
@@ -179,14 +179,24 @@ fn rgb_ok(v: Rgb) -> bool {
 pub(crate) fn validate_material(m: &Material) -> Result<(), (String, String)> {
     match m {
         Material::Translucent(t) => validate_translucent(t),
-        Material::Diffuse { albedo } => {
-            if rgb_ok(*albedo) && albedo.max_component() <= 1.0 {
-                Ok(())
-            } else {
-                Err((
+        Material::Diffuse(d) => {
+            let (lo, hi) = (d.albedo.min(), d.albedo.max());
+            if !(rgb_ok(lo) && rgb_ok(hi) && hi.max_component() <= 1.0) {
+                return Err((
                     "albedo".into(),
-                    format!("albedo must be in [0, 1], got {:?}", albedo.0),
-                ))
+                    if d.albedo.is_constant() {
+                        format!("albedo must be in [0, 1], got {:?}", hi.0)
+                    } else {
+                        format!(
+                            "albedo must be in [0, 1] everywhere, but it reaches {:?}",
+                            hi.0
+                        )
+                    },
+                ));
+            }
+            match &d.roughness {
+                Some(r) => validate_roughness(r),
+                None => Ok(()),
             }
         }
         Material::Emissive { radiance } => {
@@ -207,7 +217,32 @@ pub(crate) fn validate_material(m: &Material) -> Result<(), (String, String)> {
 
 fn validate_translucent(t: &Translucent) -> Result<(), (String, String)> {
     validate_translucent_scalars(t)?;
+    if let Some(r) = &t.roughness {
+        validate_roughness(r)?;
+    }
     validate_medium(t)
+}
+
+/// Checks a `roughness` field: grey, and within [0, 1] everywhere (its values are already
+/// finite and non-negative, as every field's).
+pub(crate) fn validate_roughness(r: &crate::field::Field) -> Result<(), (String, String)> {
+    let key = || "roughness".to_string();
+    if !r.is_grey() {
+        return Err((
+            key(),
+            "roughness is one number per point: give a number, a grey pattern, or a grey image \
+             (with equal channels and a grey `scale`)"
+                .into(),
+        ));
+    }
+    let (lo, hi) = (r.min()[0], r.max()[0]);
+    if !(lo >= 0.0 && hi <= 1.0) {
+        return Err((
+            key(),
+            format!("roughness must lie in [0, 1], got values from {lo} to {hi}"),
+        ));
+    }
+    Ok(())
 }
 
 /// Checks a translucent material's `g`, `eta` and `unit_scale` with the bounds every profile

@@ -326,6 +326,9 @@ pub struct TranslucentDesc {
     /// divided by it.
     #[serde(default = "one")]
     pub unit_scale: f64,
+    /// The boundary's roughness r ∈ [0, 1] (a grey field; default 0, smooth): a GGX
+    /// microfacet boundary of α = r² (`Translucent::roughness`).
+    pub roughness: Option<FieldDesc>,
 }
 
 fn one() -> f64 {
@@ -340,8 +343,12 @@ pub struct DiffuseDesc {
     _type: String,
     /// Name used by shapes.
     pub name: String,
-    /// Lambertian albedo in [0, 1].
-    pub albedo: RgbDesc,
+    /// Albedo in [0, 1] per channel (a field: a number, `[r, g, b]`, or a pattern or image
+    /// table).
+    pub albedo: FieldDesc,
+    /// Oren–Nayar roughness σ ∈ [0, 1] (a grey field; default 0, Lambertian;
+    /// `crate::bsdf::diffuse`).
+    pub roughness: Option<FieldDesc>,
 }
 
 /// `[[light]]` with `type = "directional"`.
@@ -389,14 +396,25 @@ pub struct QuadDesc {
     pub radiance: RgbDesc,
 }
 
-/// `[[light]]` with `type = "environment"`.
+/// `[[light]]` with `type = "environment"`: a constant `radiance`, or an image `filename`
+/// with its `scale`, `rotation` and `up` ([`crate::light::EnvironmentMap`]).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
     #[serde(rename = "type")]
     _type: String,
-    /// Constant radiance.
-    pub radiance: RgbDesc,
+    /// Constant radiance (W/(sr·m²)), without `filename`.
+    pub radiance: Option<RgbDesc>,
+    /// An equirectangular image of the radiance (`.exr` or Radiance `.hdr`; linear), relative
+    /// to the scene file.
+    pub filename: Option<String>,
+    /// With `filename`: per-channel multiplier of the texels (default 1).
+    pub scale: Option<RgbDesc>,
+    /// With `filename`: turn of the map about its up axis in DEGREES, counter-clockwise seen
+    /// from above (default 0).
+    pub rotation: Option<f64>,
+    /// With `filename`: the map's up axis, `"x" | "y" | "z"` (default z).
+    pub up: Option<AxisDesc>,
 }
 
 /// `[[light]]` with `type = "beam"`.
@@ -527,6 +545,9 @@ shape_desc!(
     MeshFileDesc {
         /// Mesh file (.obj; .gltf or .glb; .ply), relative to the scene file.
         path: String,
+        /// How to get the mesh when `path` does not exist (for a scene shipped without its
+        /// model, e.g. "run `sh scripts/fetch-bunny.sh`"): printed in the error.
+        if_missing: Option<String>,
         /// A glTF shape without `material` only: the `shape_correction` of every translucent
         /// material the file creates (as the material key; unset, the render decides).
         shape_correction: Option<bool>,

@@ -17,7 +17,7 @@ use super::builder::{
 };
 use super::desc::*;
 use super::locate::Locator;
-use super::{Material, RenderSettings, Scene, Translucent};
+use super::{Diffuse, Material, RenderSettings, Scene, Translucent};
 use crate::camera::{Camera, CameraError};
 use crate::error::{FieldError, SceneError};
 use crate::field::{
@@ -25,7 +25,7 @@ use crate::field::{
     Wrap,
 };
 use crate::geometry::{Transform, TriangleMesh, primitives};
-use crate::light::{Light, LightError};
+use crate::light::{EnvironmentError, EnvironmentMap, Light, LightError};
 
 const SECTIONS: &[&str] = &["render", "camera", "texture", "material", "light", "shape"];
 
@@ -121,7 +121,7 @@ struct Cx {
     /// Every mesh and texture file found readable, in the order they were checked.
     inputs: std::cell::RefCell<Vec<PathBuf>>,
     /// What was read but cannot be honoured (glTF material notes).
-    notes: std::cell::RefCell<Vec<String>>,
+    notes: std::cell::RefCell<Vec<super::LoadNote>>,
     options: LoadOptions,
 }
 
@@ -303,10 +303,7 @@ impl Cx {
                     }
                 },
             };
-            if let Material::Translucent(t) = &material
-                && !t.medium.is_volumetric()
-                && s.mesh.uvs.is_none()
-            {
+            if s.mesh.uvs.is_none() && material.reads_uv() {
                 return Err(self.invalid(
                     &s.key,
                     format!(
@@ -468,12 +465,32 @@ impl Cx {
                 }
                 "diffuse" => {
                     let d: DiffuseDesc = self.de(v, &key)?;
-                    let m = Material::Diffuse {
-                        albedo: Rgb(d.albedo.0),
+                    let albedo = self.field_spec(&d.albedo, &format!("{key}.albedo"), textures)?;
+                    let roughness = d
+                        .roughness
+                        .as_ref()
+                        .map(|r| self.field_spec(r, &format!("{key}.roughness"), textures))
+                        .transpose()?;
+                    // Constant values are checked now (unused materials too); images when
+                    // they are decoded.
+                    let ready = |f: &FieldSpec| match f {
+                        FieldSpec::Ready(f) => f.clone(),
+                        FieldSpec::Image { .. } => Field::Constant(Rgb::ZERO),
                     };
-                    validate_material(&m)
+                    let probe = Material::Diffuse(Diffuse {
+                        albedo: ready(&albedo),
+                        roughness: roughness.as_ref().map(ready),
+                    });
+                    validate_material(&probe)
                         .map_err(|(k, msg)| self.invalid(&format!("{key}.{k}"), msg))?;
-                    (d.name.clone(), MaterialPlan::Ready(m))
+                    (
+                        d.name.clone(),
+                        MaterialPlan::Diffuse {
+                            albedo,
+                            roughness,
+                            key: key.clone(),
+                        },
+                    )
                 }
                 other => {
                     return Err(self.parse_msg(
@@ -693,6 +710,7 @@ impl Cx {
                 .unwrap_or(Translucent::DEFAULT_CORRECTION_SEED),
             angular_coupling: d.angular_coupling.unwrap_or(true),
             unit_scale: d.unit_scale,
+            roughness: None,
             key: key.to_string(),
             line: self.loc.line_of_key(key),
         };
@@ -700,6 +718,15 @@ impl Cx {
             .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
         let field =
             |f: &FieldDesc, name: &str| self.field_spec(f, &format!("{key}.{name}"), textures);
+        let roughness = d
+            .roughness
+            .as_ref()
+            .map(|r| field(r, "roughness"))
+            .transpose()?;
+        if let Some(FieldSpec::Ready(r)) = &roughness {
+            crate::scene::builder::validate_roughness(r)
+                .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+        }
         let artist_keys = d.subsurface_color.is_some()
             || d.subsurface_radius.is_some()
             || d.radius_scale.is_some()
@@ -715,6 +742,7 @@ impl Cx {
                 sigma_a: field(a, "sigma_a")?,
                 sigma_s: field(s, "sigma_s")?,
                 artist: None,
+                roughness,
             },
             (None, None, Some(c), Some(r)) => {
                 let scale = Rgb(d.radius_scale.map_or([1.0; 3], |s| s.0));
@@ -753,13 +781,22 @@ impl Cx {
                             "a zero subsurface_radius makes a diffuse surface, which needs a constant subsurface_color",
                         ));
                     };
-                    MaterialPlan::Ready(Material::Diffuse { albedo: cv })
+                    if roughness.is_some() {
+                        return Err(self.invalid(
+                            &format!("{key}.roughness"),
+                            "a zero subsurface_radius makes a diffuse surface, which has no \
+                             dielectric boundary to be rough: use a `diffuse` material and its \
+                             `roughness`",
+                        ));
+                    }
+                    MaterialPlan::Ready(Material::diffuse(cv))
                 } else {
                     MaterialPlan::Translucent {
                         base: probe,
                         sigma_a: colour,
                         sigma_s: radius,
                         artist: Some((scale, invert)),
+                        roughness,
                     }
                 }
             }
@@ -785,15 +822,38 @@ impl Cx {
     ) -> Result<Material, SceneError> {
         match plan {
             MaterialPlan::Ready(m) => Ok(m.clone()),
+            MaterialPlan::Diffuse {
+                albedo,
+                roughness,
+                key,
+            } => {
+                let m = Material::Diffuse(Diffuse {
+                    albedo: self.realize_field(albedo, textures, decoded)?,
+                    roughness: roughness
+                        .as_ref()
+                        .map(|r| self.realize_field(r, textures, decoded))
+                        .transpose()?,
+                });
+                validate_material(&m)
+                    .map_err(|(k, msg)| self.invalid(&format!("{key}.{k}"), msg))?;
+                Ok(m)
+            }
             MaterialPlan::Translucent {
                 base,
                 sigma_a,
                 sigma_s,
                 artist,
+                roughness,
             } => {
                 let a = self.realize_field(sigma_a, textures, decoded)?;
                 let s = self.realize_field(sigma_s, textures, decoded)?;
                 let mut t = base.clone();
+                if let Some(r) = roughness {
+                    let r = self.realize_field(r, textures, decoded)?;
+                    crate::scene::builder::validate_roughness(&r)
+                        .map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
+                    t.roughness = Some(r);
+                }
                 t.medium = match artist {
                     None => MediumField::new(a, s).scaled(base.unit_scale),
                     Some((scale, invert)) => {
@@ -884,7 +944,10 @@ impl Cx {
                 }
                 "environment" => {
                     let d: EnvironmentDesc = self.de(v, &key)?;
-                    Light::environment(Rgb(d.radiance.0))
+                    match self.environment(&d, &key)? {
+                        Some(map) => Ok(map),
+                        None => Light::environment(Rgb(d.radiance.map_or([0.0; 3], |r| r.0))),
+                    }
                 }
                 "beam" => {
                     let d: BeamDesc = self.de(v, &key)?;
@@ -907,6 +970,80 @@ impl Cx {
             })?);
         }
         Ok(out)
+    }
+
+    /// An environment light read from an image (`filename`), or `None` for a constant one
+    /// (`radiance`; `scale`, `rotation` and `up` then refused).
+    fn environment(&self, d: &EnvironmentDesc, key: &str) -> Result<Option<Light>, SceneError> {
+        let k = |sub: &str| format!("{key}.{sub}");
+        let Some(rel) = &d.filename else {
+            if d.radiance.is_none() {
+                return Err(self.invalid(
+                    key,
+                    "an environment light needs `radiance` (constant) or `filename` (an image)",
+                ));
+            }
+            for (name, given) in [
+                ("scale", d.scale.is_some()),
+                ("rotation", d.rotation.is_some()),
+                ("up", d.up.is_some()),
+            ] {
+                if given {
+                    return Err(self.invalid(
+                        &k(name),
+                        format!("`{name}` applies to an environment map (`filename`)"),
+                    ));
+                }
+            }
+            return Ok(None);
+        };
+        if d.radiance.is_some() {
+            return Err(self.invalid(
+                &k("radiance"),
+                "give `radiance` (constant) or `filename` (an image), not both; `scale` \
+                 multiplies the image",
+            ));
+        }
+        let path = self.resolve(rel);
+        let path_key = k("filename");
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("exr" | "hdr")) {
+            return Err(self.invalid(
+                &path_key,
+                format!(
+                    "`{rel}`: an environment map is an `.exr` or Radiance `.hdr` image \
+                     (linear radiance)"
+                ),
+            ));
+        }
+        self.check_readable(&path_key, &path)?;
+        let texture = Texture::load(&path, true).map_err(|source| SceneError::Texture {
+            file: self.file.clone(),
+            line: self.loc.line_of_key(&path_key),
+            key: path_key.clone(),
+            source: Box::new(source),
+        })?;
+        let up = match d.up.unwrap_or(AxisDesc::Z) {
+            AxisDesc::X => Axis::X,
+            AxisDesc::Y => Axis::Y,
+            AxisDesc::Z => Axis::Z,
+        };
+        let map = EnvironmentMap::new(
+            Arc::new(texture),
+            Rgb(d.scale.map_or([1.0; 3], |s| s.0)),
+            up,
+            d.rotation.unwrap_or(0.0),
+        )
+        .map_err(|e| {
+            let sub = match e {
+                EnvironmentError::BadRotation(_) => "rotation",
+                _ => "scale",
+            };
+            self.invalid(&k(sub), e.to_string())
+        })?;
+        Ok(Some(Light::environment_map(map)))
     }
 
     fn shapes(
@@ -1049,6 +1186,14 @@ impl Cx {
                     };
                     let (common, rel) = (d.common(), d.path);
                     let path = self.resolve(&rel);
+                    if let Some(hint) = &d.if_missing
+                        && !path.exists()
+                    {
+                        return Err(self.invalid(
+                            &k("path"),
+                            format!("the mesh `{}` does not exist: {hint}", path.display()),
+                        ));
+                    }
                     self.check_readable(&k("path"), &path)?;
                     let mesh_error = |source| SceneError::Mesh {
                         file: self.file.clone(),
@@ -1161,10 +1306,12 @@ impl Cx {
         use crate::geometry::gltf_material::GltfInterpretation as I;
         let (interpretation, notes) = m.interpret();
         let file = model.file().display().to_string();
-        for n in notes {
-            self.notes
-                .borrow_mut()
-                .push(format!("{file}: material `{}`: {n}", m.name));
+        for text in notes {
+            self.notes.borrow_mut().push(super::LoadNote {
+                file: file.clone(),
+                subject: format!("material `{}`", m.name),
+                text,
+            });
         }
         let field_key = format!("{key}.path");
         let invalid =
@@ -1173,9 +1320,7 @@ impl Cx {
         // geometric mean).
         let s = (scale.x * scale.y * scale.z).abs().cbrt();
         let material = match interpretation {
-            I::Diffuse { albedo } => Material::Diffuse {
-                albedo: Rgb(albedo),
-            },
+            I::Diffuse { albedo } => Material::diffuse(Rgb(albedo)),
             I::Absorbing { sigma_a, eta } => {
                 let medium = MediumField::homogeneous(het_estimate::Coefficients {
                     sigma_a: Rgb(sigma_a) * (1.0 / s),
@@ -1350,6 +1495,12 @@ impl Cx {
 #[allow(clippy::large_enum_variant)] // a few per scene, built once
 enum MaterialPlan {
     Ready(Material),
+    Diffuse {
+        albedo: FieldSpec,
+        roughness: Option<FieldSpec>,
+        /// The material's key (`material[1]`), for messages.
+        key: String,
+    },
     Translucent {
         base: Translucent,
         /// σa, or the artist colour.
@@ -1358,6 +1509,8 @@ enum MaterialPlan {
         sigma_s: FieldSpec,
         /// For artist parameters: the radius scale and where estimators invert.
         artist: Option<(Rgb, InvertAt)>,
+        /// The boundary's roughness.
+        roughness: Option<FieldSpec>,
     },
 }
 

@@ -5,10 +5,11 @@
 //! Units are explicit: lengths in scene units, angles in degrees, coefficients in 1/scene-unit
 //! (after `unit_scale`), colours as a number (grey) or `[r, g, b]` (linear). Unknown keys are
 //! errors; every error names the file, the key path (`material[1].sigma_a.width`) and the line.
+//! Every key, with its type, default, units and an example, is in `docs/scene-format.md`.
 //!
 //! * `[render]`: `width`, `height`, `spp` (all ≥ 1), `seed` (default 0), optional `max_depth`,
 //!   `estimator` (a name the renderer parses), `averaging` (`prefiltered | monte-carlo`),
-//!   `scattering` (`multiple | single | all`).
+//!   `scattering` (`multiple | single | all`; a render counts `all` when it is not given).
 //! * `[camera]`: `type = "perspective"` with `eye`, `target`, `up`, `fov_y` (degrees, full
 //!   vertical), or `type = "orthographic"` with `centre`, `direction` (view direction; rays start
 //!   on the plane through `centre`), `up`, `width`, `height` (of the view rectangle).
@@ -22,9 +23,13 @@
 //!   artist parameters `subsurface_color` (field, in [0, 1]) and `subsurface_radius` (field,
 //!   mean free path per channel in file units), with optional `radius_scale` (RGB, default 1)
 //!   and `invert = "before" | "after"`; `anisotropy` is another name for `g`
-//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). Or `type =
-//!   "diffuse"` with `name`, `albedo`. Unused materials are validated but their textures are
-//!   not decoded.
+//!   (`docs/artist-parameters.md`, [`crate::field::MediumField::artist`]). A translucent
+//!   material's optional `roughness` (a grey field in [0, 1], default 0: smooth) makes its
+//!   boundary a GGX microfacet dielectric of α = roughness² ([`Translucent::roughness`]). Or
+//!   `type = "diffuse"` with `name`, `albedo` (a field in [0, 1]) and an optional Oren–Nayar
+//!   `roughness` (a grey field in [0, 1], default 0: Lambertian; [`Diffuse`]). Unused
+//!   materials are validated but their textures are not decoded
+//!   (`docs/lighting-and-surfaces.md`).
 //! * Fields: a number or `[r, g, b]` (constant), or a table with `type`:
 //!   `constant` (`value`); `stripe` (`width`, `angle` in degrees, `values = [v0, v1]`, `axis`,
 //!   `origin`); `check` (`width`, `values`, `axis`, `origin`); `image` (`texture`, `mapping =
@@ -32,12 +37,16 @@
 //!   `filter = "bilinear" | "nearest"`, `scale`). See [`crate::field`] for the projection.
 //! * `[[light]]`: `directional` (`direction` it travels, `irradiance`), `point` (`position`,
 //!   `intensity`), `quad` (`corner`, `edge_u`, `edge_v`, `radiance`; emits on the side of
-//!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`), `beam`
-//!   (`origin`, `direction`, `power`).
+//!   edge_u × edge_v and becomes an emissive object), `environment` (`radiance`, or an
+//!   equirectangular `.exr` or Radiance `.hdr` image `filename` with `scale` (RGB, default 1),
+//!   `rotation` (degrees about the map's up axis, default 0) and `up` (`"x" | "y" | "z"`,
+//!   default z): [`crate::light::EnvironmentMap`]), `beam` (`origin`, `direction`, `power`).
 //! * `[[shape]]`: `box` (`min`, `max`), `sphere` (`centre`, `radius`, `subdivisions`),
-//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj` (`path`), `gltf`
-//!   (`path`); each with `material`, optional `name` and `transform = { scale, rotate = { axis,
-//!   degrees }, translate }`.
+//!   `half_space` (`top`, `centre`, `size`, `depth`, `subdivisions`), `obj`, `gltf`, `ply`
+//!   (`path`, and `if_missing`: what to tell the user when the file does not exist; glTF also
+//!   `allow_outside_assets`, `shape_correction`, `shape_correction_seed`); each with
+//!   `material`, optional `name` and `transform = { scale, rotate = { axis, degrees },
+//!   translate }`.
 //!
 //! Translucent objects must not overlap one another (one inside the other, or crossing): the
 //! path tracer has no nested media, so such scenes are refused when built, naming both objects
@@ -63,7 +72,7 @@ use het_estimate::{Estimator, PreparedEstimator};
 
 use crate::camera::Camera;
 use crate::error::SceneError;
-use crate::field::MediumField;
+use crate::field::{Field, MediumField};
 use crate::geometry::{Geometry, MeshReport, ObjectSurface};
 use crate::light::{BeamLight, Light};
 
@@ -142,6 +151,12 @@ pub struct Translucent {
     pub angular_coupling: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
+    /// The boundary's roughness `r ∈ [0, 1]` (a grey field; scene key `roughness`), `None` for
+    /// a smooth boundary: a GGX microfacet dielectric of α = r² ([`crate::bsdf`]) in the path
+    /// tracer, and its directional transmittance in the BSSRDF's Fresnel terms
+    /// (`integrator/bssrdf.rs`). No effect at η = 1 (no boundary), and α below
+    /// [`crate::bsdf::SMOOTH_ALPHA`] is smooth.
+    pub roughness: Option<Field>,
     /// Key of the material in the scene file (`material[2]`) for messages.
     pub key: String,
     /// Line of the material in the scene file, if loaded from one.
@@ -162,15 +177,21 @@ impl Translucent {
         scattering: Scattering,
         estimator: Estimator,
     ) -> Result<(ProfileFamily, PreparedEstimator), (&'static str, ParamError)> {
-        let model = model
-            .or(self.profile)
-            .unwrap_or(ProfileModel::default_for(self.eta));
+        let model = self.profile_model(model);
         let family =
             ProfileFamily::new(model, scattering, self.g, self.eta).map_err(|e| ("profile", e))?;
         let prepared = estimator
             .prepare(self.g, self.eta)
             .map_err(|e| ("estimator", e))?;
         Ok((family, prepared))
+    }
+
+    /// The profile a BSSRDF renders this material with: `model` (the command line's), else the
+    /// material's own `profile`, else [`ProfileModel::default_for`] its η.
+    pub fn profile_model(&self, model: Option<ProfileModel>) -> ProfileModel {
+        model
+            .or(self.profile)
+            .unwrap_or(ProfileModel::default_for(self.eta))
     }
 
     /// A translucent material with no profile and unit scale 1 (validated when the scene is
@@ -189,8 +210,42 @@ impl Translucent {
             correction_seed: Self::DEFAULT_CORRECTION_SEED,
             angular_coupling: true,
             unit_scale: 1.0,
+            roughness: None,
             line: None,
         }
+    }
+
+    /// The same material with the boundary's roughness field `roughness` (see
+    /// [`Translucent::roughness`]).
+    pub fn with_roughness(mut self, roughness: Field) -> Self {
+        self.roughness = Some(roughness);
+        self
+    }
+}
+
+/// An opaque diffuse reflector: Lambertian, or Oren–Nayar where it is rough
+/// ([`crate::bsdf::diffuse`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diffuse {
+    /// Albedo ρ in [0, 1] per channel (a field: constant, pattern or image).
+    pub albedo: Field,
+    /// The Oren–Nayar roughness σ ∈ [0, 1] (a grey field), `None` for Lambertian.
+    pub roughness: Option<Field>,
+}
+
+impl Diffuse {
+    /// The albedo at `hit`.
+    #[inline]
+    pub fn albedo_at(&self, hit: &crate::geometry::Hit) -> Rgb {
+        self.albedo.eval(hit.p, hit.uv)
+    }
+
+    /// The roughness σ at `hit` (0 for a Lambertian surface).
+    #[inline]
+    pub fn roughness_at(&self, hit: &crate::geometry::Hit) -> f64 {
+        self.roughness
+            .as_ref()
+            .map_or(0.0, |r| r.eval(hit.p, hit.uv)[0])
     }
 }
 
@@ -202,11 +257,8 @@ impl Translucent {
 pub enum Material {
     /// A participating medium inside a (closed) mesh.
     Translucent(Translucent),
-    /// A Lambertian reflector.
-    Diffuse {
-        /// Albedo in [0, 1].
-        albedo: Rgb,
-    },
+    /// A diffuse reflector (Lambertian, or rough).
+    Diffuse(Diffuse),
     /// An emitter (the geometry of a quad light).
     Emissive {
         /// Emitted radiance (on the light's emitting side).
@@ -215,6 +267,27 @@ pub enum Material {
 }
 
 impl Material {
+    /// A Lambertian reflector of constant albedo (checked when the scene is built).
+    pub fn diffuse(albedo: Rgb) -> Material {
+        Material::Diffuse(Diffuse {
+            albedo: Field::Constant(albedo),
+            roughness: None,
+        })
+    }
+
+    /// True when a field of the material is read through texture coordinates (an image
+    /// with `mapping = "uv"`): its objects need a mesh with UVs.
+    pub fn reads_uv(&self) -> bool {
+        let uv = |f: &Field| !f.is_volumetric();
+        match self {
+            Material::Translucent(t) => {
+                !t.medium.is_volumetric() || t.roughness.as_ref().is_some_and(uv)
+            }
+            Material::Diffuse(d) => uv(&d.albedo) || d.roughness.as_ref().is_some_and(uv),
+            Material::Emissive { .. } => false,
+        }
+    }
+
     /// The translucent material, if this is one.
     pub fn translucent(&self) -> Option<&Translucent> {
         match self {
@@ -254,14 +327,31 @@ pub struct Scene {
     source_path: Option<PathBuf>,
     display_name: String,
     inputs: Vec<PathBuf>,
-    notes: Vec<String>,
+    notes: Vec<LoadNote>,
+}
+
+/// Something the loader read but could not honour (for example a part of a glTF material that
+/// is not read, `docs/gltf.md`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LoadNote {
+    /// The file it is about (a glTF model).
+    pub file: String,
+    /// What in that file (`material `jade``).
+    pub subject: String,
+    /// One sentence.
+    pub text: String,
+}
+
+impl std::fmt::Display for LoadNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}: {}", self.file, self.subject, self.text)
+    }
 }
 
 impl Scene {
-    /// What the loader read but could not honour, one sentence each (for example the parts of
-    /// a glTF material that are not read, `docs/gltf.md`). Renders list them among their
-    /// warnings.
-    pub fn load_notes(&self) -> &[String] {
+    /// What the loader read but could not honour, one sentence each. Renders list them among
+    /// their warnings, one warning per file.
+    pub fn load_notes(&self) -> &[LoadNote] {
         &self.notes
     }
 

@@ -85,9 +85,7 @@ fn zero_radius_is_a_diffuse_surface_of_the_colour() {
     ));
     assert_eq!(
         s.objects()[0].material,
-        Material::Diffuse {
-            albedo: Rgb::new(0.8, 0.5, 0.2)
-        }
+        Material::diffuse(Rgb::new(0.8, 0.5, 0.2))
     );
     // A radius scale of zero too.
     let s = load(&with_material(

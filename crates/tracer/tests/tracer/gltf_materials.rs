@@ -218,10 +218,10 @@ fn gltf_scene_takes_one_object_per_file_material() {
         panic!("jade is not translucent");
     };
     assert_eq!((t.eta, t.g), (1.3, 0.0));
-    let Material::Diffuse { albedo } = scene.objects()[1].material else {
+    let Material::Diffuse(d) = &scene.objects()[1].material else {
         panic!("the stand is not diffuse");
     };
-    assert_eq!(albedo, Rgb([0.5; 3]));
+    assert_eq!(d.albedo, tracer::field::Field::Constant(Rgb([0.5; 3])));
     // The same medium built by hand from the file's values (docs/gltf.md): colour = the base
     // colour image through UVs, mean free path = d / −ln(attenuationColor), the default
     // profile's inversion at η 1.3.

@@ -8,8 +8,16 @@
 //! * Radiance, irradiance and intensity are linear RGB; units are whatever the scene's
 //!   radiometric unit is (W for power, W/sr for intensity, W/m² for irradiance, W/(sr·m²) for
 //!   radiance, with m = the scene unit).
+//!
+//! Environment lights are constant or read from an image ([`environment`]), and are sampled in
+//! proportion to the image.
+
+pub mod environment;
+
+pub use environment::{EnvironmentError, EnvironmentMap};
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use bssrdf_core::Rgb;
 use glam::DVec3;
@@ -17,7 +25,7 @@ use glam::DVec3;
 use crate::geometry::Hit;
 
 /// A light source.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Light {
     /// Parallel light from infinitely far away.
     Directional(DirectionalLight),
@@ -25,7 +33,7 @@ pub enum Light {
     Point(PointLight),
     /// A one-sided emitting parallelogram; also an object of the scene's geometry.
     Quad(QuadLight),
-    /// Constant radiance from every direction at infinity.
+    /// Radiance from every direction at infinity: constant, or an image ([`EnvironmentMap`]).
     Environment(EnvironmentLight),
     /// A pencil beam (the paper's beam experiment): not sampled by [`Light::sample_li`] and
     /// invisible to camera rays.
@@ -83,11 +91,52 @@ impl QuadLight {
     }
 }
 
-/// Constant environment radiance.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Environment radiance: constant, or read from an image.
+#[derive(Debug, Clone, PartialEq)]
 pub struct EnvironmentLight {
-    /// Radiance arriving from every direction.
+    /// Radiance arriving from every direction, when there is no `map` (zero with one).
     pub radiance: Rgb,
+    /// The radiance by direction, from an image (replaces `radiance`).
+    pub map: Option<Arc<EnvironmentMap>>,
+}
+
+impl EnvironmentLight {
+    /// The radiance arriving along `−dir` (`dir` unit, the direction looked toward).
+    #[inline]
+    pub fn radiance_toward(&self, dir: DVec3) -> Rgb {
+        match &self.map {
+            None => self.radiance,
+            Some(m) => m.radiance(dir),
+        }
+    }
+
+    /// A direction toward the environment with the uniforms `u ∈ [0, 1)²`, its solid-angle
+    /// density and the radiance along it: uniform on the sphere for a constant environment
+    /// (pbrt-v4 §A.5.2), in proportion to the image for a map ([`EnvironmentMap::sample`]).
+    #[inline]
+    pub fn sample(&self, u: [f64; 2]) -> Option<(DVec3, f64, Rgb)> {
+        match &self.map {
+            None => Some((uniform_sphere(u), 1.0 / (4.0 * PI), self.radiance)),
+            Some(m) => m.sample(u),
+        }
+    }
+
+    /// The solid-angle density with which [`EnvironmentLight::sample`] produces `dir`.
+    #[inline]
+    pub fn pdf(&self, dir: DVec3) -> f64 {
+        match &self.map {
+            None => 1.0 / (4.0 * PI),
+            Some(m) => m.pdf(dir),
+        }
+    }
+
+    /// The radiance averaged over every direction.
+    pub fn mean_radiance(&self) -> Rgb {
+        match &self.map {
+            None => self.radiance,
+            Some(m) => m.mean_radiance(),
+        }
+    }
 }
 
 /// A pencil beam entering the scene at `origin` along `direction`.
@@ -218,7 +267,16 @@ impl Light {
     pub fn environment(radiance: Rgb) -> Result<Light, LightError> {
         Ok(Light::Environment(EnvironmentLight {
             radiance: check_rgb("radiance", radiance)?,
+            map: None,
         }))
+    }
+
+    /// An environment read from an image ([`EnvironmentMap`]).
+    pub fn environment_map(map: EnvironmentMap) -> Light {
+        Light::Environment(EnvironmentLight {
+            radiance: Rgb::ZERO,
+            map: Some(Arc::new(map)),
+        })
     }
 
     /// Pencil beam.
@@ -243,7 +301,8 @@ impl Light {
     /// * point: `li = intensity / dist²`;
     /// * quad: a uniform point on the quad, pdf converted to solid angle
     ///   (`dist² / (area · cos θ_light)`); `None` when `p` is behind the emitting side;
-    /// * environment: a uniform direction on the sphere, pdf `1/(4π)`;
+    /// * environment: a uniform direction on the sphere, pdf `1/(4π)`, or for an image a
+    ///   direction drawn in proportion to it ([`EnvironmentMap::sample`]);
     /// * beam: always `None`.
     #[inline]
     pub fn sample_li(&self, p: DVec3, u: [f64; 2]) -> Option<LightSample> {
@@ -302,14 +361,13 @@ impl Light {
                 })
             }
             Light::Environment(e) => {
-                let wi = uniform_sphere(u);
-                let pdf = 1.0 / (4.0 * PI);
+                let (wi, pdf, radiance) = e.sample(u)?;
                 Some(LightSample {
                     wi,
                     dist: f64::INFINITY,
                     point: None,
                     object: None,
-                    li: e.radiance / pdf,
+                    li: radiance / pdf,
                     pdf,
                     delta: false,
                 })
@@ -332,7 +390,7 @@ impl Light {
                 }
                 (point_on_light - p).length_squared() / (q.area * cos_l)
             }
-            Light::Environment(_) => 1.0 / (4.0 * PI),
+            Light::Environment(e) => e.pdf(wi),
             _ => 0.0,
         }
     }
@@ -340,9 +398,9 @@ impl Light {
     /// Radiance arriving along an escaped ray travelling in `dir` (environment lights; zero
     /// for the others).
     #[inline]
-    pub fn le(&self, _dir: DVec3) -> Rgb {
+    pub fn le(&self, dir: DVec3) -> Rgb {
         match self {
-            Light::Environment(e) => e.radiance,
+            Light::Environment(e) => e.radiance_toward(dir),
             _ => Rgb::ZERO,
         }
     }
@@ -366,7 +424,7 @@ impl Light {
             Light::Point(l) => 4.0 * PI * l.intensity.luminance(),
             Light::Quad(q) => PI * q.area * q.radiance.luminance(),
             Light::Environment(e) => {
-                4.0 * PI * PI * scene_radius * scene_radius * e.radiance.luminance()
+                4.0 * PI * PI * scene_radius * scene_radius * e.mean_radiance().luminance()
             }
             Light::Beam(b) => b.power.luminance(),
         }
