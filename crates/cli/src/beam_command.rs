@@ -156,8 +156,7 @@ impl SetupArgs {
 pub struct Args {
     #[command(flatten)]
     setup: SetupArgs,
-    /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
-    /// endpoints, segment, sone, kernel.
+    /// `pt` (light tracing, the reference) or a BSSRDF estimator (the other possible values).
     #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
     #[command(flatten)]

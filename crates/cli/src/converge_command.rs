@@ -60,8 +60,7 @@ pub struct Args {
     beam: bool,
     #[command(flatten)]
     setup: SetupArgs,
-    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone,
-    /// kernel.
+    /// Methods, comma-separated: `pt` and any of the BSSRDF estimators (the possible values).
     #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
     #[command(flatten)]

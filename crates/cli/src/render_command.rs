@@ -43,8 +43,7 @@ pub struct Args {
     /// `auto` (default): each translucent object with the scene's `render.estimator` (else
     /// `sone`) where a half-space profile fits, and the path tracer inside objects too small
     /// for one (the sidecar's `objects` says which). `pt`: the path-traced reference
-    /// everywhere. An estimator (jensen-in, jensen-out, endpoints, segment, sone, kernel): that
-    /// BSSRDF on every object.
+    /// everywhere. An estimator (the other possible values): that BSSRDF on every object.
     #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
     /// Shape correction of BSSRDF objects (docs/shapes.md): `auto` corrects the objects too

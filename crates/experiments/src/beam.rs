@@ -40,6 +40,8 @@ use tracer::rng::Rng;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 use tracer::volume::ChannelView;
 
+pub use crate::colour_range::ColourRange;
+
 /// Side of the box standing in for the half-space (scene units), and its depth. With
 /// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
 /// sides or bottom is below e⁻²⁴ of the beam.
@@ -537,52 +539,6 @@ pub fn write_variant_maps(example: &str, variants: impl IntoIterator<Item = Vari
         let path = std::path::Path::new(out).join(format!("{preset}-{}.exr", v.name));
         write_beam_map(&map, &setup, &path, v.sidecar).expect("write");
         println!("{} ({:.1} s)", path.display(), map.seconds);
-    }
-}
-
-/// The log colour range of a beam map's PNG, from `min` (bottom of the colour bar) to `max`
-/// (top). The maps of one figure share one, so that equal colours are equal exitances.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ColourRange {
-    /// Exitance at the bottom of the colour bar (> 0).
-    pub min: f64,
-    /// Exitance at the top.
-    pub max: f64,
-}
-
-impl ColourRange {
-    /// Decades shown below a map's largest value.
-    pub const DECADES: f64 = 6.0;
-
-    /// The range of `values`: their largest value and [`Self::DECADES`] below it (or their
-    /// smallest positive value, if higher).
-    pub fn of(values: &[f64]) -> ColourRange {
-        Self::spanning(values, Self::DECADES)
-    }
-
-    /// The range from the largest finite value of `values` down `decades` (or to their
-    /// smallest positive value, if higher); 1 and 0.1 when no value is positive.
-    pub fn spanning(values: &[f64], decades: f64) -> ColourRange {
-        let max = values
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, f64::max);
-        let max = if max > 0.0 { max } else { 1.0 };
-        let min_pos = values
-            .iter()
-            .copied()
-            .filter(|&v| v > 0.0 && v.is_finite())
-            .fold(f64::INFINITY, f64::min);
-        let min = min_pos.max(max * 10f64.powf(-decades));
-        ColourRange {
-            min: if min.is_finite() && min < max {
-                min
-            } else {
-                max / 10.0
-            },
-            max,
-        }
     }
 }
 

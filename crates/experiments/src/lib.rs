@@ -6,6 +6,7 @@
 /// re-exported so that callers build them with the same version.
 pub use serde_json;
 pub mod beam;
+pub mod colour_range;
 pub mod commentary;
 pub mod converge;
 pub mod error;

@@ -79,7 +79,7 @@ use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::preparation::PrepareObserver;
 use crate::integrator::walk::{reflect, refract};
-use crate::integrator::warnings::light_reach;
+use crate::optical_size::light_reach;
 use crate::rng::Rng;
 use crate::volume::{direction_about, orthonormal_basis};
 
