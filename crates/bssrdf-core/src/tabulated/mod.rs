@@ -20,6 +20,9 @@ pub mod angular_file;
 #[cfg_attr(not(feature = "tabulate"), allow(dead_code, unused_imports))]
 pub mod file;
 pub mod grid;
+pub mod oblique;
+#[cfg_attr(not(feature = "tabulate"), allow(dead_code, unused_imports))]
+pub mod oblique_file;
 pub mod profile;
 #[cfg(feature = "tabulate")]
 pub mod simulate;
@@ -31,5 +34,6 @@ pub mod slab;
 pub mod slab_file;
 
 pub use angular::AngularCoupling;
+pub use oblique::ObliqueShape;
 pub use profile::TabulatedTerm;
 pub use slab::{SlabFace, SlabTerm};
