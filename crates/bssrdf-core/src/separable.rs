@@ -290,7 +290,7 @@ impl SeparableBssrdf {
             }
         }
         let tt = t.factors(alpha, cos_i, cos_o);
-        let mm = m.factors(alpha, x, cos_i, cos_o);
+        let pf = m.pair(alpha, x, cos_i, cos_o);
         // Each side's harmonics sinⁿθ cos nφ, φ the angle between the chord (from that side)
         // and its light's direction of travel along the surface t (|t| = sin θ): with
         // u = x̂·t and q = |t|², u, 2u² − q and (4u² − 3q)u (Chebyshev). Each side is written
@@ -304,12 +304,11 @@ impl SeparableBssrdf {
             [u, 2.0 * u * u - q, (4.0 * u * u - 3.0 * q) * u]
         };
         let (h_i, h_o) = (harmonics(incident, chord), harmonics(exitant, -chord));
-        let ci = m.shifts(alpha, x, cos_i, cos_o);
-        let co = m.shifts(alpha, x, cos_o, cos_i);
         let dot = |c: &[f64; 3], h: &[f64; 3]| c[0] * h[0] + c[1] * h[1] + c[2] * h[2];
         Rgb(std::array::from_fn(|ch| {
-            let shift = dot(&ci[ch], &h_i) + dot(&co[ch], &h_o);
-            tt[ch] * mm[ch] * (1.0 + shift).max(0.0)
+            let p = &pf[ch];
+            let shift = dot(&p.incident, &h_i) + dot(&p.exitant, &h_o);
+            tt[ch] * p.m * (1.0 + shift).max(0.0)
         }))
     }
 

@@ -102,7 +102,7 @@ const PASSES: usize = 6;
 pub struct ObliqueShape {
     /// M's node values, `[row][j][k][node]` (symmetric in j, k).
     m: Vec<f32>,
-    /// The forward shift's coefficients C_n's node values, `[n − 1][row][j][k][node]`, j the
+    /// The forward shift's coefficients C_n's node values, `[row][j][k][node][n − 1]`, j the
     /// incident side (not symmetric).
     c: Vec<f32>,
 }
@@ -269,7 +269,7 @@ impl ObliqueShape {
                                 }
                             }
                             for h in 0..N_HARMONICS {
-                                shift[h * len + at + b] = value[h];
+                                shift[(at + b) * N_HARMONICS + h] = value[h];
                             }
                         }
                     }
@@ -283,24 +283,38 @@ impl ObliqueShape {
     /// (σt' r): see the module docs. Exactly symmetric in (`mu_i`, `mu_o`). Non-finite
     /// arguments give 1.
     pub fn factor(&self, alpha: f64, x: f64, mu_i: f64, mu_o: f64) -> f64 {
-        self.factors([alpha], [x], mu_i, mu_o)[0]
+        self.pair([alpha], [x], mu_i, mu_o)[0].m
     }
 
-    /// [`ObliqueShape::factor`] for several channels (albedo and optical radius each) at the
-    /// same pair of cosines: the cells are found once, and a channel equal to the previous
-    /// one reuses its value.
-    pub fn factors<const N: usize>(
+    /// The forward shift's coefficients C_n(x; α, μ_i → μ_o), n = 1, 2, 3 (unitless, finite,
+    /// |C_n| ≤ 8) of light entering at cosine `mu_i` and leaving at `mu_o`, `x` mean free
+    /// paths from its entry: the exit point's azimuthal density about the entry point is
+    /// ∝ 1 + Σ_n C_n · sinⁿ θ_i · cos nφ, φ measured from the incident light's direction of
+    /// travel along the surface (Fourier moments of the simulated exits, exit azimuth
+    /// averaged; docs/oblique-incidence.md). Not symmetric: the reciprocal term of the pair is
+    /// `shift(alpha, x, mu_o, mu_i)`. Non-finite arguments give 0.
+    pub fn shift(&self, alpha: f64, x: f64, mu_i: f64, mu_o: f64) -> [f64; N_HARMONICS] {
+        self.pair([alpha], [x], mu_i, mu_o)[0].incident
+    }
+
+    /// M and both sides' shift coefficients for several channels (albedo and optical radius
+    /// each) at the same pair of cosines: the cells are found once, each channel's row and
+    /// radial position once, and a channel equal to the previous one reuses its values.
+    /// `pair(…, mu_i, mu_o)` and `pair(…, mu_o, mu_i)` give the same M and swapped shift
+    /// coefficients, bit for bit.
+    pub fn pair<const N: usize>(
         &self,
         alpha: [f64; N],
         x: [f64; N],
         mu_i: f64,
         mu_o: f64,
-    ) -> [f64; N] {
-        let mut out = [1.0; N];
+    ) -> [PairFactors; N] {
+        let mut out = [PairFactors::NEUTRAL; N];
         if !(mu_i.is_finite() && mu_o.is_finite()) {
             return out;
         }
         let cells = Cells::new(mu_i, mu_o);
+        let (ci, co) = (cell(mu_i), cell(mu_o));
         for ch in 0..N {
             let same = ch > 0
                 && alpha[ch].to_bits() == alpha[ch - 1].to_bits()
@@ -308,31 +322,96 @@ impl ObliqueShape {
             out[ch] = if same {
                 out[ch - 1]
             } else if alpha[ch].is_finite() && !x[ch].is_nan() {
-                self.at(&cells, alpha[ch], x[ch])
+                let (r0, fr) = row_position(alpha[ch], N_ROWS);
+                let (i, w) = radial_position(x[ch].max(0.0).ln());
+                let rows: &[(usize, f64)] = if fr == 0.0 {
+                    &[(r0, 1.0)]
+                } else {
+                    &[(r0, 1.0 - fr), (r0 + 1, fr)]
+                };
+                let mut m = 0.0;
+                let mut incident = [0.0; N_HARMONICS];
+                let mut exitant = [0.0; N_HARMONICS];
+                for &(r, wr) in rows {
+                    let base = r * N_MU * N_MU;
+                    m += wr
+                        * cells.eval(|j, k| {
+                            let at = (base + j * N_MU + k) * N_RADII + i;
+                            (1.0 - w) * f64::from(self.m[at]) + w * f64::from(self.m[at + 1])
+                        });
+                    let a = self.shift_cells(base, ci, co, i, w);
+                    let b = self.shift_cells(base, co, ci, i, w);
+                    for h in 0..N_HARMONICS {
+                        incident[h] += wr * a[h];
+                        exitant[h] += wr * b[h];
+                    }
+                }
+                let clean = |c: [f64; N_HARMONICS]| {
+                    c.map(|v| {
+                        if v.is_finite() {
+                            v.clamp(-C_MAX, C_MAX)
+                        } else {
+                            0.0
+                        }
+                    })
+                };
+                PairFactors {
+                    m: if m.is_finite() { m.max(0.0) } else { 1.0 },
+                    incident: clean(incident),
+                    exitant: clean(exitant),
+                }
             } else {
-                1.0
+                PairFactors::NEUTRAL
             };
         }
         out
     }
 
-    fn at(&self, cells: &Cells, alpha: f64, x: f64) -> f64 {
-        let (r0, fr) = row_position(alpha, N_ROWS);
-        let (i, w) = radial_position(x.max(0.0).ln());
-        let row = |r: usize| {
-            let base = r * N_MU * N_MU;
-            cells.eval(|j, k| {
-                let at = (base + j * N_MU + k) * N_RADII + i;
-                (1.0 - w) * f64::from(self.m[at]) + w * f64::from(self.m[at + 1])
-            })
-        };
-        let v = if fr == 0.0 {
-            row(r0)
-        } else {
-            (1.0 - fr) * row(r0) + fr * row(r0 + 1)
-        };
-        if v.is_finite() { v.max(0.0) } else { 1.0 }
+    /// C_n of one row (`base` its first entry) for the incident side's cell `(j, fj)` and the
+    /// exit side's `(k, fk)`, at radial node `i` and weight `w`: bilinear in the cells.
+    #[inline]
+    fn shift_cells(
+        &self,
+        base: usize,
+        (j, fj): (usize, f64),
+        (k, fk): (usize, f64),
+        i: usize,
+        w: f64,
+    ) -> [f64; N_HARMONICS] {
+        let mut out = [0.0; N_HARMONICS];
+        for (a, wa) in [(j, 1.0 - fj), (j + 1, fj)] {
+            for (c, wc) in [(k, 1.0 - fk), (k + 1, fk)] {
+                let at = ((base + a * N_MU + c) * N_RADII + i) * N_HARMONICS;
+                let wac = wa * wc;
+                for h in 0..N_HARMONICS {
+                    let v = (1.0 - w) * f64::from(self.c[at + h])
+                        + w * f64::from(self.c[at + N_HARMONICS + h]);
+                    out[h] += wac * v;
+                }
+            }
+        }
+        out
     }
+}
+
+/// What [`ObliqueShape::pair`] reads for one channel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairFactors {
+    /// The radial part M (symmetric in the two cosines).
+    pub m: f64,
+    /// C_n of the light entering at the first cosine and leaving at the second.
+    pub incident: [f64; N_HARMONICS],
+    /// C_n of the reverse: entering at the second cosine, leaving at the first.
+    pub exitant: [f64; N_HARMONICS],
+}
+
+impl PairFactors {
+    /// M = 1 and no shift: what a channel without a valid albedo reads.
+    pub const NEUTRAL: PairFactors = PairFactors {
+        m: 1.0,
+        incident: [0.0; N_HARMONICS],
+        exitant: [0.0; N_HARMONICS],
+    };
 }
 
 /// ⟨sinⁿ θ⟩ over the cosine bin `j` (μ² = u uniform in [a, b] = [j/N, (j + 1)/N]):
@@ -350,69 +429,6 @@ fn cell(mu: f64) -> (usize, f64) {
     let x = mu.clamp(0.0, 1.0).powi(2) * N_MU as f64 - 0.5;
     let i = (x.max(0.0) as usize).min(N_MU - 2);
     (i, x - i as f64)
-}
-
-impl ObliqueShape {
-    /// The forward shift's coefficients C_n(x; α, μ_i → μ_o), n = 1, 2, 3 (unitless, finite,
-    /// |C_n| ≤ 8) of light entering at cosine `mu_i` and leaving at `mu_o`, `x` mean free
-    /// paths from its entry: the exit point's azimuthal density about the entry point is
-    /// ∝ 1 + Σ_n C_n · sinⁿ θ_i · cos nφ, φ measured from the incident light's direction of
-    /// travel along the surface (Fourier moments of the simulated exits, exit azimuth
-    /// averaged; docs/oblique-incidence.md). Not symmetric: the reciprocal term of the pair is
-    /// `shift(alpha, x, mu_o, mu_i)`. Non-finite arguments give 0.
-    pub fn shift(&self, alpha: f64, x: f64, mu_i: f64, mu_o: f64) -> [f64; N_HARMONICS] {
-        self.shifts([alpha], [x], mu_i, mu_o)[0]
-    }
-
-    /// [`ObliqueShape::shift`] for several channels at the same pair of cosines.
-    pub fn shifts<const N: usize>(
-        &self,
-        alpha: [f64; N],
-        x: [f64; N],
-        mu_i: f64,
-        mu_o: f64,
-    ) -> [[f64; N_HARMONICS]; N] {
-        let mut out = [[0.0; N_HARMONICS]; N];
-        if !(mu_i.is_finite() && mu_o.is_finite()) {
-            return out;
-        }
-        let ((j, fj), (k, fk)) = (cell(mu_i), cell(mu_o));
-        let len = N_ROWS * N_MU * N_MU * N_RADII;
-        for ch in 0..N {
-            let same = ch > 0
-                && alpha[ch].to_bits() == alpha[ch - 1].to_bits()
-                && x[ch].to_bits() == x[ch - 1].to_bits();
-            out[ch] = if same {
-                out[ch - 1]
-            } else if alpha[ch].is_finite() && !x[ch].is_nan() {
-                let (r0, fr) = row_position(alpha[ch], N_ROWS);
-                let (i, w) = radial_position(x[ch].max(0.0).ln());
-                std::array::from_fn(|h| {
-                    let row = |r: usize| {
-                        let m = |a: usize, c: usize| {
-                            let at = h * len + ((r * N_MU + a) * N_MU + c) * N_RADII + i;
-                            (1.0 - w) * f64::from(self.c[at]) + w * f64::from(self.c[at + 1])
-                        };
-                        (1.0 - fj) * ((1.0 - fk) * m(j, k) + fk * m(j, k + 1))
-                            + fj * ((1.0 - fk) * m(j + 1, k) + fk * m(j + 1, k + 1))
-                    };
-                    let v = if fr == 0.0 {
-                        row(r0)
-                    } else {
-                        (1.0 - fr) * row(r0) + fr * row(r0 + 1)
-                    };
-                    if v.is_finite() {
-                        v.clamp(-C_MAX, C_MAX)
-                    } else {
-                        0.0
-                    }
-                })
-            } else {
-                [0.0; N_HARMONICS]
-            };
-        }
-        out
-    }
 }
 
 #[cfg(test)]
