@@ -55,7 +55,7 @@ fn half_space_render_equals_the_public_s() {
         scattering: Scattering::All,
         max_depth: 8,
     };
-    let (mean, se, lost) = mean_and_se_rgb(&scene, method, options, 128, 12);
+    let (mean, se, lost) = mean_and_se_rgb(&scene, method, options, 512, 12);
     assert_eq!(lost, 0);
     let s = SeparableBssrdf::new(ProfileModel::Tabulated, Scattering::All, 0.0, eta).unwrap();
     assert!(s.has_angular_coupling());

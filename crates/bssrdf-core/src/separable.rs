@@ -256,17 +256,19 @@ impl SeparableBssrdf {
     /// The coupling of the pair `incident` → `exitant` at the coefficients `c`: T(α',
     /// cos_i, cos_o) ([`Self::coupling`]) times, with the oblique shape
     /// ([`Self::with_oblique_shape`], [`crate::tabulated::oblique`]), its radial part
-    /// M(σt' r; α', cos_i, cos_o) and the forward shift
+    /// M(σt' r; α', cos_i, cos_o) and the forward shift, a product of one factor per side,
     ///
-    /// max(0, 1 + Σ_n C_n(σt' r; α', μ_i → μ_o) sinⁿθ_i cos nφ_i
-    ///           + Σ_n C_n(σt' r; α', μ_o → μ_i) sinⁿθ_o cos nφ_o),   n = 1, 2, 3,
+    /// max(0, 1 + Σ_n C_n(σt' r; α', μ_i → μ_o) sinⁿθ_i cos nφ_i) / N_i
+    ///   · max(0, 1 + Σ_n C_n(σt' r; α', μ_o → μ_i) sinⁿθ_o cos nφ_o) / N_o,   n = 1, 2, 3,
     ///
+    /// (N the azimuthal mean of each clamped series, 1 where it cannot go negative),
     /// r = |x_o − x_i|, φ_i the angle between x_o − x_i and t_i = −(ω_i − (ω_i·n_i) n_i), the
     /// incident light's direction of travel along the surface (|t_i| = sin θ_i), and φ_o the
     /// angle between x_i − x_o and t_o, the same for light arriving along −ω_o at x_o (α' and
     /// σt' the reduced albedo and extinction per channel, at which the tabulated profile reads
     /// its shape; C_n from [`ObliqueShape::shift`]). 1 without a coupling. Symmetric under
-    /// `incident` ↔ `exitant` bit for bit (the two sides' terms swap, and their sum commutes).
+    /// `incident` ↔ `exitant` bit for bit (the two sides' factors swap, and their product
+    /// commutes).
     pub fn coupling_between(
         &self,
         c: &Coefficients,
@@ -304,11 +306,15 @@ impl SeparableBssrdf {
             [u, 2.0 * u * u - q, (4.0 * u * u - 3.0 * q) * u]
         };
         let (h_i, h_o) = (harmonics(incident, chord), harmonics(exitant, -chord));
-        let dot = |c: &[f64; 3], h: &[f64; 3]| c[0] * h[0] + c[1] * h[1] + c[2] * h[2];
+        let (q_i, q_o) = (
+            (incident.normal * cos_i - incident.direction).length_squared(),
+            (exitant.normal * cos_o - exitant.direction).length_squared(),
+        );
         Rgb(std::array::from_fn(|ch| {
             let p = &pf[ch];
-            let shift = dot(&p.incident, &h_i) + dot(&p.exitant, &h_o);
-            tt[ch] * p.m * (1.0 + shift).max(0.0)
+            // The product of the two sides' factors, formed before it meets T and M.
+            let sides = side_factor(&p.incident, &h_i, q_i) * side_factor(&p.exitant, &h_o, q_o);
+            tt[ch] * p.m * sides
         }))
     }
 
@@ -346,6 +352,42 @@ impl SeparableBssrdf {
             cos_i,
             cos_o,
         ))
+    }
+}
+
+/// One side's forward-shift factor max(0, 1 + Σ_n C_n sinⁿθ cos nφ) / N, with `c` the
+/// coefficients C_n, `h` the harmonics sinⁿθ cos nφ and `q` = sin²θ; N, the azimuthal mean of
+/// the clamped series, keeps the factor's mean over φ at 1 (so the totals stay T's) where the
+/// truncated series would go negative (grazing light near its entry point, single scattering
+/// most: without N a uniform sky put 3.9 % too much single and multiple scattering into a
+/// half-space at η 1, ϖ 0.97). N is 1 wherever the series cannot go negative.
+#[inline]
+fn side_factor(c: &[f64; 3], h: &[f64; 3], q: f64) -> f64 {
+    let value = 1.0 + c[0] * h[0] + c[1] * h[1] + c[2] * h[2];
+    // The amplitudes C_n sinⁿθ of cos nφ.
+    let s = q.max(0.0).sqrt();
+    let amp = [c[0] * s, c[1] * q, c[2] * q * s];
+    if amp.iter().map(|a| a.abs()).sum::<f64>() <= 1.0 {
+        return value.max(0.0);
+    }
+    // The mean of the clamped series over φ: midpoints, exact for the unclamped series.
+    const K: usize = 48;
+    static COS: std::sync::OnceLock<[[f64; 3]; K]> = std::sync::OnceLock::new();
+    let cos = COS.get_or_init(|| {
+        std::array::from_fn(|k| {
+            let phi = std::f64::consts::TAU * (k as f64 + 0.5) / K as f64;
+            [phi.cos(), (2.0 * phi).cos(), (3.0 * phi).cos()]
+        })
+    });
+    let mean = cos
+        .iter()
+        .map(|c| (1.0 + amp[0] * c[0] + amp[1] * c[1] + amp[2] * c[2]).max(0.0))
+        .sum::<f64>()
+        / K as f64;
+    if mean > 0.0 && mean.is_finite() {
+        value.max(0.0) / mean
+    } else {
+        1.0
     }
 }
 
