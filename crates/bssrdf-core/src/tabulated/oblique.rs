@@ -383,10 +383,10 @@ impl ObliqueShape {
             for (c, wc) in [(k, 1.0 - fk), (k + 1, fk)] {
                 let at = ((base + a * N_MU + c) * N_RADII + i) * N_HARMONICS;
                 let wac = wa * wc;
-                for h in 0..N_HARMONICS {
+                for (h, o) in out.iter_mut().enumerate() {
                     let v = (1.0 - w) * f64::from(self.c[at + h])
                         + w * f64::from(self.c[at + N_HARMONICS + h]);
-                    out[h] += wac * v;
+                    *o += wac * v;
                 }
             }
         }
