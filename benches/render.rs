@@ -3,7 +3,8 @@
 //! Figure 5 situation) at 32 × 32, one sample per pixel per iteration, single-threaded so that
 //! ratios are stable on a shared machine.
 //!
-//! Run: `cargo bench --bench render`. Ids are `render/<method>`; criterion reports the time
+//! Run: `cargo bench --bench render`. Ids are `render/<method>` (`<estimator>-tabulated`: the
+//! same scene with the tabulated profile instead of the scene's dipole); criterion reports the time
 //! per 1024 camera samples and the throughput in samples/s. Compare methods as ratios.
 //!
 //! `render/sone eta=1.3` and `render/sone eta=1.3 roughness=0.3` render the same slab with a
@@ -13,7 +14,7 @@
 use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use het_bssrdf::bssrdf_core::Scattering;
+use het_bssrdf::bssrdf_core::{ProfileModel, Scattering};
 use het_bssrdf::experiments::scenes::CHECKER_SLAB;
 use het_bssrdf::tracer::integrator::{Method, PathIntegrator, PathOptions};
 use het_bssrdf::tracer::render::{RenderOptions, render};
@@ -74,6 +75,28 @@ fn renders(c: &mut Criterion) {
         .expect("renderable");
         let mut seed = 0;
         group.bench_function(name, |b| {
+            b.iter(|| {
+                seed += 1;
+                pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))
+            })
+        });
+    }
+    // The same scene with the tabulated profile (and so its angular coupling and oblique
+    // shape, docs/oblique-incidence.md): the cost of the tabulated S per BSSRDF sample.
+    for name in ["sone", "endpoints"] {
+        let estimator = name.parse().expect("built-in estimator");
+        let method = Method::bssrdf(estimator, Some(ProfileModel::Tabulated));
+        let integrator = PathIntegrator::new(
+            &scene,
+            method,
+            PathOptions {
+                scattering: Scattering::Multiple,
+                max_depth: 8,
+            },
+        )
+        .expect("renderable");
+        let mut seed = 0;
+        group.bench_function(format!("{name}-tabulated"), |b| {
             b.iter(|| {
                 seed += 1;
                 pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))

@@ -648,7 +648,7 @@ fn bssrdf_renders_of_a_forward_scattering_block_match_the_path_tracer() {
         .build()
         .unwrap();
     let camera = camera_traced(&scene, sone(), 16);
-    let light = light_traced(&scene, sone(), Roles::Physical, 120_000);
+    let light = light_traced(&scene, sone(), Roles::Physical, 200_000);
     assert_agree("forward-scattering block", &light, &camera);
     let pt = PathIntegrator::new(&scene, Method::PathTraced, OPTIONS).unwrap();
     let images: Vec<Vec<Rgb>> = (0..SEEDS)

@@ -7,6 +7,7 @@ mod fuzz_regressions;
 mod image_prefilter;
 mod index_matched;
 mod integrators;
+mod oblique;
 mod precision;
 mod readme;
 mod reciprocity;

@@ -211,6 +211,13 @@ impl ProfileFamily {
         Ok(self.reduced(sigma_a, sigma_s).albedo)
     }
 
+    /// The reduced extinction and albedo (similarity theory with this family's g) of validated
+    /// `sigma_a`, `sigma_s`: what the tabulated profile's shape is read at.
+    pub(crate) fn reduced_of(&self, sigma_a: f64, sigma_s: f64) -> Result<Reduced, ParamError> {
+        let (sigma_a, sigma_s) = validate_sigmas(sigma_a, sigma_s)?;
+        Ok(self.reduced(sigma_a, sigma_s))
+    }
+
     /// The exact single scattering of the real medium (HG g, unreduced σs and σt) when the
     /// family counts it and the medium scatters.
     fn single(&self, sigma_a: f64, sigma_s: f64) -> Option<SingleScattering> {

@@ -4,7 +4,8 @@
 //! `crates/bssrdf-core/data/halfspace-profile-v1.bin`, made with the defaults below; `--slab`
 //! writes the slab table instead (`crates/bssrdf-core/data/slab-profile-v1.bin`, made with
 //! `--slab --photons 4000000`); `--angular` writes the angular coupling
-//! (`crates/bssrdf-core/data/angular-coupling-v1.bin`).
+//! (`crates/bssrdf-core/data/angular-coupling-v1.bin`); `--oblique` the coupling's radial part
+//! (`crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 98304`).
 
 use std::path::PathBuf;
 
@@ -12,6 +13,7 @@ use anyhow::Context;
 use bssrdf_core::tabulated::angular_file::{ANGULAR_ETAS, tabulate_angular};
 use bssrdf_core::tabulated::file::tabulate;
 use bssrdf_core::tabulated::grid::ETAS;
+use bssrdf_core::tabulated::oblique_file::tabulate_oblique;
 use bssrdf_core::tabulated::slab::{SLAB_ETAS, SLAB_THICKNESSES};
 use bssrdf_core::tabulated::slab_file::tabulate_slab;
 
@@ -31,13 +33,19 @@ pub struct Args {
     seed: u64,
     /// Simulate the slab table (`bssrdf_core::tabulated::slab`, built in as
     /// `crates/bssrdf-core/data/slab-profile-v1.bin`) instead of the half-space one.
-    #[arg(long, conflicts_with = "angular")]
+    #[arg(long, conflicts_with_all = ["angular", "oblique"])]
     slab: bool,
     /// Simulate the angular coupling (`bssrdf_core::tabulated::angular`, built in as
     /// `crates/bssrdf-core/data/angular-coupling-v1.bin`, made with `--angular --photons
     /// 65536`; photons per incidence bin and plane) instead of the half-space table.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "oblique")]
     angular: bool,
+    /// Simulate the angular coupling's radial part, the oblique shape
+    /// (`bssrdf_core::tabulated::oblique`, built in as
+    /// `crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 98304`;
+    /// photons per incidence bin and plane) instead of the half-space table.
+    #[arg(long)]
+    oblique: bool,
     /// Worker threads (default: every core); the file does not depend on it.
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     threads: Option<u64>,
@@ -61,6 +69,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.angular {
         return simulate_and_write(&args, ANGULAR_ETAS.len(), "angular planes", |progress| {
             let data = tabulate_angular(args.seed, args.photons, threads, progress);
+            let capped = data.planes.iter().map(|p| p.capped).sum();
+            (data.to_bytes(), capped)
+        });
+    }
+    if args.oblique {
+        return simulate_and_write(&args, ANGULAR_ETAS.len(), "oblique planes", |progress| {
+            let data = tabulate_oblique(args.seed, args.photons, threads, progress);
             let capped = data.planes.iter().map(|p| p.capped).sum();
             (data.to_bytes(), capped)
         });

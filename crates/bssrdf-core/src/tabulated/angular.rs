@@ -198,7 +198,7 @@ impl AngularCoupling {
 /// them is symmetric bit for bit): the lower cell index and the weight of the next, per
 /// cosine, the weight in [−½, 3/2] over the outer half bins (linear extrapolation).
 #[derive(Clone, Copy)]
-struct Cells {
+pub(super) struct Cells {
     j: usize,
     fj: f64,
     k: usize,
@@ -206,7 +206,7 @@ struct Cells {
 }
 
 impl Cells {
-    fn new(mu_a: f64, mu_b: f64) -> Self {
+    pub(super) fn new(mu_a: f64, mu_b: f64) -> Self {
         let (a, b) = if mu_a <= mu_b {
             (mu_a, mu_b)
         } else {
@@ -223,7 +223,7 @@ impl Cells {
 
     /// The matrix `m(j, k)` (values at the bins' centres) interpolated at the two cosines.
     #[inline]
-    fn eval(&self, m: impl Fn(usize, usize) -> f64) -> f64 {
+    pub(super) fn eval(&self, m: impl Fn(usize, usize) -> f64) -> f64 {
         let Self { j, fj, k, fk } = *self;
         (1.0 - fj) * ((1.0 - fk) * m(j, k) + fk * m(j, k + 1))
             + fj * ((1.0 - fk) * m(j + 1, k) + fk * m(j + 1, k + 1))

@@ -21,6 +21,9 @@ pub mod angular_file;
 pub mod file;
 pub mod grid;
 pub mod half_space;
+pub mod oblique;
+#[cfg_attr(not(feature = "tabulate"), allow(dead_code, unused_imports))]
+pub mod oblique_file;
 #[cfg(feature = "tabulate")]
 pub mod simulate;
 #[cfg(not(feature = "tabulate"))]
@@ -32,4 +35,5 @@ pub mod slab_file;
 
 pub use angular::AngularCoupling;
 pub use half_space::TabulatedTerm;
+pub use oblique::ObliqueShape;
 pub use slab::{SlabFace, SlabTerm};

@@ -158,6 +158,27 @@ pub(crate) fn trace_from(
     rng: &mut Stream,
     mut exit: impl FnMut(u32, f64, Face, f64),
 ) -> bool {
+    trace_at(
+        dir,
+        eta,
+        thickness,
+        MAX_EVENTS,
+        rng,
+        |n, [x, y], face, cos| exit(n, (x * x + y * y).sqrt(), face, cos),
+    )
+}
+
+/// [`trace_from`] with the exit point's position `[x, y]` on the face instead of its radius
+/// (the same random numbers) and at most `max_events` scattering events (a path with more is
+/// dropped: false).
+pub(crate) fn trace_at(
+    dir: [f64; 3],
+    eta: f64,
+    thickness: f64,
+    max_events: u32,
+    rng: &mut Stream,
+    mut exit: impl FnMut(u32, [f64; 2], Face, f64),
+) -> bool {
     let (mut px, mut py, mut pz) = (0.0f64, 0.0f64, 0.0f64);
     let [mut dx, mut dy, mut dz] = dir;
     let mut n = 0u32;
@@ -181,14 +202,14 @@ pub(crate) fn trace_from(
                 dz = -dz; // internal reflection; the free path restarts (memoryless)
                 continue;
             }
-            exit(n, (px * px + py * py).sqrt(), face, dz.abs());
+            exit(n, [px, py], face, dz.abs());
             return true;
         }
         px += t * dx;
         py += t * dy;
         pz = z_new;
         n += 1;
-        if n > MAX_EVENTS {
+        if n > max_events {
             return false;
         }
         let z = 1.0 - 2.0 * rng.uniform();

@@ -32,8 +32,10 @@
 //! coupling"): with the tabulated profile (unless the material sets `angular_coupling =
 //! false`), S is also multiplied by T(α', cos θ_i, cos θ_o), the exact half-space response per
 //! pair of directions over the separable one, per channel at the pair's reduced albedo. T is
-//! symmetric in its two cosines bit for bit, so reciprocity holds as above. Pairs weighed by
-//! the slab profile's transmission keep T = 1.
+//! symmetric in its two cosines bit for bit, so reciprocity holds as above. T carries its
+//! radial part M(σt' r; α', cos θ_i, cos θ_o) (the oblique shape,
+//! docs/oblique-incidence.md), symmetric in the cosines as T is. Pairs weighed by the slab
+//! profile's transmission keep T = 1.
 //!
 //! Thin parts ([`BssrdfObject::profile`], docs/shapes.md "Thin parts: the slab profile"):
 //! with the tabulated profile, |g| ≤ [`SLAB_MAX_G`] and a material that is `thickness_aware`
@@ -49,7 +51,9 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use bssrdf_core::{ProfileFamily, ProfileModel, Rgb, Scattering, SeparableBssrdf, SlabFace};
+use bssrdf_core::{
+    Crossing, ProfileFamily, ProfileModel, Rgb, Scattering, SeparableBssrdf, SlabFace,
+};
 use glam::DVec3;
 use het_estimate::{Estimator, PreparedEstimator};
 
@@ -114,6 +118,9 @@ pub(crate) struct PairWeight {
     pub rd: Rgb,
     /// The homogeneous coefficients the estimator gave for the pair.
     coeffs: het_estimate::Coefficients,
+    /// The incident and exitant points: where the coupling's radial part and forward shift
+    /// are read.
+    points: (DVec3, DVec3),
     /// Whether R is a reflection profile (the half-space's, or a slab's reflection), to which
     /// the half-space's angular coupling applies; not for slab transmission.
     reflection: bool,
@@ -269,21 +276,26 @@ impl BssrdfObject {
         PairWeight {
             rd,
             coeffs: est.coefficients,
+            points: (x_i.p, x_o.p),
             reflection,
         }
     }
 
-    /// The angular coupling T(α', μ_i, μ_o) per channel for a pair weighed as `w`, light
-    /// entering at cosine `cos_i` and leaving at `cos_o` about the normals S uses (α' the
-    /// reduced albedo of the pair's coefficients, as the tabulated profile reads its rows;
-    /// [`bssrdf_core::tabulated::angular`]); 1 without a coupling or for slab transmission.
+    /// The angular coupling per channel for a pair weighed as `w`, light arriving from the unit
+    /// direction `w_i` about the normal `n_i` at x_i and leaving toward `w_o` about `n_o` at
+    /// x_o (the normals S uses, [`facing_normal`]): T(α', μ_i, μ_o) times the oblique shape's
+    /// radial part and forward shift (`SeparableBssrdf::coupling_between`;
+    /// [`bssrdf_core::tabulated::angular`], [`bssrdf_core::tabulated::oblique`]); 1 without a
+    /// coupling or for slab transmission.
     /// Symmetric in the two cosines, bit for bit.
     #[inline]
-    pub fn coupling(&self, w: &PairWeight, cos_i: f64, cos_o: f64) -> Rgb {
+    pub fn coupling(&self, w: &PairWeight, w_i: DVec3, n_i: DVec3, w_o: DVec3, n_o: DVec3) -> Rgb {
         if !w.reflection {
             return Rgb::splat(1.0);
         }
-        self.bssrdf.coupling(&w.coeffs, cos_i, cos_o)
+        let incident = Crossing::new(w.points.0, n_i, w_i);
+        let exitant = Crossing::new(w.points.1, n_o, w_o);
+        self.bssrdf.coupling_between(&w.coeffs, &incident, &exitant)
     }
 
     /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium
@@ -341,7 +353,7 @@ impl BssrdfObject {
         let (cos_i, cos_o) = (w_i.dot(n_i), w_o.dot(n_o));
         let (alpha_i, alpha_o) = (self.alpha_at(x_i), self.alpha_at(x_o));
         let w = self.profile(surface, medium, x_i, x_o, rng, counters);
-        let t = self.coupling(&w, cos_i, cos_o);
+        let t = self.coupling(&w, w_i, n_i, w_o, n_o);
         let s = if self.rough.is_some() && (alpha_i > 0.0 || alpha_o > 0.0) {
             let fresnel = self.transmission(cos_i, alpha_i) * self.transmission(cos_o, alpha_o);
             w.rd * (fresnel / (self.pair_norm(alpha_i, alpha_o) * PI)) * t

@@ -480,10 +480,12 @@ struct Deferred {
     x_i: Hit,
     x_o: Hit,
     scale: f64,
-    /// Cosines of the continuation's direction at x_i and of the exit direction at x_o, for
-    /// the angular coupling ([`BssrdfObject::coupling`]).
-    cos_i: f64,
-    cos_o: f64,
+    /// The continuation's direction at x_i (about x_i's shading normal) and the exit
+    /// direction at x_o about the normal `n_o`, for the angular coupling
+    /// ([`BssrdfObject::coupling`]).
+    w_i: DVec3,
+    w_o: DVec3,
+    n_o: DVec3,
 }
 
 impl PathState {
@@ -1459,7 +1461,6 @@ impl<'s> PathIntegrator<'s> {
             None => {}
         }
         let alpha_o = alpha_o.unwrap_or(0.0);
-        let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
         if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
             st.beta *= f_o; // the shape correction's exit factor
         }
@@ -1500,15 +1501,16 @@ impl<'s> PathIntegrator<'s> {
                 rng,
                 counters,
             );
-            // The shape correction's entry factor for the light's direction, and the cosine
-            // the angular coupling reads.
-            let (ld, cos_light) = match facing_normal(&x_i, ld.wi) {
+            // The shape correction's entry factor for the light's direction, and the direction
+            // and normal the angular coupling reads.
+            let w_light = ld.wi;
+            let (ld, n_light) = match facing_normal(&x_i, ld.wi) {
                 Some(n) if !ld.l.is_zero() => (
                     b.correction_along(&x_i, ld.wi, n)
                         .map_or(ld.l, |f_i| ld.l * f_i),
-                    ld.wi.dot(n),
+                    n,
                 ),
-                _ => (ld.l, 0.0),
+                _ => (ld.l, x_i.ns),
             };
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather, nothing to carry
@@ -1525,7 +1527,7 @@ impl<'s> PathIntegrator<'s> {
             let w = pw.rd * weight;
             self.settle(st, rng, counters);
             if !ld.is_zero() {
-                st.l += st.beta * w * ld * b.coupling(&pw, cos_light, cos_o);
+                st.l += st.beta * w * ld * b.coupling(&pw, w_light, n_light, -ray.dir, n_o);
             }
             if k == carrier {
                 next = Some((x_i, Ok((w * set.len() as f64, pw))));
@@ -1563,15 +1565,16 @@ impl<'s> PathIntegrator<'s> {
         }
         // The angular coupling for the continuation: now, or when the owed weight is settled.
         match carried {
-            Ok(pw) => st.beta *= b.coupling(&pw, cos, cos_o),
+            Ok(pw) => st.beta *= b.coupling(&pw, wi, x_i.ns, -ray.dir, n_o),
             Err(scale) => {
                 st.deferred = Some(Deferred {
                     object,
                     x_i,
                     x_o: *hit,
                     scale,
-                    cos_i: cos,
-                    cos_o,
+                    w_i: wi,
+                    w_o: -ray.dir,
+                    n_o,
                 })
             }
         }
@@ -1595,7 +1598,7 @@ impl<'s> PathIntegrator<'s> {
             object: d.object,
         };
         let pw = b.profile(&surface, &material.medium, &d.x_i, &d.x_o, rng, counters);
-        st.beta *= pw.rd * d.scale * b.coupling(&pw, d.cos_i, d.cos_o);
+        st.beta *= pw.rd * d.scale * b.coupling(&pw, d.w_i, d.x_i.ns, d.w_o, d.n_o);
     }
 
     /// The translucent material and BSSRDF data of `object`, when it is rendered with a
