@@ -30,6 +30,7 @@ DEPENDENCIES = {
     "bssrdf-core": ("crates/bssrdf-core", None),
     "het-estimate": ("crates/het-estimate", None),
     "tracer": ("crates/tracer", "het-bssrdf-tracer"),
+    "pipeline": ("crates/pipeline", "het-bssrdf-pipeline"),
     "experiments": ("crates/experiments", "het-bssrdf-experiments"),
     "het-bssrdf": (".", None),
 }

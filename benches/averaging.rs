@@ -52,6 +52,7 @@ use std::time::Duration;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DVec3;
 use het_bssrdf::bssrdf_core::Rgb;
+use het_bssrdf::het_estimate::FieldCapabilities;
 use het_bssrdf::het_estimate::analytic::{
     CheckField, ConstantField, Plane, PlanePoint, StripeField,
 };
@@ -283,8 +284,8 @@ impl CoefficientField<PlanePoint> for PlaneMedium {
     fn ellipse_average(&self, e: &PlanarEllipse) -> Option<Coefficients> {
         CoefficientField::<Hit>::ellipse_average(&self.0, e)
     }
-    fn has_ellipse_average(&self) -> bool {
-        CoefficientField::<Hit>::has_ellipse_average(&self.0)
+    fn capabilities(&self) -> FieldCapabilities {
+        CoefficientField::<Hit>::capabilities(&self.0)
     }
 }
 
@@ -464,8 +465,8 @@ impl CoefficientField<Hit> for PointsOnly<'_> {
     fn averaged_at_point(&self, x: DVec3) -> Option<Coefficients> {
         CoefficientField::<Hit>::averaged_at_point(self.0, x)
     }
-    fn has_point_lookup(&self) -> bool {
-        CoefficientField::<Hit>::has_point_lookup(self.0)
+    fn capabilities(&self) -> FieldCapabilities {
+        CoefficientField::<Hit>::capabilities(self.0)
     }
 }
 

@@ -17,9 +17,9 @@
 //! * the image mean per channel ± its standard error over the runs, to check that a change of
 //!   the estimator leaves the image unchanged within noise.
 
-use experiments::run::{RenderJob, render_scene};
 use experiments::time_to_error::{ErrorSpread, cpu_seconds};
 use het_bssrdf::tracer;
+use pipeline::job::{RenderJob, render_scene};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::{Material, Scene};

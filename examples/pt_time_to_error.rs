@@ -16,10 +16,10 @@
 //! The median is corrected for its bias with few runs (`experiments::time_to_error`).
 
 use bssrdf_core::Scattering;
-use experiments::run::{RenderJob, render_scene};
 use experiments::scenes::CHECKER_SLAB;
 use experiments::time_to_error::{ErrorSpread, cpu_seconds};
 use het_bssrdf::{bssrdf_core, tracer};
+use pipeline::job::{RenderJob, render_scene};
 use tracer::integrator::Method;
 use tracer::render::Budget;
 use tracer::scene::Scene;

@@ -29,4 +29,5 @@ pub mod reciprocity {}
 #[doc = include_str!("../docs/artist-parameters.md")]
 pub mod artist_parameters {}
 pub use het_estimate;
+pub use pipeline;
 pub use tracer;

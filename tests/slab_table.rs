@@ -6,7 +6,7 @@
 
 use bssrdf_core::fresnel::dielectric;
 use bssrdf_core::tabulated::grid::{N_ALBEDO, N_BINS, albedo_of_row, centre};
-use bssrdf_core::tabulated::profile::table;
+use bssrdf_core::tabulated::half_space::table;
 use bssrdf_core::tabulated::slab::{
     SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, SlabFace, SlabTerm, slab_albedo_of_row, slab_table,
 };

@@ -5,7 +5,7 @@
 
 use bssrdf_core::tabulated::file::TableData;
 use bssrdf_core::tabulated::grid::{ETAS, N_ALBEDO, S_MIN, albedo_of_row};
-use bssrdf_core::tabulated::profile::table;
+use bssrdf_core::tabulated::half_space::table;
 use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
 
 use crate::common::chandrasekhar::{half_space_albedo, single_scattering_albedo};

@@ -442,7 +442,7 @@ fn profiles(r: &mut Report, g: f64, eta: f64, extent: Extent) {
                 // The table covers η ≤ 1.6; beyond, a typed error is the documented answer.
                 Err(_)
                     if model == ProfileModel::Tabulated
-                        && eta > bssrdf_core::tabulated::profile::ETA_MAX =>
+                        && eta > bssrdf_core::tabulated::half_space::ETA_MAX =>
                 {
                     continue;
                 }

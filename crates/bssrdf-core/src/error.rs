@@ -34,7 +34,38 @@ pub enum ParamError {
     /// A name that matches no choice of a closed set (a profile model, an estimator, …), so
     /// that parsing composes with `?` alongside the other parameter checks.
     #[error(transparent)]
-    UnknownName(#[from] crate::model::UnknownName),
+    UnknownName(#[from] UnknownName),
+}
+
+/// A name that matches no variant of a closed set.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {what} `{given}` (expected one of: {expected})")]
+pub struct UnknownName {
+    /// What was being parsed ("profile model", …).
+    pub what: &'static str,
+    /// The string given.
+    pub given: String,
+    /// The accepted names, comma-separated.
+    pub expected: String,
+}
+
+impl UnknownName {
+    /// The element of `all` whose `name` is `given`, or an error listing the accepted names.
+    pub fn find<T: Copy>(
+        given: &str,
+        what: &'static str,
+        all: &[T],
+        name: impl Fn(T) -> &'static str,
+    ) -> Result<T, UnknownName> {
+        all.iter()
+            .copied()
+            .find(|&m| name(m) == given)
+            .ok_or_else(|| UnknownName {
+                what,
+                given: given.to_string(),
+                expected: all.iter().map(|&m| name(m)).collect::<Vec<_>>().join(", "),
+            })
+    }
 }
 
 /// A number as error messages print it: as written when that is short (`0.5`, `-1`, `1.6`),
@@ -64,6 +95,10 @@ pub fn check_non_negative(name: &'static str, value: f64) -> Result<f64, ParamEr
     }
     Ok(value)
 }
+
+/// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
+/// |g| = 1 and `σs' = (1 − g)σs` degenerates; docs/physics.md#hazards).
+pub const G_MAX: f64 = 1.0 - 1e-6;
 
 /// Checks a Henyey–Greenstein mean cosine: finite with `|g| < 1` (the phase function is 0/0 at
 /// `|g| = 1`).

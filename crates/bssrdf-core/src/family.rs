@@ -19,10 +19,7 @@ use crate::profile::{RadialProfile, TWO_PI, clean_f, clean_u, numeric_radius_for
 use crate::single_scattering::SingleScattering;
 use crate::tabulated::TabulatedTerm;
 
-pub use crate::error::{ETA_RANGE, SIGMA_EPSILON, SIGMA_MAX, validate_sigmas};
-/// Largest |g| used: accepted `g ∈ (−1, 1)` is clamped to `[−G_MAX, G_MAX]` (HG is 0/0 at
-/// |g| = 1 and `σs' = (1 − g)σs` degenerates; docs/physics.md#hazards).
-pub const G_MAX: f64 = 1.0 - 1e-6;
+pub use crate::error::{ETA_RANGE, G_MAX, SIGMA_EPSILON, SIGMA_MAX, validate_sigmas};
 
 /// Options of a family beyond the model, `g` and `η`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -93,7 +90,7 @@ impl ProfileFamily {
     ) -> Result<Self, ParamError> {
         check_g(g)?;
         check_eta(eta)?;
-        if model == ProfileModel::Tabulated && eta > crate::tabulated::profile::ETA_MAX {
+        if model == ProfileModel::Tabulated && eta > crate::tabulated::half_space::ETA_MAX {
             return Err(ParamError::OutOfRange {
                 name: "eta",
                 range: "[1, 1.6] (the tabulated profile's table)",

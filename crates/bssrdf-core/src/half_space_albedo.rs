@@ -42,7 +42,7 @@ use crate::profile::RadialProfile;
 use crate::quadrature::{gl12, integrate_nodes};
 use crate::single_scattering::SingleScattering;
 use crate::tabulated::grid::{N_ALBEDO, albedo_of_row};
-use crate::tabulated::profile::{RowTotals, totals_between_rows};
+use crate::tabulated::half_space::{RowTotals, totals_between_rows};
 
 /// Gauss–Legendre nodes on each side of the critical cosine.
 pub const SUB_NODES: usize = 12;
@@ -66,7 +66,7 @@ pub fn plane_albedo(albedo: f64, g: f64, eta: f64) -> f64 {
         0.0
     };
     let g = if g.is_finite() {
-        g.clamp(-crate::family::G_MAX, crate::family::G_MAX)
+        g.clamp(-crate::error::G_MAX, crate::error::G_MAX)
     } else {
         0.0
     };
@@ -168,7 +168,7 @@ impl AnisotropicTotals {
         let all = plane_albedos(&albedos, g, eta);
         let eta_c = if eta.is_finite() { eta.max(1.0) } else { 1.0 };
         let g_c = if g.is_finite() {
-            g.clamp(-crate::family::G_MAX, crate::family::G_MAX)
+            g.clamp(-crate::error::G_MAX, crate::error::G_MAX)
         } else {
             0.0
         };

@@ -73,7 +73,7 @@ pub mod tabulated;
 
 pub use albedo_inversion::AlbedoInversion;
 pub use coefficients::Coefficients;
-pub use error::ParamError;
+pub use error::{ParamError, UnknownName};
 pub use error::{SIGMA_EPSILON, SIGMA_MAX};
 pub use family::{FamilyOptions, MultipleTerm, Profile, ProfileFamily};
 pub use fresnel::{DiffuseFresnel, FresnelMoments};
@@ -81,7 +81,7 @@ pub use fresnel::{DiffuseFresnel, FresnelMoments};
 /// same glam version as this crate.
 pub use glam;
 pub use medium::MediumParams;
-pub use model::{ProfileModel, Scattering, UnknownName};
+pub use model::{ProfileModel, Scattering};
 pub use profile::RadialProfile;
 pub use rgb::Rgb;
 pub use rgb_profile::RgbProfile;

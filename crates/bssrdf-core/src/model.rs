@@ -4,6 +4,8 @@
 use std::fmt;
 use std::str::FromStr;
 
+use crate::error::UnknownName;
+
 /// A homogeneous radial profile model. Adding a model is one more variant here plus its module.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[non_exhaustive]
@@ -34,7 +36,7 @@ impl ProfileModel {
     /// material's relative refractive index; a NaN gives the tabulated model, whose
     /// construction then reports the invalid η.
     pub fn default_for(eta: f64) -> ProfileModel {
-        if eta > crate::tabulated::profile::ETA_MAX {
+        if eta > crate::tabulated::half_space::ETA_MAX {
             ProfileModel::Pbd
         } else {
             ProfileModel::Tabulated
@@ -55,37 +57,6 @@ impl ProfileModel {
 impl fmt::Display for ProfileModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-/// A name that matches no variant of a closed set.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("unknown {what} `{given}` (expected one of: {expected})")]
-pub struct UnknownName {
-    /// What was being parsed ("profile model", …).
-    pub what: &'static str,
-    /// The string given.
-    pub given: String,
-    /// The accepted names, comma-separated.
-    pub expected: String,
-}
-
-impl UnknownName {
-    /// The element of `all` whose `name` is `given`, or an error listing the accepted names.
-    pub fn find<T: Copy>(
-        given: &str,
-        what: &'static str,
-        all: &[T],
-        name: impl Fn(T) -> &'static str,
-    ) -> Result<T, UnknownName> {
-        all.iter()
-            .copied()
-            .find(|&m| name(m) == given)
-            .ok_or_else(|| UnknownName {
-                what,
-                given: given.to_string(),
-                expected: all.iter().map(|&m| name(m)).collect::<Vec<_>>().join(", "),
-            })
     }
 }
 
@@ -113,19 +84,6 @@ impl Scattering {
     /// Every variant.
     pub const ALL: &'static [Scattering] =
         &[Scattering::Multiple, Scattering::Single, Scattering::All];
-
-    /// The model used when none is asked for: the exact [`ProfileModel::Tabulated`] profile
-    /// wherever its table reaches (η ≤ 1.6), otherwise photon beam diffusion, the least biased
-    /// of the diffusion models on a half-space (`docs/tabulated-profile.md`). `eta` is the
-    /// material's relative refractive index; a NaN gives the tabulated model, whose
-    /// construction then reports the invalid η.
-    pub fn default_for(eta: f64) -> ProfileModel {
-        if eta > crate::tabulated::profile::ETA_MAX {
-            ProfileModel::Pbd
-        } else {
-            ProfileModel::Tabulated
-        }
-    }
 
     /// The name used on the command line and in scene files.
     pub const fn name(self) -> &'static str {

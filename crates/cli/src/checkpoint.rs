@@ -6,7 +6,7 @@ use crate::diag::say;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use experiments::progress::RenderBar;
+use pipeline::progress::RenderBar;
 use tracer::integrator::PathCounters;
 use tracer::render::{Partial, RenderObserver};
 

@@ -54,7 +54,7 @@ pub fn parse_exr_out(s: &str) -> Result<PathBuf, String> {
 /// JSON written beside it cannot be written. The library error names the path; the context
 /// names the flag.
 pub fn check_writable(path: &Path) -> anyhow::Result<()> {
-    experiments::run::check_render_outputs(path).context("invalid --out")
+    pipeline::files::check_render_outputs(path).context("invalid --out")
 }
 
 /// Claims the output set of a run (the EXR `exr` and the PNG and JSON beside it) before its
@@ -64,7 +64,7 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
 /// the last file is written.
 pub fn claim_outputs(exr: &Path, inputs: &[&Path]) -> anyhow::Result<OutputLock> {
     check_writable(exr)?;
-    let (png, json) = experiments::run::sidecar_paths(exr);
+    let (png, json) = pipeline::files::sidecar_paths(exr);
     let set = [exr, png.as_path(), json.as_path()];
     tracer::output::check_not_inputs(set, inputs).context("invalid --out")?;
     let lock = OutputLock::acquire(exr).context("invalid --out")?;

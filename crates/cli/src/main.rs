@@ -4,25 +4,25 @@
 //! Exit codes: 0 success; 1 a run-time error (bad scene, unreadable file, unwritable output,
 //! invalid parameter), printed with its cause chain; 2 a command-line usage error (from clap);
 //! 128 + the signal (130, 143, 129) when `render`, `beam` or `merge` was interrupted by SIGINT,
-//! SIGTERM or SIGHUP (see `interrupt`).
+//! SIGTERM or SIGHUP (see `signals`).
 //!
 //! Numeric flags accept values starting with `-`, so that `--photons -5` is reported as an
 //! invalid value of `--photons` rather than as an unknown argument `-5`.
 
-mod beam;
+mod beam_command;
 mod checkpoint;
 mod choices;
 mod common;
-mod compare;
-mod converge;
+mod compare_command;
+mod converge_command;
 mod diag;
 mod flags;
-mod interrupt;
-mod merge;
-mod profile;
-mod render;
-mod reproduce;
-mod tabulate;
+mod merge_command;
+mod profile_command;
+mod render_command;
+mod reproduce_command;
+mod signals;
+mod tabulate_command;
 
 use std::process::ExitCode;
 
@@ -47,19 +47,19 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Print a homogeneous radial profile R(r) as CSV, or its total diffuse reflectance.
-    Profile(profile::Args),
+    Profile(profile_command::Args),
     /// Render a scene file with the path-traced reference or a BSSRDF method.
-    Render(render::Args),
+    Render(render_command::Args),
     /// Assemble the shards of a render (`render --tile I/N`) into the whole image.
-    Merge(merge::Args),
+    Merge(merge_command::Args),
     /// The paper's Figure 4: exitance map of a pencil beam in a textured half-space.
-    Beam(beam::Args),
+    Beam(beam_command::Args),
     /// Error metrics of a test image against a reference, and a difference image.
-    Compare(compare::Args),
+    Compare(compare_command::Args),
     /// Error against run time of several methods, and their speed-up over path tracing.
-    Converge(converge::Args),
+    Converge(converge_command::Args),
     /// Run the paper's experiments end to end and write report.md.
-    Reproduce(reproduce::Args),
+    Reproduce(reproduce_command::Args),
     /// Print a shell completion script, e.g. `het-bssrdf completions bash > het-bssrdf.bash`.
     Completions {
         /// The shell.
@@ -67,7 +67,7 @@ enum Command {
         shell: clap_complete::Shell,
     },
     /// Regenerate the tabulated half-space profile's data file by photon simulation.
-    Tabulate(tabulate::Args),
+    Tabulate(tabulate_command::Args),
 }
 
 fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
@@ -78,24 +78,24 @@ fn run(cli: Cli, given: flags::Given) -> anyhow::Result<()> {
             .context("cannot start the worker threads (--threads)")?;
     }
     match cli.command {
-        Command::Profile(args) => profile::run(args),
-        Command::Render(args) => render::run(args),
-        Command::Merge(args) => merge::run(args),
-        Command::Beam(args) => beam::run(args, &given),
-        Command::Compare(args) => compare::run(args),
-        Command::Converge(args) => converge::run(args, &given),
-        Command::Reproduce(args) => reproduce::run(args),
+        Command::Profile(args) => profile_command::run(args),
+        Command::Render(args) => render_command::run(args),
+        Command::Merge(args) => merge_command::run(args),
+        Command::Beam(args) => beam_command::run(args),
+        Command::Compare(args) => compare_command::run(args),
+        Command::Converge(args) => converge_command::run(args, &given),
+        Command::Reproduce(args) => reproduce_command::run(args),
         Command::Completions { shell } => {
             let mut cmd = Cli::command();
             clap_complete::generate(shell, &mut cmd, "het-bssrdf", &mut std::io::stdout());
             Ok(())
         }
-        Command::Tabulate(args) => tabulate::run(args),
+        Command::Tabulate(args) => tabulate_command::run(args),
     }
 }
 
 fn main() -> ExitCode {
-    interrupt::ignore_file_size_signal();
+    signals::ignore_file_size_signal();
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let given = flags::Given::from_matches(matches.subcommand().map(|(_, m)| m));
@@ -105,7 +105,7 @@ fn main() -> ExitCode {
             // The libraries' errors do not repeat their sources in their messages (they return
             // them from `source()`), so the cause chain prints each cause once.
             say!("error: {err:#}");
-            ExitCode::from(interrupt::exit_status().unwrap_or(1))
+            ExitCode::from(signals::exit_status().unwrap_or(1))
         }
     }
 }

@@ -25,7 +25,7 @@ fn fixed_length_arrays_refuse_extra_elements() {
         (
             "max = [1.0, 1.0, 0.0]",
             "max = [1.0, 1.0, 0.0, 5.0]",
-            "bad.toml:29",
+            "bad.toml:24",
         ),
         (
             "centre = [0.0, 0.0, 5.0]",

@@ -40,6 +40,8 @@ use tracer::rng::Rng;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 use tracer::volume::ChannelView;
 
+pub use crate::colour_range::ColourRange;
+
 /// Side of the box standing in for the half-space (scene units), and its depth. With
 /// σa ≥ 0.005 and σs = 1 the diffusion length 1/σtr is about 8, so light reaching the box's
 /// sides or bottom is below e⁻²⁴ of the beam.
@@ -540,52 +542,6 @@ pub fn write_variant_maps(example: &str, variants: impl IntoIterator<Item = Vari
     }
 }
 
-/// The log colour range of a beam map's PNG, from `min` (bottom of the colour bar) to `max`
-/// (top). The maps of one figure share one, so that equal colours are equal exitances.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ColourRange {
-    /// Exitance at the bottom of the colour bar (> 0).
-    pub min: f64,
-    /// Exitance at the top.
-    pub max: f64,
-}
-
-impl ColourRange {
-    /// Decades shown below a map's largest value.
-    pub const DECADES: f64 = 6.0;
-
-    /// The range of `values`: their largest value and [`Self::DECADES`] below it (or their
-    /// smallest positive value, if higher).
-    pub fn of(values: &[f64]) -> ColourRange {
-        Self::spanning(values, Self::DECADES)
-    }
-
-    /// The range from the largest finite value of `values` down `decades` (or to their
-    /// smallest positive value, if higher); 1 and 0.1 when no value is positive.
-    pub fn spanning(values: &[f64], decades: f64) -> ColourRange {
-        let max = values
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0f64, f64::max);
-        let max = if max > 0.0 { max } else { 1.0 };
-        let min_pos = values
-            .iter()
-            .copied()
-            .filter(|&v| v > 0.0 && v.is_finite())
-            .fold(f64::INFINITY, f64::min);
-        let min = min_pos.max(max * 10f64.powf(-decades));
-        ColourRange {
-            min: if min.is_finite() && min < max {
-                min
-            } else {
-                max / 10.0
-            },
-            max,
-        }
-    }
-}
-
 /// Writes a beam map: grey EXR at `exr`, a false-colour log-scale PNG with a colour bar
 /// beside it (feature `plot`), and a JSON sidecar with the set-up, the method, timings and
 /// counters (`extra` is merged in). The colour bar spans the map's own range
@@ -655,7 +611,7 @@ pub fn write_beam_map_in(
     let json = exr.with_extension("json");
     set.add(
         &json,
-        tracer::output::json_bytes(&crate::provenance::stamped(value), &json)?,
+        tracer::output::json_bytes(&pipeline::provenance::stamped(value), &json)?,
     );
     #[cfg(feature = "plot")]
     set.add(&exr.with_extension("png"), png_bytes);

@@ -6,7 +6,7 @@
 use std::fmt::Write as _;
 
 use crate::converge::MethodSummary;
-use crate::reproduce::ErrorRow;
+use crate::metrics::ErrorRow;
 
 /// The report's section explaining the methods and the metrics.
 pub const METHODS_AND_METRICS: &str = "## Methods and metrics\n\n\

@@ -237,7 +237,7 @@ pub fn write_outputs(
         obj.extend(more);
     }
     write_json(
-        &crate::provenance::stamped(value),
+        &pipeline::provenance::stamped(value),
         &dir.join("summary.json"),
     )?;
     Ok(())
@@ -245,7 +245,7 @@ pub fn write_outputs(
 
 /// Checks that `dir` exists, is a directory and accepts new files (before a long study).
 pub fn check_dir(dir: &Path) -> Result<(), OutputError> {
-    crate::run::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
+    pipeline::files::check_dir_accepts_files(dir, &dir.join("convergence.csv"))
 }
 
 #[cfg(test)]
@@ -319,7 +319,7 @@ mod tests {
     /// of a squared error over 1024 pixels is about 5 %.
     #[test]
     fn path_traced_errors_against_a_path_traced_reference_follow_the_model() {
-        use crate::run::{RenderJob, render_scene};
+        use pipeline::job::{RenderJob, render_scene};
         use tracer::integrator::Method;
         use tracer::render::Budget;
         let scene = tracer::scene::Scene::from_toml_str(

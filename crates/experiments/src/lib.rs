@@ -6,6 +6,7 @@
 /// re-exported so that callers build them with the same version.
 pub use serde_json;
 pub mod beam;
+pub mod colour_range;
 pub mod commentary;
 pub mod converge;
 pub mod error;
@@ -13,11 +14,7 @@ pub mod ledger;
 pub mod metrics;
 #[cfg(feature = "plot")]
 pub mod plot;
-pub mod progress;
-pub mod provenance;
 pub mod reproduce;
-pub mod run;
 pub mod scenes;
-pub mod shard;
 pub mod study;
 pub mod time_to_error;

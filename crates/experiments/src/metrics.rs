@@ -143,6 +143,19 @@ pub fn log_ratio(test: &tracer::film::Film, reference: &tracer::film::Film) -> V
         .collect()
 }
 
+/// One row of an error table.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ErrorRow {
+    /// Experiment (`beam stripe`, `checker slab`).
+    pub experiment: String,
+    /// Method (and profile).
+    pub method: String,
+    /// Wall seconds.
+    pub seconds: f64,
+    /// Errors against the reference.
+    pub metrics: Metrics,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

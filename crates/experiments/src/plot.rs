@@ -72,7 +72,7 @@ pub enum MapScale {
 impl MapScale {
     /// A log scale spanning the positive values of `values`, clipped to `decades` below the max.
     pub fn log_for(values: &[f64], decades: f64) -> MapScale {
-        let r = crate::beam::ColourRange::spanning(values, decades);
+        let r = crate::colour_range::ColourRange::spanning(values, decades);
         MapScale::Log {
             min: r.min,
             max: r.max,

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use bssrdf_core::{ProfileModel, Scattering};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::beam::{
     BeamSetup, BeamTexture, ColourRange, PhotonBudget, run_method, write_beam_map,
@@ -17,10 +17,11 @@ use crate::beam::{
 use crate::converge::{MethodSummary, summarize, write_outputs};
 use crate::error::WriteError;
 use crate::ledger::{Ledger, LedgerError};
-use crate::metrics::{Metrics, compare, compare_films};
-use crate::run::{RenderJob, render_scene, write_render};
+use crate::metrics::{ErrorRow, compare, compare_films};
 use crate::scenes::CHECKER_SLAB;
 use crate::study::{BeamBudgets, REFERENCE_SEED_OFFSET, StudyError, beam_study, scene_study};
+use pipeline::files::write_render;
+use pipeline::job::{RenderJob, render_scene};
 use tracer::integrator::Method;
 use tracer::output::{write_atomic, write_exr};
 use tracer::render::Budget;
@@ -142,19 +143,6 @@ impl From<tracer::error::SceneError> for ReproduceError {
     fn from(e: tracer::error::SceneError) -> Self {
         ReproduceError::Study(e.into())
     }
-}
-
-/// One row of an error table.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct ErrorRow {
-    /// Experiment (`beam stripe`, `checker slab`).
-    pub experiment: String,
-    /// Method (and profile).
-    pub method: String,
-    /// Wall seconds.
-    pub seconds: f64,
-    /// Errors against the reference.
-    pub metrics: Metrics,
 }
 
 fn mkdir(path: &Path) -> Result<(), ReproduceError> {

@@ -9,7 +9,7 @@ use bssrdf_core::ProfileModel;
 use crate::beam::{BeamMap, BeamSetup, PhotonBudget, run_method};
 use crate::converge::Run;
 use crate::metrics::{MetricsError, compare, compare_films};
-use crate::run::{RenderJob, RenderOutcome, prepare, render_prepared_with_bar, render_scene};
+use pipeline::job::{RenderJob, RenderOutcome, prepare, render_prepared_with_bar, render_scene};
 use tracer::error::SceneError;
 use tracer::film::Film;
 use tracer::integrator::{Method, RenderError};

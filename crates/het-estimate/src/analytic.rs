@@ -8,7 +8,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::ellipse::PlanarEllipse;
-use crate::field::{CoefficientField, Coefficients, FieldBounds};
+use crate::field::{CoefficientField, Coefficients, FieldBounds, FieldCapabilities};
 use crate::pattern::{BinaryPattern, Check, Ramp, Stripe};
 use crate::prefilter::{PlaneFootprint, check_fraction, stripe_fraction};
 use crate::surface::{SurfacePoint, SurfaceQuery};
@@ -77,8 +77,11 @@ impl CoefficientField<PlanePoint> for ConstantField {
     fn ellipse_average(&self, _: &PlanarEllipse) -> Option<Coefficients> {
         Some(self.0)
     }
-    fn has_ellipse_average(&self) -> bool {
-        true
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            ellipse_average: true,
+            ..FieldCapabilities::default()
+        }
     }
 }
 
@@ -138,8 +141,12 @@ impl<P: FootprintPattern> CoefficientField<PlanePoint> for PatternField<P> {
         Some(self.values[self.pattern.select(x.x, x.y)])
     }
 
-    fn has_point_lookup(&self) -> bool {
-        true
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            point_lookup: true,
+            ellipse_average: true,
+            ..FieldCapabilities::default()
+        }
     }
 
     /// Exact: the plane is flat, so projecting the ellipse along its normal onto z = 0 is
@@ -154,9 +161,6 @@ impl<P: FootprintPattern> CoefficientField<PlanePoint> for PatternField<P> {
         })
     }
 
-    fn has_ellipse_average(&self) -> bool {
-        true
-    }
     #[inline]
     fn bounds(&self) -> Option<FieldBounds> {
         Some(FieldBounds {
@@ -261,8 +265,11 @@ impl CoefficientField<PlanePoint> for RampField {
         ok.then(|| self.linear(c.x, c.y))
     }
 
-    fn has_ellipse_average(&self) -> bool {
-        true
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            ellipse_average: true,
+            ..FieldCapabilities::default()
+        }
     }
 }
 
@@ -295,12 +302,12 @@ mod tests {
         };
         let by_ref = &field;
         let x = DVec3::new(2.5, -1.0, 0.3);
-        assert!(CoefficientField::<PlanePoint>::has_point_lookup(&by_ref));
+        assert!(CoefficientField::<PlanePoint>::capabilities(&by_ref).point_lookup);
         assert_eq!(
             CoefficientField::<PlanePoint>::averaged_at_point(&by_ref, x),
             CoefficientField::<PlanePoint>::averaged_at_point(&field, x)
         );
-        assert!(CoefficientField::<PlanePoint>::has_ellipse_average(&by_ref));
+        assert!(CoefficientField::<PlanePoint>::capabilities(&by_ref).ellipse_average);
     }
 
     #[test]

@@ -5,13 +5,16 @@ use std::sync::Arc;
 
 use bssrdf_core::ParamError;
 
-use crate::estimate::{Estimate, Region};
+use crate::budget::SampleBudget;
+use crate::estimator_output::{Estimate, Region};
 use crate::field::CoefficientField;
 use crate::kernel::{self, KernelParams};
 use crate::kernel_table::KernelTable;
 use crate::known::Known;
 use crate::names::Named;
+use crate::path_integral::SemiMinorAxis;
 use crate::point_lookup;
+use crate::prefilter::Averaging;
 use crate::random::UniformSource;
 use crate::region_average::Probe;
 use crate::segment::{self, SegmentParams};
@@ -20,11 +23,12 @@ use crate::surface::SurfaceQuery;
 
 /// How the homogeneous parameters for a pair (x_i, x_o) are estimated.
 ///
-/// Names (`Display`/`FromStr`, used by the CLI and scene files): `jensen-in`, `jensen-out`,
-/// `endpoints`, `segment`, `sone`, `kernel`. Parsing a name gives the variant with default
-/// parameters.
+/// Names (`Display`/`FromStr`, used by the CLI and scene files): those of [`Estimator::ALL`].
+/// Parsing a name gives the variant with default parameters.
 ///
-/// New methods are one more variant each, with their parameters in their own module.
+/// New methods are one more variant each, with their parameters in their own module; the
+/// variant says which options it takes ([`Estimator::options`]), and the renderer and the
+/// command line read that (docs/architecture.md, "Adding an estimator").
 /// Prefiltered constant-time averaging is an option of `sone` ([`SoneParams::averaging`], on
 /// by default), not a separate estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -138,6 +142,150 @@ impl Estimator {
             g,
             kernel,
         })
+    }
+}
+
+/// The options an estimator takes beyond its name (what a command line or scene file may set
+/// on it): each flag says whether [`Estimator::with_samples`], [`Estimator::with_averaging`]
+/// and [`Estimator::with_semi_minor`] change it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct EstimatorOptions {
+    /// Averaging samples per region (a [`SampleBudget`]).
+    pub samples: bool,
+    /// Prefiltered or Monte Carlo averaging ([`Averaging`]).
+    pub averaging: bool,
+    /// The semi-minor axis reading of the path-integral ellipse ([`SemiMinorAxis`]).
+    pub semi_minor: bool,
+}
+
+impl EstimatorOptions {
+    /// The names of the estimators of [`Estimator::ALL`] for which `takes` holds, e.g.
+    /// `"segment, sone and kernel"`, for help texts and error messages.
+    pub fn names_of(takes: impl Fn(EstimatorOptions) -> bool) -> String {
+        let names: Vec<&str> = Estimator::ALL
+            .iter()
+            .filter(|e| takes(e.options()))
+            .map(|e| e.name())
+            .collect();
+        match names.split_last() {
+            None => String::new(),
+            Some((last, [])) => (*last).to_string(),
+            Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
+        }
+    }
+}
+
+impl Estimator {
+    /// Which options this estimator takes.
+    pub const fn options(self) -> EstimatorOptions {
+        match self {
+            Estimator::JensenIn | Estimator::JensenOut | Estimator::Endpoints => EstimatorOptions {
+                samples: false,
+                averaging: false,
+                semi_minor: false,
+            },
+            Estimator::Segment(_) => EstimatorOptions {
+                samples: true,
+                averaging: false,
+                semi_minor: false,
+            },
+            Estimator::Sone(_) => EstimatorOptions {
+                samples: true,
+                averaging: true,
+                semi_minor: true,
+            },
+            Estimator::Kernel(_) => EstimatorOptions {
+                samples: true,
+                averaging: true,
+                semi_minor: false,
+            },
+        }
+    }
+
+    /// The estimator with `samples` averaging samples per region (segment: on the chord;
+    /// Sone: in the disk and in the ellipse; kernel: points drawn around the chord, at most
+    /// [`KernelParams::MAX_SAMPLES`], which [`Estimator::prepare`] enforces); unchanged when
+    /// it takes no samples ([`EstimatorOptions::samples`]).
+    pub const fn with_samples(self, samples: SampleBudget) -> Self {
+        match self {
+            Estimator::Segment(p) => Estimator::Segment(p.with_samples(samples)),
+            Estimator::Sone(p) => Estimator::Sone(p.with_samples(samples)),
+            Estimator::Kernel(p) => Estimator::Kernel(p.with_samples(samples)),
+            e => e,
+        }
+    }
+
+    /// The estimator with its averaging set to `averaging`; unchanged when it has none
+    /// ([`EstimatorOptions::averaging`]).
+    pub const fn with_averaging(self, averaging: Averaging) -> Self {
+        match self {
+            Estimator::Sone(p) => Estimator::Sone(p.with_averaging(averaging)),
+            Estimator::Kernel(p) => Estimator::Kernel(p.with_averaging(averaging)),
+            e => e,
+        }
+    }
+
+    /// The estimator with the semi-minor axis reading of Eq. (2) set to `semi_minor`;
+    /// unchanged when it has no ellipse ([`EstimatorOptions::semi_minor`]).
+    pub const fn with_semi_minor(self, semi_minor: SemiMinorAxis) -> Self {
+        match self {
+            Estimator::Sone(mut p) => {
+                p.semi_minor = semi_minor;
+                Estimator::Sone(p)
+            }
+            e => e,
+        }
+    }
+
+    /// The estimator's averaging (`None` when it has none).
+    pub const fn averaging(&self) -> Option<Averaging> {
+        match self {
+            Estimator::Sone(p) => Some(p.averaging),
+            Estimator::Kernel(p) => Some(p.averaging),
+            _ => None,
+        }
+    }
+
+    /// The estimator's semi-minor axis reading (`None` when it has no ellipse).
+    pub const fn semi_minor(&self) -> Option<SemiMinorAxis> {
+        match self {
+            Estimator::Sone(p) => Some(p.semi_minor),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod options_tests {
+    use super::*;
+
+    /// Each option an estimator says it takes changes it, and each it says it does not take
+    /// leaves it unchanged (so the flags refused by the command line are the ignored ones).
+    #[test]
+    fn options_say_what_the_setters_change() {
+        for &e in Estimator::ALL {
+            let o = e.options();
+            let budget = SampleBudget::fixed(3);
+            assert_eq!(e.with_samples(budget) != e, o.samples, "{e}");
+            let other = match e.averaging() {
+                Some(Averaging::Prefiltered) => Averaging::MonteCarlo,
+                _ => Averaging::Prefiltered,
+            };
+            assert_eq!(e.with_averaging(other) != e, o.averaging, "{e}");
+            assert_eq!(e.averaging().is_some(), o.averaging, "{e}");
+            let b = match e.semi_minor() {
+                Some(SemiMinorAxis::Width) => SemiMinorAxis::HalfWidth,
+                _ => SemiMinorAxis::Width,
+            };
+            assert_eq!(e.with_semi_minor(b) != e, o.semi_minor, "{e}");
+            assert_eq!(e.semi_minor().is_some(), o.semi_minor, "{e}");
+        }
+        assert_eq!(
+            EstimatorOptions::names_of(|o| o.samples),
+            "segment, sone and kernel"
+        );
+        assert_eq!(EstimatorOptions::names_of(|o| o.semi_minor), "sone");
     }
 }
 

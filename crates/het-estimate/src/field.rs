@@ -28,6 +28,33 @@ impl FieldBounds {
     }
 }
 
+/// The optional capabilities of a [`CoefficientField`], as one value
+/// ([`CoefficientField::capabilities`]). Each flag says that the field answers the methods it
+/// names; the estimators ask those only then. All false by default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct FieldCapabilities {
+    /// [`CoefficientField::ellipse_average`] (or, for a field that reads texture coordinates,
+    /// [`CoefficientField::ellipse_average_in_chart`]) can answer, for some regions. The
+    /// estimator asks for field averages, checks the surface's flatness and counts fallbacks
+    /// only for such fields.
+    pub ellipse_average: bool,
+    /// The field reads the surface's texture coordinates (a UV-mapped image), so that its
+    /// constant-time averages need the texture coordinates over the region: the estimators
+    /// then ask [`CoefficientField::ellipse_average_in_chart`] and
+    /// [`CoefficientField::averaged_at_points_in_chart`] instead of the chart-free versions,
+    /// with the region's chart from [`crate::SurfaceQuery::uv_chart`] at x_i and x_o
+    /// ([`UvChart::between`]), and sample the region where there is none.
+    pub reads_uv: bool,
+    /// [`CoefficientField::averaged_at_point`] can answer.
+    pub point_lookup: bool,
+    /// [`CoefficientField::averaged`] is not σa, σs but values of the field's own averaging
+    /// space. Estimators then map means through [`CoefficientField::coefficients_of_mean`]
+    /// (which they skip, at no cost, when this is false: override the three together) and
+    /// take plain arithmetic means (the kernel estimator's power mean of σa is specific to
+    /// σa).
+    pub own_averaging_space: bool,
+}
+
 /// σa and σs over the surface of the object being shaded.
 pub trait CoefficientField<P> {
     /// The coefficients at surface point `p`. Must be finite and non-negative.
@@ -46,12 +73,21 @@ pub trait CoefficientField<P> {
         None
     }
 
+    /// What the field can do beyond point lookups (constant-time region averages, texture
+    /// coordinates, point lookups in space, its own averaging space): see
+    /// [`FieldCapabilities`]. Default: none of them. Override it together with the methods
+    /// the capabilities name.
+    #[inline]
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities::default()
+    }
+
     /// Optional capability: the exact (or prefiltered) area average of Eq. (3) of the paper
     /// over `region`, i.e. the mean of the coefficients at the projections of the ellipse's
     /// points onto the surface along `±region.normal`, uniformly weighted by area in the
     /// ellipse's plane. Fields that can answer in constant time (summed-area tables, EWA over
     /// a texture, closed forms: see [`crate::prefilter`]) override this together with
-    /// [`CoefficientField::has_ellipse_average`]; the Sone estimator then asks it before
+    /// [`FieldCapabilities::ellipse_average`]; the Sone estimator then asks it before
     /// sampling wherever the surface is flat enough for a flat footprint (see
     /// `SoneParams::averaging` and [`crate::Flatness`]). An implementation may answer for the
     /// ellipse as it lies in its plane (the flat-surface reading). `None` means "not for this
@@ -80,27 +116,8 @@ pub trait CoefficientField<P> {
         None
     }
 
-    /// True when [`CoefficientField::ellipse_average`] (or, for a field that
-    /// [reads texture coordinates](CoefficientField::reads_uv),
-    /// [`CoefficientField::ellipse_average_in_chart`]) can answer (for some regions). The
-    /// estimator asks for field averages, checks the surface's flatness and counts fallbacks
-    /// only for such fields. Default: false.
-    fn has_ellipse_average(&self) -> bool {
-        false
-    }
-
-    /// True when the field reads the surface's texture coordinates (a UV-mapped image), so
-    /// that its constant-time averages need the texture coordinates over the region: the
-    /// estimators then ask [`CoefficientField::ellipse_average_in_chart`] and
-    /// [`CoefficientField::averaged_at_points_in_chart`] instead of the chart-free versions,
-    /// with the region's chart from [`crate::SurfaceQuery::uv_chart`] at x_i and x_o
-    /// ([`UvChart::between`]), and sample the region where there is none. Default: false.
-    fn reads_uv(&self) -> bool {
-        false
-    }
-
     /// [`CoefficientField::ellipse_average`] for a field that
-    /// [reads texture coordinates](CoefficientField::reads_uv): `chart` maps the region's
+    /// [reads texture coordinates](FieldCapabilities::reads_uv): `chart` maps the region's
     /// plane to them (the region lies in the surface: a flat pair). A UV-mapped image averages
     /// over the footprint the chart gives (the ellipse's axes mapped by the chart's gradients:
     /// the UV Jacobian at the region's centre). The default ignores the chart.
@@ -114,7 +131,7 @@ pub trait CoefficientField<P> {
     }
 
     /// [`CoefficientField::averaged_at_points`] for a field that
-    /// [reads texture coordinates](CoefficientField::reads_uv): each point of the region's
+    /// [reads texture coordinates](FieldCapabilities::reads_uv): each point of the region's
     /// plane is read at the coordinates `chart` gives it. The default ignores the chart.
     #[inline]
     fn averaged_at_points_in_chart(
@@ -137,11 +154,6 @@ pub trait CoefficientField<P> {
     fn averaged_at_point(&self, x: glam::DVec3) -> Option<Coefficients> {
         let _ = x;
         None
-    }
-
-    /// True when [`CoefficientField::averaged_at_point`] can answer. Default: false.
-    fn has_point_lookup(&self) -> bool {
-        false
     }
 
     /// [`CoefficientField::averaged_at_point`] at every point of `xs`, into `out` (as long as
@@ -180,20 +192,15 @@ pub trait CoefficientField<P> {
     fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         mean
     }
-
-    /// False when [`CoefficientField::averaged`] is not σa, σs. Estimators then map means
-    /// through [`CoefficientField::coefficients_of_mean`] (which they skip, at no cost, when
-    /// this is true: override the three methods together) and take plain arithmetic means
-    /// (the kernel estimator's power mean of σa is specific to σa). Default: true.
-    #[inline]
-    fn averages_coefficients(&self) -> bool {
-        true
-    }
 }
 
 impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     fn coefficients(&self, p: &P) -> Coefficients {
         (**self).coefficients(p)
+    }
+    #[inline]
+    fn capabilities(&self) -> FieldCapabilities {
+        (**self).capabilities()
     }
     fn bounds(&self) -> Option<FieldBounds> {
         (**self).bounds()
@@ -201,14 +208,8 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     fn ellipse_average(&self, region: &PlanarEllipse) -> Option<Coefficients> {
         (**self).ellipse_average(region)
     }
-    fn has_ellipse_average(&self) -> bool {
-        (**self).has_ellipse_average()
-    }
     fn displacement_scale(&self, region: &PlanarEllipse) -> Option<f64> {
         (**self).displacement_scale(region)
-    }
-    fn reads_uv(&self) -> bool {
-        (**self).reads_uv()
     }
     fn ellipse_average_in_chart(
         &self,
@@ -234,15 +235,9 @@ impl<P, F: CoefficientField<P> + ?Sized> CoefficientField<P> for &F {
     fn coefficients_of_mean(&self, mean: Coefficients) -> Coefficients {
         (**self).coefficients_of_mean(mean)
     }
-    fn averages_coefficients(&self) -> bool {
-        (**self).averages_coefficients()
-    }
     #[inline]
     fn averaged_at_point(&self, x: glam::DVec3) -> Option<Coefficients> {
         (**self).averaged_at_point(x)
-    }
-    fn has_point_lookup(&self) -> bool {
-        (**self).has_point_lookup()
     }
     #[inline]
     fn averaged_at_points(&self, xs: &[glam::DVec3], out: &mut [Coefficients]) -> bool {

@@ -50,7 +50,7 @@ use bssrdf_core::ParamError;
 use glam::{DVec2, DVec3};
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
 use crate::known::Known;
@@ -324,7 +324,7 @@ where
     // Means live in the field's averaging space; the kernel's weights need coefficients.
     let start = known.finish(probe.endpoints());
     let start_sigma = probe.to_coefficients(start);
-    let exponent = if probe.field.averages_coefficients() {
+    let exponent = if !probe.field.capabilities().own_averaging_space {
         params.exponent
     } else {
         1.0
@@ -351,7 +351,7 @@ where
     // pair is flat) for a field defined in space, or read through texture coordinates that
     // are one affine map over the region; the others are projected by rays.
     let lift_radius = if params.averaging == Averaging::Prefiltered
-        && (probe.field.has_point_lookup() || probe.field.reads_uv())
+        && (probe.field.capabilities().point_lookup || probe.field.capabilities().reads_uv)
     {
         probe.prepare_prefilter(params.flatness, &chord);
         let radius = probe.lifting_radius(&chord.ellipse(chord.half_len));

@@ -49,8 +49,8 @@ pub mod analytic;
 pub mod budget;
 mod chord;
 pub mod ellipse;
-pub mod estimate;
 pub mod estimator;
+pub mod estimator_output;
 pub mod field;
 pub mod frame;
 pub mod green;
@@ -77,9 +77,9 @@ pub use bssrdf_core;
 pub use bssrdf_core::Rgb;
 pub use budget::{MissPolicy, SampleBudget};
 pub use ellipse::PlanarEllipse;
-pub use estimate::{Diagnostics, Estimate, Region};
-pub use estimator::{Estimator, PreparedEstimator};
-pub use field::{CoefficientField, Coefficients, FieldBounds};
+pub use estimator::{Estimator, EstimatorOptions, PreparedEstimator};
+pub use estimator_output::{Diagnostics, Estimate, Region};
+pub use field::{CoefficientField, Coefficients, FieldBounds, FieldCapabilities};
 /// The vector types of the public traits (`glam::DVec3`), re-exported so that implementors
 /// use the same glam version as this crate.
 pub use glam;

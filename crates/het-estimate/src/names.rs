@@ -1,7 +1,6 @@
-//! Closed sets of options with stable names (the CLI and scene files use these names), and the
-//! shared parameter checks.
+//! Closed sets of options with stable names (the CLI and scene files use these names).
 
-use bssrdf_core::{ParamError, UnknownName};
+use bssrdf_core::UnknownName;
 
 /// A closed set of named choices (estimators and their options). `Display`/`FromStr` of
 /// these types use exactly [`Named::name`]; [`Named::ALL`] lists the choices, e.g. for CLI help.
@@ -17,17 +16,6 @@ pub trait Named: Copy + 'static {
 /// Parses one of `T::ALL` by exact name.
 pub(crate) fn parse_named<T: Named>(s: &str) -> Result<T, UnknownName> {
     UnknownName::find(s, T::WHAT, T::ALL, T::name)
-}
-
-/// Checks that `value` is finite and `>= 0`.
-pub(crate) fn check_non_negative(name: &'static str, value: f64) -> Result<f64, ParamError> {
-    if !value.is_finite() {
-        return Err(ParamError::NotFinite { name, value });
-    }
-    if value < 0.0 {
-        return Err(ParamError::Negative { name, value });
-    }
-    Ok(value)
 }
 
 /// Implements `Display` (the name) and `FromStr` (exact name, error `UnknownName`) for types

@@ -37,10 +37,10 @@
 //! absurd case where w itself overflows).
 
 use bssrdf_core::ParamError;
-use bssrdf_core::error::check_g;
+use bssrdf_core::error::{check_g, check_non_negative};
 use bssrdf_core::hg;
 
-use crate::names::{Named, check_non_negative};
+use crate::names::Named;
 
 /// Which value of the mean square scattering angle ⟨θ²⟩ to use in Eq. (2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

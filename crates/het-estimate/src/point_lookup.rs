@@ -1,7 +1,7 @@
 //! The point-lookup baselines: Jensen et al. (JMLH01) and d'Eon & Irving (dEI11), as the
 //! paper's §4 describes them.
 
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::region_average::Probe;
 use crate::surface::SurfaceQuery;

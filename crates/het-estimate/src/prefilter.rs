@@ -133,7 +133,7 @@ impl Flatness {
     /// negative or non-finite angle is an error.
     pub fn new(max_normal_angle: f64) -> Result<Self, bssrdf_core::ParamError> {
         let theta =
-            crate::names::check_non_negative("flatness.max_normal_angle", max_normal_angle)?;
+            bssrdf_core::error::check_non_negative("flatness.max_normal_angle", max_normal_angle)?;
         let (sin, cos) = theta.sin_cos();
         Ok(Self {
             max_normal_angle: theta,
@@ -147,7 +147,7 @@ impl Flatness {
     /// displacement scale; 0 admits only regions the model says are exactly flat); a
     /// negative or non-finite value is an error.
     pub fn with_tolerance(self, tolerance: f64) -> Result<Self, bssrdf_core::ParamError> {
-        let tolerance = crate::names::check_non_negative("flatness.tolerance", tolerance)?;
+        let tolerance = bssrdf_core::error::check_non_negative("flatness.tolerance", tolerance)?;
         Ok(Self { tolerance, ..self })
     }
 

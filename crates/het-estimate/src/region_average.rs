@@ -5,7 +5,7 @@ use bssrdf_core::Rgb;
 use glam::DVec3;
 
 use crate::budget::{REPLICATES, SampleBudget};
-use crate::estimate::Diagnostics;
+use crate::estimator_output::Diagnostics;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::sanitise;
 use crate::local_surface::{Curvature, End, LocalSurface};
@@ -324,7 +324,7 @@ where
     /// that average their coefficients.
     #[inline]
     pub fn to_coefficients(&self, mean: Coefficients) -> Coefficients {
-        if self.field.averages_coefficients() {
+        if !self.field.capabilities().own_averaging_space {
             mean
         } else {
             sanitise(self.field.coefficients_of_mean(mean))
@@ -342,7 +342,7 @@ where
                 Some(chord)
             }
             None => {
-                self.diag.region = crate::estimate::Region::Endpoints;
+                self.diag.region = crate::estimator_output::Region::Endpoints;
                 None
             }
         }
@@ -371,7 +371,7 @@ where
             [&e_i, &e_o],
         );
         let angle_flat = flatness.is_flat(e_i.normal, e_o.normal, chord.x_hat);
-        if model.is_some() && self.field.reads_uv() {
+        if model.is_some() && self.field.capabilities().reads_uv {
             self.chart = match (
                 self.surface.uv_chart(self.x_i),
                 self.surface.uv_chart(self.x_o),
@@ -413,11 +413,11 @@ where
         else {
             return Reading::Rays;
         };
-        let reads_uv = self.field.reads_uv();
+        let reads_uv = self.field.capabilities().reads_uv;
         if reads_uv && self.chart.is_none() {
             return Reading::Rays;
         }
-        let points = self.field.has_point_lookup() || reads_uv;
+        let points = self.field.capabilities().point_lookup || reads_uv;
         match self.field.displacement_scale(e) {
             // The angle test; the plane stands for the surface (the model is flat there).
             None if angle_flat && closed_form => Reading::ClosedForm,
@@ -453,8 +453,10 @@ where
         else {
             return 0.0;
         };
-        let reads_uv = self.field.reads_uv();
-        if !(self.field.has_point_lookup() || reads_uv) || (reads_uv && self.chart.is_none()) {
+        let reads_uv = self.field.capabilities().reads_uv;
+        if !(self.field.capabilities().point_lookup || reads_uv)
+            || (reads_uv && self.chart.is_none())
+        {
             return 0.0;
         }
         match self.field.displacement_scale(disk) {
@@ -477,7 +479,7 @@ where
     pub fn field_ellipse_average(&self, e: &crate::PlanarEllipse) -> Option<Coefficients> {
         match &self.chart {
             Some(chart) => self.field.ellipse_average_in_chart(e, chart),
-            None if self.field.reads_uv() => None,
+            None if self.field.capabilities().reads_uv => None,
             None => self.field.ellipse_average(e),
         }
     }
@@ -518,7 +520,7 @@ where
     /// ([`SurfaceQuery::project_position`]).
     #[inline]
     pub fn project_value(&mut self, origin: DVec3, dir: DVec3) -> Option<Coefficients> {
-        let position = if self.field.has_point_lookup() {
+        let position = if self.field.capabilities().point_lookup {
             self.surface.project_position(origin, dir)
         } else {
             Projected::Undecided
@@ -661,7 +663,7 @@ where
         let positions = &mut positions[..origins.len()];
         let mut values = [Coefficients::default(); CHUNK];
         let mut read = false;
-        if self.field.has_point_lookup() {
+        if self.field.capabilities().point_lookup {
             self.surface.project_positions(origins, dir, positions);
             // The field at every position found, read together.
             let mut xs = [DVec3::ZERO; CHUNK];

@@ -4,7 +4,7 @@
 //! to be dEI11's rule (docs/physics.md#heuristics).
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::Known;
 use crate::random::UniformSource;

@@ -22,7 +22,7 @@
 //! see [`crate::prefilter`]), if the field has one and the pair is flat by
 //! [`SoneParams::flatness`]; a curved pair is sampled and flagged
 //! ([`crate::Diagnostics::prefilter_fallback`]). A field read through texture coordinates
-//! ([`CoefficientField::reads_uv`]) is averaged through the region's chart
+//! ([`FieldCapabilities::reads_uv`](crate::FieldCapabilities::reads_uv)) is averaged through the region's chart
 //! ([`crate::UvChart::between`]: the UV Jacobian at the region's centre), and sampled (and
 //! flagged) where the charts at x_i and x_o disagree. [`Averaging::MonteCarlo`] always samples.
 //!
@@ -48,7 +48,7 @@ use std::num::NonZeroU32;
 use bssrdf_core::Rgb;
 
 use crate::budget::{MissPolicy, SampleBudget};
-use crate::estimate::Region;
+use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
@@ -78,7 +78,7 @@ pub struct SoneParams {
     pub misses: MissPolicy,
     /// Prefiltered (default) or Monte Carlo averaging. Prefiltered asks
     /// [`CoefficientField::ellipse_average`] first, for fields that have it
-    /// ([`CoefficientField::has_ellipse_average`]) and pairs that pass `flatness`, and samples
+    /// ([`FieldCapabilities::ellipse_average`](crate::FieldCapabilities::ellipse_average)) and pairs that pass `flatness`, and samples
     /// otherwise; Monte Carlo always samples.
     pub averaging: Averaging,
     /// The fallback criterion of prefiltered averaging (default: normals within 2°).
@@ -290,9 +290,11 @@ where
 
     // Prefiltered averaging: each region in closed form, on the local quadric, or by rays,
     // by the criterion of `params.flatness`.
-    let closed_form = probe.field.has_ellipse_average();
+    let closed_form = probe.field.capabilities().ellipse_average;
     let prefiltered = params.averaging == Averaging::Prefiltered
-        && (closed_form || probe.field.has_point_lookup() || probe.field.reads_uv());
+        && (closed_form
+            || probe.field.capabilities().point_lookup
+            || probe.field.capabilities().reads_uv);
     if prefiltered {
         probe.prepare_prefilter(params.flatness, &chord);
     }
@@ -413,7 +415,9 @@ where
     F: CoefficientField<S::Point> + ?Sized,
 {
     match reading {
-        Reading::ClosedForm if probe.field.has_point_lookup() || probe.field.reads_uv() => {
+        Reading::ClosedForm
+            if probe.field.capabilities().point_lookup || probe.field.capabilities().reads_uv =>
+        {
             Reading::Lifted
         }
         Reading::Lifted => Reading::Lifted,

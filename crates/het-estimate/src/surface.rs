@@ -78,7 +78,7 @@ pub trait SurfaceQuery {
 
     /// Optional capability: the texture coordinates around `p` as an affine map (for a mesh,
     /// the map of `p`'s triangle, taken at `p`), for fields read through texture coordinates
-    /// ([`crate::CoefficientField::reads_uv`]). The estimators build the chart of a flat
+    /// ([`crate::FieldCapabilities::reads_uv`]). The estimators build the chart of a flat
     /// pair's averaging region from the charts at x_i and x_o ([`UvChart::between`]) and
     /// average such a field in constant time through it; `None` (the default: no texture
     /// coordinates, or a degenerate triangle) means the region is sampled.

@@ -6,6 +6,7 @@ use std::f64::consts::{FRAC_PI_4, PI};
 use std::num::NonZeroU32;
 
 use glam::DVec3;
+use het_estimate::FieldCapabilities;
 use het_estimate::analytic::{
     CheckField, ConstantField, Plane, PlanePoint, RampField, StripeField,
 };
@@ -1135,8 +1136,12 @@ impl CoefficientField<PlanePoint> for Doubled {
             Self::double(m)
         })
     }
-    fn has_ellipse_average(&self) -> bool {
-        true
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            ellipse_average: true,
+            own_averaging_space: self.averaging_space,
+            ..FieldCapabilities::default()
+        }
     }
     fn averaged(&self, p: &PlanePoint) -> Coefficients {
         if self.averaging_space {
@@ -1151,9 +1156,6 @@ impl CoefficientField<PlanePoint> for Doubled {
         } else {
             mean
         }
-    }
-    fn averages_coefficients(&self) -> bool {
-        !self.averaging_space
     }
 }
 

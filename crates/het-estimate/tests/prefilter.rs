@@ -8,6 +8,7 @@
 //! mean, sqrt(p(1 − p)/N), plus 1e-12.
 
 use glam::{DVec2, DVec3};
+use het_estimate::FieldCapabilities;
 use het_estimate::analytic::{CheckField, Plane, PlanePoint, StripeField};
 use het_estimate::pattern::{BinaryPattern, Check, Stripe};
 use het_estimate::prefilter::{FootprintWeight, PlaneFootprint, check_fraction, stripe_fraction};
@@ -323,8 +324,11 @@ impl CoefficientField<SpherePoint> for ProjectedStripe {
             sigma_s: v0.sigma_s * (1.0 - f) + v1.sigma_s * f,
         })
     }
-    fn has_ellipse_average(&self) -> bool {
-        true
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            ellipse_average: true,
+            ..FieldCapabilities::default()
+        }
     }
 }
 

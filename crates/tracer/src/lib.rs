@@ -19,6 +19,7 @@ pub mod integrator;
 pub mod interrupt;
 pub mod light;
 pub mod memory;
+pub mod optical_size;
 pub mod output;
 pub mod render;
 pub mod rng;

@@ -30,7 +30,7 @@ use std::sync::OnceLock;
 
 use super::angular_file::{ANGULAR_ETAS, AngularData, N_MU, index};
 use super::grid::N_ALBEDO;
-use super::profile::{row_position, table};
+use super::half_space::{row_position, table};
 use crate::fresnel::{dielectric, fresnel_moment};
 use crate::model::Scattering;
 

@@ -39,6 +39,25 @@ pub fn albedo_of_row_in(k: usize, rows: usize) -> f64 {
     1.0 - s * s
 }
 
+// The slab table's grid (`super::slab`): thicknesses, refractive indices and albedo rows.
+
+/// Optical thicknesses σt·d (mean free paths) of the slab table's planes.
+pub const SLAB_THICKNESSES: [f64; 7] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
+/// Relative refractive indices of the slab table's planes (uniform; cubic interpolation between).
+pub const SLAB_ETAS: [f64; 5] = [1.0, 1.15, 1.3, 1.45, 1.6];
+/// Number of slab albedo rows: `s = √(1 − α)` geometric from [`S_MIN`] to 1.
+pub const SLAB_ROWS: usize = 16;
+
+/// `s = √(1 − α)` of slab row `k`.
+pub fn slab_s_of_row(k: usize) -> f64 {
+    s_of_row_in(k, SLAB_ROWS)
+}
+
+/// Albedo α of slab row `k`.
+pub fn slab_albedo_of_row(k: usize) -> f64 {
+    albedo_of_row_in(k, SLAB_ROWS)
+}
+
 /// Radial bins in optical units x = σt·r: bin 0 is `[0, X_FIRST)`, then [`BINS_PER_DECADE`]
 /// geometric bins per decade up to [`X_LAST`]; exits beyond count in the totals only.
 pub const X_FIRST: f64 = 1e-3;

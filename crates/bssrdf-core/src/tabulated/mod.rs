@@ -20,7 +20,7 @@ pub mod angular_file;
 #[cfg_attr(not(feature = "tabulate"), allow(dead_code, unused_imports))]
 pub mod file;
 pub mod grid;
-pub mod profile;
+pub mod half_space;
 #[cfg(feature = "tabulate")]
 pub mod simulate;
 #[cfg(not(feature = "tabulate"))]
@@ -31,5 +31,5 @@ pub mod slab;
 pub mod slab_file;
 
 pub use angular::AngularCoupling;
-pub use profile::TabulatedTerm;
+pub use half_space::TabulatedTerm;
 pub use slab::{SlabFace, SlabTerm};

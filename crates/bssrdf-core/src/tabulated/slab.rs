@@ -28,29 +28,13 @@
 
 use std::sync::OnceLock;
 
-use super::grid::{albedo_of_row_in, s_of_row_in};
-use super::profile::{
+use super::half_space::{
     Corner, POOL_REL_SE, RowTotals, TabulatedTerm, conserve_bin_masses, eta_weights, radial_value,
     row_position, totals_between_rows,
 };
 use super::slab_file::{SlabData, SlabPlane};
 
-/// Optical thicknesses σt·d (mean free paths) of the table's planes.
-pub const SLAB_THICKNESSES: [f64; 7] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0];
-/// Relative refractive indices of the table's planes (uniform; cubic interpolation between).
-pub const SLAB_ETAS: [f64; 5] = [1.0, 1.15, 1.3, 1.45, 1.6];
-/// Number of albedo rows: `s = √(1 − α)` geometric from [`super::grid::S_MIN`] to 1.
-pub const SLAB_ROWS: usize = 16;
-
-/// `s = √(1 − α)` of slab row `k`.
-pub fn slab_s_of_row(k: usize) -> f64 {
-    s_of_row_in(k, SLAB_ROWS)
-}
-
-/// Albedo α of slab row `k`.
-pub fn slab_albedo_of_row(k: usize) -> f64 {
-    albedo_of_row_in(k, SLAB_ROWS)
-}
+pub use super::grid::{SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, slab_albedo_of_row, slab_s_of_row};
 
 /// The data file built into the crate (regenerate with `het-bssrdf tabulate --slab`).
 static DATA: &[u8] = include_bytes!("../../data/slab-profile-v1.bin");

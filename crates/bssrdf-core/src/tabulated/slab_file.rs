@@ -30,8 +30,8 @@ use super::file::{
     put_f64s,
 };
 use super::grid::{N_BINS, bin_of};
+use super::grid::{SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, slab_albedo_of_row};
 use super::simulate::{ExitSums, Face, Stream, add_into, for_each_row_weight, in_chunks, trace};
-use super::slab::{SLAB_ETAS, SLAB_ROWS, SLAB_THICKNESSES, slab_albedo_of_row};
 
 const MAGIC: &[u8; 8] = b"HBSSRDFS";
 /// Format version of the slab table.

@@ -224,38 +224,13 @@ pub fn permissions_ignored(dir: &Path) -> bool {
     ignored
 }
 
-/// A small valid scene: an index-matched translucent box lit from above, seen by an
-/// orthographic camera, 8 × 8 pixels at 1 spp.
-pub const MINIMAL: &str = r#"[render]
-width = 8
-height = 8
-spp = 1
-
-[camera]
-type = "orthographic"
-centre = [0.0, 0.0, 5.0]
-direction = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-width = 10.0
-height = 10.0
-
-[[material]]
-name = "m"
-type = "translucent"
-sigma_a = 0.1
-sigma_s = 1.0
-
-[[light]]
-type = "directional"
-direction = [0.0, 0.0, -1.0]
-irradiance = 1.0
-
-[[shape]]
-type = "box"
-material = "m"
-min = [-1.0, -1.0, -1.0]
-max = [1.0, 1.0, 0.0]
-"#;
+/// A small valid scene: the shared minimal scene (`tests/fixtures/minimal-scene.toml`, an
+/// index-matched translucent box seen by an orthographic camera, 8 × 8 pixels at 1 spp) lit
+/// from above.
+pub const MINIMAL: &str = concat!(
+    include_str!("../../../../tests/fixtures/minimal-scene.toml"),
+    "\n[[light]]\ntype = \"directional\"\ndirection = [0.0, 0.0, -1.0]\nirradiance = 1.0\n"
+);
 
 /// `text` with `from` replaced by `to`; panics if `from` is absent (so that a test can never
 /// silently run the unmodified scene).

@@ -32,7 +32,9 @@ use bssrdf_core::Rgb;
 use glam::{DVec2, DVec3};
 use het_estimate::pattern::{BinaryPattern, Check, Stripe};
 use het_estimate::prefilter::{PlaneFootprint, check_fraction, stripe_fraction};
-use het_estimate::{CoefficientField, Coefficients, FieldBounds, PlanarEllipse, UvChart};
+use het_estimate::{
+    CoefficientField, Coefficients, FieldBounds, FieldCapabilities, PlanarEllipse, UvChart,
+};
 
 use crate::error::FieldError;
 use crate::geometry::Hit;
@@ -874,7 +876,7 @@ impl MediumField {
     /// (`Texture::area_table`); a render calls this while it is prepared, so that no sample
     /// waits for a table.
     pub fn build_area_tables(&self) {
-        if !CoefficientField::<Hit>::has_ellipse_average(self) {
+        if !CoefficientField::<Hit>::capabilities(self).ellipse_average {
             return;
         }
         for field in [&self.sigma_a, &self.sigma_s] {
@@ -887,7 +889,7 @@ impl MediumField {
     /// The textures whose summed-area tables [`MediumField::build_area_tables`] would build
     /// (none already built), for a memory estimate before a render is prepared.
     pub fn area_table_textures(&self) -> Vec<&Arc<Texture>> {
-        if !CoefficientField::<Hit>::has_ellipse_average(self) {
+        if !CoefficientField::<Hit>::capabilities(self).ellipse_average {
             return Vec::new();
         }
         [&self.sigma_a, &self.sigma_s]
@@ -987,11 +989,19 @@ impl CoefficientField<Hit> for MediumField {
         self.both_averages(|f| f.ellipse_average(e))
     }
 
-    /// True unless the medium is an artist medium inverted before averaging: every field has a
-    /// constant-time average for some regions (UV-mapped images through a chart,
-    /// [`CoefficientField::ellipse_average_in_chart`]).
-    fn has_ellipse_average(&self) -> bool {
-        self.artist.is_none() || self.inverts_after()
+    /// Constant-time region averages unless the medium is an artist medium inverted before
+    /// averaging (every field has one for some regions: UV-mapped images through a chart,
+    /// [`CoefficientField::ellipse_average_in_chart`]); texture coordinates when either field
+    /// is a UV-mapped image; point lookups in space otherwise; the colour and mean free path
+    /// as averaging space for an artist medium inverted after averaging.
+    #[inline]
+    fn capabilities(&self) -> FieldCapabilities {
+        FieldCapabilities {
+            ellipse_average: self.artist.is_none() || self.inverts_after(),
+            reads_uv: !self.volumetric,
+            point_lookup: self.is_volumetric(),
+            own_averaging_space: self.inverts_after(),
+        }
     }
 
     /// The smaller of the two fields' [`Field::displacement_scale`] (an artist medium's colour
@@ -1002,11 +1012,6 @@ impl CoefficientField<Hit> for MediumField {
                 .displacement_scale(e)
                 .min(self.sigma_s.displacement_scale(e)),
         )
-    }
-
-    /// True when either field is a UV-mapped image.
-    fn reads_uv(&self) -> bool {
-        !self.volumetric
     }
 
     /// Both fields' [`Field::ellipse_average_in_chart`]; `None` as for
@@ -1045,10 +1050,6 @@ impl CoefficientField<Hit> for MediumField {
         Some(self.in_averaging_space(self.raw_at_surface(x, DVec2::ZERO)))
     }
 
-    fn has_point_lookup(&self) -> bool {
-        self.is_volumetric()
-    }
-
     /// Each field decides what it is once for all the points ([`Field::eval_points`]).
     fn averaged_at_points(&self, xs: &[DVec3], out: &mut [Coefficients]) -> bool {
         if !self.is_volumetric() {
@@ -1065,11 +1066,6 @@ impl CoefficientField<Hit> for MediumField {
         } else {
             mean
         }
-    }
-
-    #[inline]
-    fn averages_coefficients(&self) -> bool {
-        !self.inverts_after()
     }
 }
 

@@ -13,18 +13,9 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use super::area_table::AreaTable;
+pub use super::texture_mapping::Wrap;
 
 use crate::error::TextureError;
-
-/// How lookups outside `[0, 1]²` behave.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub enum Wrap {
-    /// Tile the image.
-    #[default]
-    Repeat,
-    /// Extend the edge texels.
-    Clamp,
-}
 
 /// Reconstruction filter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -270,7 +261,9 @@ impl Texture {
     /// thread-safe; later calls wait for or share it). Only prefiltered averaging calls this,
     /// so textures read by other methods never pay for a table.
     pub fn area_table(&self) -> &AreaTable {
-        self.area.0.get_or_init(|| AreaTable::build(self))
+        self.area
+            .0
+            .get_or_init(|| AreaTable::build(self.width, self.height, &self.texels))
     }
 
     /// True once [`Texture::area_table`] has built the table (observability for tests and

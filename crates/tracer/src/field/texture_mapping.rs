@@ -1,9 +1,20 @@
 //! Planar projection: the map from a 3-D point to the 2-D coordinates `(s, t)` of a pattern or
 //! a planar-mapped image. The field is then constant along the projection axis (the paper's
-//! assumption that coefficients vary only along tangent directions, §3.1).
+//! assumption that coefficients vary only along tangent directions, §3.1). Also how an image
+//! repeats beyond its edges ([`Wrap`]).
 
 use glam::{DVec2, DVec3};
 use het_estimate::prefilter::PlaneFootprint;
+
+/// How lookups outside `[0, 1]²` behave.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Wrap {
+    /// Tile the image.
+    #[default]
+    Repeat,
+    /// Extend the edge texels.
+    Clamp,
+}
 
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]

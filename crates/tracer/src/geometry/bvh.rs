@@ -12,15 +12,13 @@ use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use glam::{DVec2, DVec3, Vec3A};
+use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::reinsertion::ReinsertionOptimizer;
 use obvhs::cwbvh::CwBvh;
-use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
-use obvhs::ploc::PlocBuilder;
 use obvhs::ray::{Ray as BvhRay, RayHit};
-use obvhs::{Boundable, BvhBuildParams};
 
-use super::tlas::{Tlas, slab};
+use super::cwbvh::{PaddedBox, build_cwbvh, safe_inv, slab};
+use super::tlas::Tlas;
 use super::watertight::{LeafTri, ShearedRay, refine_f64};
 use het_estimate::{Projected, UvChart};
 
@@ -58,15 +56,6 @@ fn box_pad(lo: DVec3, hi: DVec3) -> DVec3 {
             0.0
         } + 1e-30,
     )
-}
-
-/// A triangle's padded bounding box, what the BVH is built on.
-pub(super) struct PaddedBox(pub(super) Aabb);
-
-impl Boundable for PaddedBox {
-    fn aabb(&self) -> Aabb {
-        self.0
-    }
 }
 
 /// One object's acceleration structure.
@@ -154,41 +143,11 @@ impl RayCounter {
     }
 }
 
-/// `1/x` for the BVH node test, finite and with the sign convention of obvhs's octant test
-/// (`x < 0` ⇔ negative inverse; `±0` → `+1e30`).
-#[inline]
-pub(super) fn safe_inv(x: f32) -> f32 {
-    if x == 0.0 {
-        1e30
-    } else {
-        (1.0 / x).clamp(-1e30, 1e30)
-    }
-}
-
 /// The `f32` ray of one object's scaled space.
 #[derive(Clone, Copy)]
 struct ScaledRay {
     bvh: BvhRay,
     sheared: ShearedRay,
-}
-
-/// Builds the CWBVH as obvhs's `cwbvh::builder::build_cwbvh` helper does (PLOC, reinsertion,
-/// conversion to the 8-wide tree), minus the helper's `validate()` in debug builds: that check
-/// asserts node quantisation origins within an absolute 1e-5 of their parent's bounds, below
-/// f32 resolution at the scaled coordinates used here (up to ~4e3, ulp 2.4e-4), and it panicked
-/// on valid scenes when debug assertions are on (found by the scene fuzzer,
-/// `tests/fuzz_regressions.rs`). The origins' rounding is harmless: children are quantised
-/// conservatively relative to them. The BVH is checked against brute force in the tests.
-pub(super) fn build_cwbvh(boxes: &[PaddedBox], config: BvhBuildParams) -> CwBvh {
-    let mut bvh2 = PlocBuilder::with_capacity(boxes.len()).build(
-        config.ploc_search_distance,
-        boxes,
-        (0..boxes.len() as u32).collect(),
-        config.sort_precision,
-        config.search_depth_threshold,
-    );
-    ReinsertionOptimizer::default().run(&mut bvh2, config.reinsertion_batch_ratio, None);
-    bvh2_to_cwbvh(&bvh2, config.max_prims_per_leaf.clamp(1, 3), true, false)
 }
 
 impl ObjectAccel {

@@ -25,6 +25,7 @@
 mod bvh;
 pub mod closest;
 mod curvature;
+mod cwbvh;
 #[cfg(feature = "gltf")]
 pub mod gltf;
 pub mod gltf_assets;
@@ -36,16 +37,16 @@ pub mod mesh;
 pub mod obj;
 #[cfg(feature = "obj")]
 mod obj_lines;
+pub mod object_surface;
 #[cfg(feature = "ply")]
 pub mod ply;
 pub mod primitives;
-pub mod surface;
 mod tlas;
 mod watertight;
 
 pub use bvh::Geometry;
 pub use mesh::{MeshReport, Transform, TriangleMesh};
-pub use surface::ObjectSurface;
+pub use object_surface::ObjectSurface;
 
 use glam::{DVec2, DVec3};
 

@@ -24,7 +24,7 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray as BvhRay, RayHit};
 
-use super::bvh::{PaddedBox, build_cwbvh, safe_inv};
+use super::cwbvh::{PaddedBox, build_cwbvh, safe_inv, slab};
 
 /// Target extent of the scene in the tree's scaled space: 2¹², as for objects.
 const SCALED_EXTENT_LOG2: i32 = 12;
@@ -46,26 +46,6 @@ pub(crate) struct Tlas {
     hi: DVec3,
     centre: DVec3,
     scale: f64,
-}
-
-/// Entry distance of the ray into `[lo, hi]` within `[t_min, t_max]`, if it enters.
-#[inline]
-pub(crate) fn slab(
-    lo: DVec3,
-    hi: DVec3,
-    origin: DVec3,
-    inv_dir: DVec3,
-    t_min: f64,
-    t_max: f64,
-) -> Option<f64> {
-    let t0 = (lo - origin) * inv_dir;
-    let t1 = (hi - origin) * inv_dir;
-    let near = t0.min(t1);
-    let far = t0.max(t1);
-    // NaN (0 · inf) components are ignored by max/min of f64 (they return the other).
-    let enter = near.max_element().max(t_min);
-    let exit = far.min_element().min(t_max);
-    (enter <= exit).then_some(enter)
 }
 
 /// `x` rounded to `f32` toward −∞ (`down`) or +∞.

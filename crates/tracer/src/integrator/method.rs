@@ -10,9 +10,8 @@ use super::Method;
 
 impl FromStr for Method {
     type Err = String;
-    /// `pt`, `auto` ([`Method::auto`]), or an estimator name (`jensen-in`, `jensen-out`,
-    /// `endpoints`, `segment`, `sone`, `kernel`) with the estimator's default parameters and
-    /// each material's own profile.
+    /// `pt`, `auto` ([`Method::auto`]), or an estimator name (those of [`Estimator::ALL`])
+    /// with the estimator's default parameters and each material's own profile.
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "pt" => return Ok(Method::PathTraced),
@@ -34,37 +33,15 @@ impl FromStr for Method {
 }
 
 impl Method {
-    /// The method with `n` averaging samples per region (segment: on the chord; Sone: in the
-    /// disk and in the ellipse; kernel: points drawn around the chord, at most
-    /// `KernelParams::MAX_SAMPLES`, which `prepare` enforces); other methods are unchanged.
-    pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
-        let Some(n) = n else { return self };
-        let budget = het_estimate::SampleBudget::fixed(n.max(1));
+    /// The BSSRDF method's estimator changed by `f`; the path tracer unchanged.
+    fn map_estimator(self, f: impl FnOnce(Estimator) -> Estimator) -> Self {
         match self {
             Method::Bssrdf {
-                estimator: Estimator::Segment(p),
+                estimator,
                 profile,
                 policy,
             } => Method::Bssrdf {
-                estimator: Estimator::Segment(p.with_samples(budget)),
-                profile,
-                policy,
-            },
-            Method::Bssrdf {
-                estimator: Estimator::Sone(p),
-                profile,
-                policy,
-            } => Method::Bssrdf {
-                estimator: Estimator::Sone(p.with_samples(budget)),
-                profile,
-                policy,
-            },
-            Method::Bssrdf {
-                estimator: Estimator::Kernel(p),
-                profile,
-                policy,
-            } => Method::Bssrdf {
-                estimator: Estimator::Kernel(p.with_samples(budget)),
+                estimator: f(estimator),
                 profile,
                 policy,
             },
@@ -72,78 +49,53 @@ impl Method {
         }
     }
 
-    /// The method with Sone's or the kernel's averaging set to `averaging` (prefiltered or
-    /// Monte Carlo); other methods are unchanged.
+    /// The estimator of a BSSRDF method (`None` for the path tracer).
+    fn estimator(&self) -> Option<Estimator> {
+        match self {
+            Method::Bssrdf { estimator, .. } => Some(*estimator),
+            _ => None,
+        }
+    }
+
+    /// The method with `n` averaging samples per region ([`Estimator::with_samples`]); methods
+    /// whose estimator takes none are unchanged.
+    pub fn with_estimator_samples(self, n: Option<u32>) -> Self {
+        let Some(n) = n else { return self };
+        let budget = het_estimate::SampleBudget::fixed(n.max(1));
+        self.map_estimator(|e| e.with_samples(budget))
+    }
+
+    /// The method with its estimator's averaging set to `averaging` (prefiltered or Monte
+    /// Carlo, [`Estimator::with_averaging`]); other methods and `None` leave it unchanged.
     pub fn with_averaging(self, averaging: Option<het_estimate::Averaging>) -> Self {
-        match (self, averaging) {
-            (
-                Method::Bssrdf {
-                    estimator,
-                    profile,
-                    policy,
-                },
-                Some(a),
-            ) => Method::Bssrdf {
-                estimator: match estimator {
-                    Estimator::Sone(p) => Estimator::Sone(p.with_averaging(a)),
-                    Estimator::Kernel(p) => Estimator::Kernel(p.with_averaging(a)),
-                    e => e,
-                },
-                profile,
-                policy,
-            },
-            (m, _) => m,
+        match averaging {
+            Some(a) => self.map_estimator(|e| e.with_averaging(a)),
+            None => self,
         }
     }
 
-    /// The same method with Sone's semi-minor axis reading of Eq. (2) replaced by
-    /// `semi_minor` (b = w, the default, or b = w/2, the literal reading); other methods and
-    /// `None` leave it unchanged.
+    /// The same method with the semi-minor axis reading of Eq. (2) replaced by `semi_minor`
+    /// ([`Estimator::with_semi_minor`]); other methods and `None` leave it unchanged.
     pub fn with_semi_minor(self, semi_minor: Option<het_estimate::SemiMinorAxis>) -> Self {
-        match (self, semi_minor) {
-            (
-                Method::Bssrdf {
-                    estimator: Estimator::Sone(mut p),
-                    profile,
-                    policy,
-                },
-                Some(b),
-            ) => {
-                p.semi_minor = b;
-                Method::Bssrdf {
-                    estimator: Estimator::Sone(p),
-                    profile,
-                    policy,
-                }
-            }
-            (m, _) => m,
+        match semi_minor {
+            Some(b) => self.map_estimator(|e| e.with_semi_minor(b)),
+            None => self,
         }
     }
 
-    /// Sone's semi-minor axis reading (`None` for other methods).
+    /// The estimator's semi-minor axis reading (`None` for methods without one).
     pub fn semi_minor(&self) -> Option<het_estimate::SemiMinorAxis> {
-        match self {
-            Method::Bssrdf {
-                estimator: Estimator::Sone(p),
-                ..
-            } => Some(p.semi_minor),
-            _ => None,
-        }
+        self.estimator().and_then(|e| e.semi_minor())
     }
 
-    /// Sone's or the kernel's averaging (`None` for other methods).
+    /// The estimator's averaging (`None` for methods without one).
     pub fn averaging(&self) -> Option<het_estimate::Averaging> {
-        match self {
-            Method::Bssrdf {
-                estimator: Estimator::Sone(p),
-                ..
-            } => Some(p.averaging),
-            Method::Bssrdf {
-                estimator: Estimator::Kernel(p),
-                ..
-            } => Some(p.averaging),
-            _ => None,
-        }
+        self.estimator().and_then(|e| e.averaging())
+    }
+
+    /// The options the method's estimator takes (none for the path tracer).
+    pub fn estimator_options(&self) -> het_estimate::EstimatorOptions {
+        self.estimator().map(|e| e.options()).unwrap_or_default()
     }
 
     /// The method with its profile model overridden (BSSRDF methods only).

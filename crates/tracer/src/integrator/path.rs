@@ -89,7 +89,7 @@ pub struct Policy {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Correction {
     /// Each material's own `shape_correction` where it sets one; else the objects too small
-    /// for a half-space profile ([`crate::integrator::warnings::is_optically_small`]). The
+    /// for a half-space profile ([`crate::optical_size::is_optically_small`]). The
     /// default of `render` and of `--method auto`.
     Auto,
     /// Each material's own `shape_correction`, off where it sets none: the library's default
@@ -147,7 +147,7 @@ pub enum Coverage {
     #[default]
     Every,
     /// The objects a half-space profile fits; the optically small ones
-    /// ([`crate::integrator::warnings::is_optically_small`]) are path traced, where the path
+    /// ([`crate::optical_size::is_optically_small`]) are path traced, where the path
     /// tracer can walk them (`--method auto`).
     HalfSpaceOnly,
 }

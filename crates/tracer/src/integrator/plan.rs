@@ -2,8 +2,8 @@
 //! without the shape correction. One decision, read by the integrator that prepares the
 //! render, by the warnings and by the sidecar.
 
-use crate::integrator::warnings::is_optically_small;
 use crate::integrator::{Coverage, Method};
+use crate::optical_size::is_optically_small;
 use crate::scene::Scene;
 
 /// How one translucent object is rendered.

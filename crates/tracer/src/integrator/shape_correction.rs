@@ -79,7 +79,7 @@ use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::preparation::PrepareObserver;
 use crate::integrator::walk::{reflect, refract};
-use crate::integrator::warnings::light_reach;
+use crate::optical_size::light_reach;
 use crate::rng::Rng;
 use crate::volume::{direction_about, orthonormal_basis};
 
@@ -691,14 +691,14 @@ fn point_sums(
                 if !(majorant > 0.0 && majorant.is_finite()) {
                     continue;
                 }
-                WalkMedium::Field { field, channel: ch }
+                EscapeMedium::Field { field, channel: ch }
             }
             None => {
                 let sigma_t = coeffs.sigma_a[ch] + coeffs.sigma_s[ch];
                 if !(sigma_t > 0.0 && sigma_t.is_finite()) {
                     continue;
                 }
-                WalkMedium::Homogeneous {
+                EscapeMedium::Homogeneous {
                     sigma_t,
                     albedo: coeffs.sigma_s[ch] / sigma_t,
                 }
@@ -1066,7 +1066,7 @@ impl Boundary<'_> {
 
 /// What a walk scatters in.
 #[derive(Clone, Copy)]
-enum WalkMedium<'m> {
+enum EscapeMedium<'m> {
     /// One σt (1/length) and single-scattering albedo everywhere: x_o's coefficients.
     Homogeneous { sigma_t: f64, albedo: f64 },
     /// The medium's own field, in one channel (its majorant σ̄ ≥ σt everywhere must be
@@ -1090,7 +1090,7 @@ const MIN_TRANSMITTANCE: f64 = 1e-9;
 
 /// A walk's medium and which escapes count.
 struct Walk<'m> {
-    medium: WalkMedium<'m>,
+    medium: EscapeMedium<'m>,
     g: f64,
     eta: f64,
     orders: Scattering,
@@ -1119,10 +1119,10 @@ impl Walk<'_> {
             return 0.0;
         };
         match self.medium {
-            WalkMedium::Homogeneous { sigma_t, albedo } => {
+            EscapeMedium::Homogeneous { sigma_t, albedo } => {
                 self.escape_homogeneous(sigma_t, albedo, boundary, x_o, d, w, rng)
             }
-            WalkMedium::Field { field, channel } => {
+            EscapeMedium::Field { field, channel } => {
                 let majorant = field.majorant()[channel];
                 let sigma = |p: DVec3| {
                     let c = field.at_point(p);
@@ -1511,7 +1511,7 @@ mod tests {
 
     /// The mean and standard error of `n` escapes from the origin of the half-space z < 0
     /// (η 1, g 0, all orders), leaving along `w_o`, in `medium`.
-    fn escapes(medium: WalkMedium<'_>, w_o: DVec3, n: u64) -> (f64, f64) {
+    fn escapes(medium: EscapeMedium<'_>, w_o: DVec3, n: u64) -> (f64, f64) {
         let plane = TangentPlane {
             p0: DVec3::ZERO,
             n: DVec3::Z,
@@ -1549,11 +1549,11 @@ mod tests {
         for (mu, albedo) in [(1.0_f64, 0.41494748), (0.5, 0.507939)] {
             let w_o = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
             let media = [
-                WalkMedium::Field {
+                EscapeMedium::Field {
                     field: &field,
                     channel: 0,
                 },
-                WalkMedium::Homogeneous {
+                EscapeMedium::Homogeneous {
                     sigma_t: 1.0,
                     albedo: 0.9,
                 },
@@ -1576,13 +1576,13 @@ mod tests {
     #[test]
     fn tracked_walks_see_the_medium_below_the_surface() {
         let field = checks(0.1, [0.0, 1000.0], 1.0);
-        let field_walks = WalkMedium::Field {
+        let field_walks = EscapeMedium::Field {
             field: &field,
             channel: 0,
         };
         let (mean, se) = escapes(field_walks, DVec3::Z, 4000);
         assert!(mean < 0.049 + 4.0 * se, "{mean} ± {se}");
-        let local = WalkMedium::Homogeneous {
+        let local = EscapeMedium::Homogeneous {
             sigma_t: 1.0,
             albedo: 1.0,
         };
@@ -1633,7 +1633,7 @@ mod tests {
         };
         let field = checks(4.0, [0.01, 0.5], 0.99);
         let walk = Walk {
-            medium: WalkMedium::Field {
+            medium: EscapeMedium::Field {
                 field: &field,
                 channel: 0,
             },

@@ -221,6 +221,17 @@ fn check_pos(what: &'static str, p: DVec3) -> Result<DVec3, LightError> {
 }
 
 impl Light {
+    /// The light's kind as scene files name it (`type = "…"`), for messages.
+    pub const fn kind(&self) -> &'static str {
+        match self {
+            Light::Directional(_) => "directional",
+            Light::Point(_) => "point",
+            Light::Quad(_) => "quad",
+            Light::Environment(_) => "environment",
+            Light::Beam(_) => "beam",
+        }
+    }
+
     /// Parallel light travelling along `direction` (normalised here).
     pub fn directional(direction: DVec3, irradiance: Rgb) -> Result<Light, LightError> {
         Ok(Light::Directional(DirectionalLight {

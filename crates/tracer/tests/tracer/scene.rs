@@ -314,32 +314,9 @@ pub(crate) fn check(e: &SceneError, key: &str, words: &[&str]) {
     }
 }
 
-pub(crate) const MINIMAL: &str = r#"
-[render]
-width = 8
-height = 8
-spp = 1
-
-[camera]
-type = "orthographic"
-centre = [0.0, 0.0, 5.0]
-direction = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-width = 10.0
-height = 10.0
-
-[[material]]
-name = "m"
-type = "translucent"
-sigma_a = 0.1
-sigma_s = 1.0
-
-[[shape]]
-type = "box"
-material = "m"
-min = [-1.0, -1.0, -1.0]
-max = [1.0, 1.0, 0.0]
-"#;
+/// The shared minimal scene (`tests/fixtures/minimal-scene.toml`): an index-matched
+/// translucent box seen by an orthographic camera, 8 × 8 pixels at 1 spp, no light.
+pub(crate) const MINIMAL: &str = include_str!("../../../../tests/fixtures/minimal-scene.toml");
 
 #[test]
 fn minimal_scene_loads_and_orthographic_camera_works() {
@@ -355,8 +332,8 @@ fn minimal_scene_loads_and_orthographic_camera_works() {
 #[test]
 fn malformed_toml() {
     let e = load_err(&MINIMAL.replace("spp = 1", "spp = = 1"));
-    assert!(matches!(e, SceneError::Parse { line: Some(5), .. }), "{e}");
-    assert!(e.to_string().contains("bad.toml:5"), "{e}");
+    assert!(matches!(e, SceneError::Parse { line: Some(4), .. }), "{e}");
+    assert!(e.to_string().contains("bad.toml:4"), "{e}");
 }
 
 #[test]

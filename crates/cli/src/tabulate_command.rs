@@ -81,7 +81,7 @@ fn simulate_and_write(
     what: &str,
     simulate: impl FnOnce(&mut dyn FnMut(usize)) -> (Vec<u8>, u64),
 ) -> anyhow::Result<()> {
-    let bar = experiments::progress::bar(planes as u64, "tabulate", "planes");
+    let bar = pipeline::progress::bar(planes as u64, "tabulate", "planes");
     let start = std::time::Instant::now();
     let (bytes, capped) = simulate(&mut |_| bar.inc(1));
     bar.finish_and_clear();

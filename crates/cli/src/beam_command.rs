@@ -15,8 +15,8 @@ use tracer::integrator::Method;
 use crate::common::{
     check_writable, parse_exr_out, parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{Given, RegionFlags, check_method_flags};
-use crate::interrupt;
+use crate::flags::EstimatorFlags;
+use crate::signals;
 
 /// Texture kinds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -156,20 +156,11 @@ impl SetupArgs {
 pub struct Args {
     #[command(flatten)]
     setup: SetupArgs,
-    /// `pt` (light tracing, the reference) or a BSSRDF estimator: jensen-in, jensen-out,
-    /// endpoints, segment, sone, kernel.
+    /// `pt` (light tracing, the reference) or a BSSRDF estimator (the other possible values).
     #[arg(long, value_parser = crate::choices::method(), default_value = "sone")]
     method: Method,
-    /// Profile model for BSSRDF methods (default: tabulated, the exact profile).
-    #[arg(long, value_parser = crate::choices::profile())]
-    profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
-    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
-    /// at most 1024).
-    #[arg(long, value_parser = parse_positive)]
-    estimator_samples: Option<u64>,
     #[command(flatten)]
-    region: RegionFlags,
+    estimator: EstimatorFlags,
     /// Photons for `pt` (rounded up to batches of 8192).
     #[arg(long, value_parser = parse_positive, conflicts_with = "time", allow_hyphen_values = true)]
     photons: Option<u64>,
@@ -202,7 +193,7 @@ pub fn run_method(
     show_progress: bool,
 ) -> anyhow::Result<BeamMap> {
     let bar = if !show_progress {
-        experiments::progress::ProgressBar::hidden()
+        pipeline::progress::ProgressBar::hidden()
     } else if method == Method::PathTraced {
         let len = match photons {
             PhotonBudget::Count(n) => {
@@ -210,9 +201,9 @@ pub fn run_method(
             }
             PhotonBudget::Time(_) => 0,
         };
-        experiments::progress::bar(len, "pt", "photons")
+        pipeline::progress::bar(len, "pt", "photons")
     } else {
-        experiments::progress::bar(setup.resolution as u64, method.name(), "rows")
+        pipeline::progress::bar(setup.resolution as u64, method.name(), "rows")
     };
     let map =
         experiments::beam::run_method(setup, method, profile, photons, subsamples, seed, &|k| {
@@ -242,16 +233,14 @@ fn check_subsamples(k: u64) -> anyhow::Result<u32> {
 const BEAM_BYTES_PER_PIXEL: f64 = 8.0 * 3.0 + 4.0 * 16.0 + 8.0 + 6.0;
 
 /// Runs the subcommand.
-pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
-    check_method_flags(
-        &[args.method],
-        given.has("profile"),
-        args.estimator_samples.is_some(),
-    )?;
-    args.region.check(&[args.method])?;
+pub fn run(args: Args) -> anyhow::Result<()> {
+    args.estimator.check(&[args.method])?;
     let setup = args.setup.setup()?;
     // The beam's half-space is index-matched (η = 1).
-    let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
+    let profile = args
+        .estimator
+        .profile
+        .unwrap_or(ProfileModel::default_for(1.0));
     let name = match args.method {
         Method::PathTraced => "pt".to_string(),
         m => format!("{}-{}", m.name(), profile),
@@ -273,16 +262,10 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     )
     .context("--resolution")?;
     set_collision_cap(args.max_collisions);
-    interrupt::install(interrupt::Mode::Finish)?;
-    let method = args.region.apply(
-        args.method.with_estimator_samples(
-            args.estimator_samples
-                .map(|n| n.min(u32::MAX as u64) as u32),
-        ),
-        None,
-    );
+    signals::install(signals::Mode::Finish)?;
+    let method = args.estimator.apply_options(args.method, None);
     let map = run_method(&setup, method, profile, photons, sub, args.seed, true)?;
-    let interrupted = interrupt::received().map(interrupt::name);
+    let interrupted = signals::received().map(signals::name);
     if let Some(signal) = interrupted
         && map.samples == 0
     {

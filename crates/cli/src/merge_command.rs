@@ -1,12 +1,12 @@
 //! `het-bssrdf merge`: assemble the shards written by `render --tile I/N` into the whole
-//! image (EXR, PNG preview and JSON sidecar); see `experiments::shard` for the partition, the
+//! image (EXR, PNG preview and JSON sidecar); see `pipeline::sharding` and `pipeline::shard_merge` for the partition, the
 //! checks and what a merge guarantees.
 
 use crate::diag::say;
 use std::path::{Path, PathBuf};
 
 use crate::common::{claim_outputs, parse_exr_out};
-use crate::interrupt;
+use crate::signals;
 
 /// Arguments of `het-bssrdf merge`.
 #[derive(Debug, clap::Args)]
@@ -27,7 +27,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sidecars: Vec<PathBuf> = args
         .shards
         .iter()
-        .map(|p| experiments::run::sidecar_paths(p).1)
+        .map(|p| pipeline::files::sidecar_paths(p).1)
         .collect();
     let inputs: Vec<&Path> = args
         .shards
@@ -36,8 +36,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(PathBuf::as_path)
         .collect();
     let _lock = claim_outputs(&args.out, &inputs)?;
-    interrupt::install(interrupt::Mode::Quit)?;
-    let summary = experiments::shard::merge(&args.shards, &args.out, args.exposure)?;
+    signals::install(signals::Mode::Quit)?;
+    let summary = pipeline::shard_merge::merge(&args.shards, &args.out, args.exposure)?;
     let (png, json) = &summary.sidecars;
     let spp = if summary.spp.0 == summary.spp.1 {
         format!("{} spp", summary.spp.0)

@@ -54,7 +54,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.out.display()
         )
     })?;
-    experiments::run::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
+    pipeline::files::check_dir_accepts_files(&args.out, &args.out.join("report.md"))
         .context("invalid --out")?;
     say!(
         "reproduce ({} scale): expected time {}; writing into {}",
@@ -62,7 +62,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         scale.expected,
         args.out.display()
     );
-    let bar = experiments::progress::ProgressBar::new_spinner();
+    let bar = pipeline::progress::ProgressBar::new_spinner();
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
     let start = Instant::now();
     let mut step = |msg: &str| {

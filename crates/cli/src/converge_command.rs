@@ -10,18 +10,19 @@ use anyhow::{Context, bail};
 use bssrdf_core::ProfileModel;
 use experiments::beam::{PhotonBudget, write_beam_map};
 use experiments::converge::{MethodSummary, check_dir, summarize_with_reference, write_outputs};
-use experiments::run::{RenderJob, write_render};
 use experiments::study::{
     BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
     reference_key, scene_reference, scene_study,
 };
+use pipeline::files::write_render;
+use pipeline::job::RenderJob;
 use tracer::integrator::Method;
 use tracer::output::read_exr;
 use tracer::scene::Scene;
 
-use crate::beam::{SetupArgs, run_method};
+use crate::beam_command::{SetupArgs, run_method};
 use crate::common::parse_positive;
-use crate::flags::{Given, RegionFlags, check_method_flags};
+use crate::flags::{EstimatorFlags, Given};
 
 /// Flags that set up the beam experiment: they do not apply to a scene.
 const BEAM_ONLY: &[&str] = &[
@@ -59,19 +60,11 @@ pub struct Args {
     beam: bool,
     #[command(flatten)]
     setup: SetupArgs,
-    /// Methods, comma-separated: `pt` and any of jensen-in, jensen-out, endpoints, segment, sone,
-    /// kernel.
+    /// Methods, comma-separated: `pt` and any of the BSSRDF estimators (the possible values).
     #[arg(long, value_delimiter = ',', value_parser = crate::choices::method(), default_value = "pt,jensen-out,endpoints,sone")]
     methods: Vec<Method>,
-    /// Profile model of the BSSRDF methods (scene: default each material's, else tabulated
-    /// where η ≤ 1.6 and pbd above; beam: tabulated).
-    #[arg(long, value_parser = crate::choices::profile())]
-    profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment, Sone and kernel estimators.
-    #[arg(long, value_parser = parse_positive)]
-    estimator_samples: Option<u64>,
     #[command(flatten)]
-    region: RegionFlags,
+    estimator: EstimatorFlags,
     /// A reference image (EXR). Default: path traced at `--reference-spp` (scene: cached in
     /// `--cache-dir` under a hash of everything the render reads) or `--reference-photons`
     /// (beam, in --out).
@@ -124,12 +117,6 @@ fn keep_latest<T>(finals: &mut Vec<(String, T)>, method: &str, item: T) {
     }
 }
 
-/// `--estimator-samples`, saturated to `u32`.
-fn estimator_samples(args: &Args) -> Option<u32> {
-    args.estimator_samples
-        .map(|n| n.min(u32::MAX as u64) as u32)
-}
-
 fn doubling(from: u64, to: u64) -> Vec<u64> {
     std::iter::successors(Some(from), |&v| Some(v * 2))
         .take_while(|&v| v <= to)
@@ -169,12 +156,7 @@ pub fn run(args: Args, given: &Given) -> anyhow::Result<()> {
     if args.methods.is_empty() {
         bail!("--methods: give at least one method");
     }
-    check_method_flags(
-        &args.methods,
-        args.profile.is_some(),
-        args.estimator_samples.is_some(),
-    )?;
-    args.region.check(&args.methods)?;
+    args.estimator.check(&args.methods)?;
     if args.beam {
         given.refuse(SCENE_ONLY, "with --beam (it applies to a scene study)")?;
     } else {
@@ -221,7 +203,7 @@ fn cache_dir(given: Option<&Path>, out: &Path) -> PathBuf {
         return out.to_path_buf();
     };
     let usable = std::fs::create_dir_all(&dir).is_ok()
-        && experiments::run::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
+        && pipeline::files::check_dir_accepts_files(&dir, &dir.join("reference-pt.exr")).is_ok();
     if usable {
         dir
     } else {
@@ -279,15 +261,9 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     let methods: Vec<Method> = args
         .methods
         .iter()
-        .map(|m| {
-            args.region.apply(
-                m.with_profile(args.profile)
-                    .with_estimator_samples(estimator_samples(args)),
-                scene.settings().averaging,
-            )
-        })
+        .map(|m| args.estimator.apply(*m, scene.settings().averaging))
         .collect();
-    let bar = experiments::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
+    let bar = pipeline::progress::bar((methods.len() * spp.len()) as u64, "converge", "runs");
     let mut finals = Vec::new();
     let mut log = RunLog::new(out);
     let runs = scene_study(
@@ -381,7 +357,10 @@ impl RunLog {
 fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     let setup = args.setup.setup()?;
     // The beam's half-space is index-matched (η = 1).
-    let profile = args.profile.unwrap_or(ProfileModel::default_for(1.0));
+    let profile = args
+        .estimator
+        .profile
+        .unwrap_or(ProfileModel::default_for(1.0));
     let given = args.reference.as_deref().map(read_exr).transpose()?;
     prepare_out(out)?;
     let reference: Vec<f64> = match given {
@@ -431,14 +410,13 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
             }
         })
         .sum();
-    let bar = experiments::progress::bar(runs_total as u64, "converge", "runs");
+    let bar = pipeline::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
     let mut log = RunLog::new(out);
-    let samples = estimator_samples(args);
     let methods: Vec<Method> = args
         .methods
         .iter()
-        .map(|m| args.region.apply(m.with_estimator_samples(samples), None))
+        .map(|&m| args.estimator.apply_options(m, None))
         .collect();
     let runs = beam_study(
         &setup,

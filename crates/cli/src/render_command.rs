@@ -6,11 +6,10 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use anyhow::{Context, bail};
-use bssrdf_core::{ProfileModel, Scattering};
-use experiments::run::{
-    RenderJob, RenderOutcome, render_scene_observed, sidecar_paths, write_render,
-};
+use bssrdf_core::Scattering;
 use het_estimate::{Estimator, SoneParams};
+use pipeline::files::{sidecar_paths, write_render};
+use pipeline::job::{RenderJob, RenderOutcome, render_scene_observed};
 use tracer::film::Film;
 use tracer::integrator::{Method, PathCounters};
 use tracer::render::{Budget, Partial};
@@ -21,8 +20,8 @@ use crate::common::{
     check_image_memory, check_writable, claim_outputs, note_triangles, parse_exr_out,
     parse_positive, parse_seconds, set_collision_cap, warn_counters,
 };
-use crate::flags::{RegionFlags, check_method_flags};
-use crate::interrupt;
+use crate::flags::EstimatorFlags;
+use crate::signals;
 
 /// Which way paths are traced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -44,8 +43,7 @@ pub struct Args {
     /// `auto` (default): each translucent object with the scene's `render.estimator` (else
     /// `sone`) where a half-space profile fits, and the path tracer inside objects too small
     /// for one (the sidecar's `objects` says which). `pt`: the path-traced reference
-    /// everywhere. An estimator (jensen-in, jensen-out, endpoints, segment, sone, kernel): that
-    /// BSSRDF on every object.
+    /// everywhere. An estimator (the other possible values): that BSSRDF on every object.
     #[arg(long, value_parser = crate::choices::method())]
     method: Option<Method>,
     /// Shape correction of BSSRDF objects (docs/shapes.md): `auto` corrects the objects too
@@ -54,17 +52,8 @@ pub struct Args {
     /// estimator named, each material's own `shape_correction` (off where it sets none).
     #[arg(long, value_parser = crate::choices::correction())]
     shape_correction: Option<tracer::integrator::Correction>,
-    /// Profile model for BSSRDF methods (default: each material's, else the tabulated exact
-    /// profile where it applies (η ≤ 1.6), else photon beam diffusion).
-    #[arg(long, value_parser = crate::choices::profile())]
-    profile: Option<ProfileModel>,
-    /// Averaging samples per region of the segment, Sone and kernel estimators (default: 16 on
-    /// the segment; 16 in the disk and 32 in the ellipse for Sone; 64 points for the kernel,
-    /// at most 1024).
-    #[arg(long, value_parser = parse_positive)]
-    estimator_samples: Option<u64>,
     #[command(flatten)]
-    region: RegionFlags,
+    estimator: EstimatorFlags,
     /// Where the estimators invert artist materials' colours and radii: `before` averaging
     /// (per point) or `after` (default: each material's `invert`; see
     /// docs/artist-parameters.md).
@@ -147,19 +136,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(c) => method.with_correction(c),
         None => method,
     };
-    check_method_flags(
-        &[method],
-        args.profile.is_some(),
-        args.estimator_samples.is_some(),
-    )?;
-    args.region.check(&[method])?;
-    let method = args.region.apply(
-        method.with_profile(args.profile).with_estimator_samples(
-            args.estimator_samples
-                .map(|n| n.min(u32::MAX as u64) as u32),
-        ),
-        scene.settings().averaging,
-    );
+    args.estimator.check(&[method])?;
+    let method = args.estimator.apply(method, scene.settings().averaging);
     let mut job = RenderJob::from_scene(&scene, method);
     if let Some(spp) = args.spp {
         job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);
@@ -179,7 +157,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     job.progress = true;
     if let Some(shard) = args.tile {
         job.shard = Some(
-            experiments::shard::ShardJob::new(shard, &scene)
+            pipeline::sharding::ShardJob::new(shard, &scene)
                 .with_context(|| format!("cannot hash the scene `{}`", args.scene.display()))?,
         );
     }
@@ -228,7 +206,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return run_light_traced(&scene, &job, &out, args.exposure, args.verbose);
     }
     set_collision_cap(args.max_collisions);
-    interrupt::install(interrupt::Mode::Finish)?;
+    signals::install(signals::Mode::Finish)?;
     let rays_before = scene.geometry().rays_traced();
     let write_checkpoint = |partial: &Partial<'_, PathCounters>| -> anyhow::Result<()> {
         let mut film = Film::new(partial.width, partial.height);
@@ -246,7 +224,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Ok(())
     };
     let observer = Checkpoints::new(
-        experiments::progress::RenderBar::new(
+        pipeline::progress::RenderBar::new(
             method.name(),
             width,
             args.tile.map_or(height, |t| t.rows(height)),
@@ -259,7 +237,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     observer.finish();
     let outcome = outcome.with_context(|| format!("cannot render `{}`", args.scene.display()))?;
     if outcome.interrupted {
-        let signal = interrupt::received().map_or("interrupt", interrupt::name);
+        let signal = signals::received().map_or("interrupt", signals::name);
         if outcome.spp == 0 {
             bail!("{signal} before the first pass completed; nothing written");
         }
