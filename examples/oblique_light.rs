@@ -111,7 +111,11 @@ fn scene(light: Lighting, sigma: (f64, f64), eta: f64) -> (Scene, f64) {
         .object(
             "half-space",
             primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
-            Material::Translucent(Translucent::new("m", field, 0.0, eta)),
+            // The oblique shape is opt-in (`oblique_shape = true` in a scene).
+            Material::Translucent(Translucent {
+                oblique_shape: true,
+                ..Translucent::new("m", field, 0.0, eta)
+            }),
         )
         .build()
         .unwrap();

@@ -38,6 +38,7 @@ fn quad_scene(coupled: bool) -> Scene {
             primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
             Material::Translucent(Translucent {
                 angular_coupling: coupled,
+                oblique_shape: coupled,
                 ..Translucent::new("m", field, 0.0, 1.0)
             }),
         )

@@ -143,8 +143,9 @@ impl BssrdfObject {
             && family.g().abs() <= SLAB_MAX_G;
         // The tabulated profile's angular coupling, unless the material turns it off
         // (`angular_coupling = false`).
-        let bssrdf =
-            SeparableBssrdf::from_family(family).with_angular_coupling(material.angular_coupling);
+        let bssrdf = SeparableBssrdf::from_family(family)
+            .with_angular_coupling(material.angular_coupling)
+            .with_oblique_shape(material.oblique_shape);
         let rough = boundary_table(material).map(|table| RoughBoundary {
             roughness: material
                 .roughness

@@ -709,6 +709,7 @@ impl Cx {
                 .shape_correction_seed
                 .unwrap_or(Translucent::DEFAULT_CORRECTION_SEED),
             angular_coupling: d.angular_coupling.unwrap_or(true),
+            oblique_shape: d.oblique_shape.unwrap_or(false),
             unit_scale: d.unit_scale,
             roughness: None,
             key: key.to_string(),
