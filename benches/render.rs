@@ -4,8 +4,9 @@
 //! ratios are stable on a shared machine.
 //!
 //! Run: `cargo bench --bench render`. Ids are `render/<method>` (`<estimator>-tabulated`: the
-//! same scene with the tabulated profile instead of the scene's dipole); criterion reports the time
-//! per 1024 camera samples and the throughput in samples/s. Compare methods as ratios.
+//! same scene with the tabulated profile instead of the scene's dipole; `… oblique` with its
+//! opt-in oblique shape); criterion reports the time per 1024 camera samples and the
+//! throughput in samples/s. Compare methods as ratios.
 //!
 //! `render/sone eta=1.3` and `render/sone eta=1.3 roughness=0.3` render the same slab with a
 //! refractive boundary, smooth and rough (docs/lighting-and-surfaces.md): their ratio is the
@@ -20,11 +21,17 @@ use het_bssrdf::tracer::integrator::{Method, PathIntegrator, PathOptions};
 use het_bssrdf::tracer::render::{RenderOptions, render};
 use het_bssrdf::tracer::scene::Scene;
 
-fn renders(c: &mut Criterion) {
-    let scene = Scene::from_toml_str(CHECKER_SLAB, std::path::Path::new("."), "checker-slab")
+/// The built-in checker slab at 32 × 32, its material's `eta = 1.0` line replaced by
+/// `material` (the material's other keys stay).
+fn slab(material: &str) -> Scene {
+    let text = CHECKER_SLAB.replace("eta = 1.0", material);
+    Scene::from_toml_str(&text, std::path::Path::new("."), "checker-slab")
         .expect("built-in scene")
         .with_resolution(32, 32)
-        .expect("positive");
+        .expect("positive")
+}
+
+fn renders(c: &mut Criterion) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
@@ -35,60 +42,43 @@ fn renders(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3))
         .sample_size(20);
-    for name in ["pt", "jensen-out", "endpoints", "segment", "sone"] {
-        let method: Method = name.parse().expect("built-in method");
-        let integrator = PathIntegrator::new(
-            &scene,
-            method,
-            PathOptions {
-                scattering: Scattering::Multiple,
-                max_depth: 8,
-            },
+    let method = |name: &str| -> Method { name.parse().expect("built-in method") };
+    let tabulated = |name: &str| {
+        Method::bssrdf(
+            name.parse().expect("built-in estimator"),
+            Some(ProfileModel::Tabulated),
         )
-        .expect("renderable");
-        let mut seed = 0;
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                seed += 1;
-                pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))
-            })
-        });
-    }
-    for (name, boundary) in [
-        ("sone eta=1.3", "eta = 1.3"),
-        ("sone eta=1.3 roughness=0.3", "eta = 1.3\nroughness = 0.3"),
-    ] {
-        let text = CHECKER_SLAB.replace("eta = 1.0", boundary);
-        let scene = Scene::from_toml_str(&text, std::path::Path::new("."), "checker-slab")
-            .expect("built-in scene")
-            .with_resolution(32, 32)
-            .expect("positive");
-        let method: Method = "sone".parse().expect("built-in method");
-        let integrator = PathIntegrator::new(
-            &scene,
-            method,
-            PathOptions {
-                scattering: Scattering::Multiple,
-                max_depth: 8,
-            },
-        )
-        .expect("renderable");
-        let mut seed = 0;
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                seed += 1;
-                pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))
-            })
-        });
-    }
-    // The same scene with the tabulated profile (and so its angular coupling and oblique
-    // shape, docs/oblique-incidence.md): the cost of the tabulated S per BSSRDF sample.
+    };
+    let mut cases: Vec<(String, Scene, Method)> =
+        ["pt", "jensen-out", "endpoints", "segment", "sone"]
+            .into_iter()
+            .map(|name| (name.to_string(), slab("eta = 1.0"), method(name)))
+            .collect();
+    // A refractive boundary, smooth and rough (docs/lighting-and-surfaces.md).
+    cases.push(("sone eta=1.3".into(), slab("eta = 1.3"), method("sone")));
+    cases.push((
+        "sone eta=1.3 roughness=0.3".into(),
+        slab("eta = 1.3\nroughness = 0.3"),
+        method("sone"),
+    ));
+    // The tabulated profile with its angular coupling, without and with the opt-in oblique
+    // shape (docs/oblique-incidence.md): the cost of the tabulated S per BSSRDF sample.
     for name in ["sone", "endpoints"] {
-        let estimator = name.parse().expect("built-in estimator");
-        let method = Method::bssrdf(estimator, Some(ProfileModel::Tabulated));
+        cases.push((
+            format!("{name}-tabulated"),
+            slab("eta = 1.0"),
+            tabulated(name),
+        ));
+        cases.push((
+            format!("{name}-tabulated oblique"),
+            slab("eta = 1.0\noblique_shape = true"),
+            tabulated(name),
+        ));
+    }
+    for (id, scene, method) in &cases {
         let integrator = PathIntegrator::new(
-            &scene,
-            method,
+            scene,
+            *method,
             PathOptions {
                 scattering: Scattering::Multiple,
                 max_depth: 8,
@@ -96,7 +86,7 @@ fn renders(c: &mut Criterion) {
         )
         .expect("renderable");
         let mut seed = 0;
-        group.bench_function(format!("{name}-tabulated"), |b| {
+        group.bench_function(id.as_str(), |b| {
             b.iter(|| {
                 seed += 1;
                 pool.install(|| render(32, 32, &integrator, &RenderOptions::samples(1, seed)))

@@ -25,4 +25,6 @@ pub mod render;
 pub mod rng;
 pub mod scene;
 pub mod spectral;
+#[cfg(test)]
+mod sphere_bins;
 pub mod volume;

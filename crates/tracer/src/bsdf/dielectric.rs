@@ -251,6 +251,7 @@ impl RoughDielectric {
 mod tests {
     use super::*;
     use crate::rng::Rng;
+    use crate::sphere_bins::SphereBins;
     use bssrdf_core::chi_square::ChiSquareTest;
     use std::f64::consts::PI;
 
@@ -317,41 +318,22 @@ mod tests {
         for (k, (alpha, cos_o)) in cases.into_iter().enumerate() {
             let b = RoughDielectric::new(1.33, alpha);
             let wo = direction(cos_o, 0.9);
-            let (nt, np, sub) = (40, 24, 10);
-            let mut expected = vec![0.0; nt * np + 1];
-            for a in 0..nt {
-                for c in 0..np {
-                    let mut s = 0.0;
-                    for e in 0..sub {
-                        for g in 0..sub {
-                            let cos =
-                                1.0 - 2.0 * (a as f64 + (e as f64 + 0.5) / sub as f64) / nt as f64;
-                            let phi =
-                                2.0 * PI * (c as f64 + (g as f64 + 0.5) / sub as f64) / np as f64;
-                            s += b.pdf(wo, direction(cos, phi));
-                        }
-                    }
-                    expected[a * np + c] = s / (sub * sub) as f64 * 4.0 * PI / (nt * np) as f64;
-                }
-            }
+            let bins = SphereBins { nt: 40, np: 24 };
+            let mut expected = bins.probabilities(10, |wi| b.pdf(wo, wi));
             let inside: f64 = expected.iter().sum();
             assert!(
                 inside <= 1.0 + 5e-3,
                 "α {alpha}, cos {cos_o}: ∫ pdf = {inside}"
             );
-            expected[nt * np] = (1.0 - inside).max(0.0);
+            expected.push((1.0 - inside).max(0.0));
+            let lost = bins.len();
             let n = 400_000;
-            let mut counts = vec![0u64; nt * np + 1];
+            let mut counts = vec![0u64; lost + 1];
             let mut rng = Rng::from_keys(8, &[k as u64]);
             for _ in 0..n {
                 match b.sample(wo, rng.uniform(), rng.uniform2()) {
-                    None => counts[nt * np] += 1,
-                    Some(s) => {
-                        let a = (((1.0 - s.wi.z) / 2.0 * nt as f64) as usize).min(nt - 1);
-                        let phi = s.wi.y.atan2(s.wi.x).rem_euclid(2.0 * PI);
-                        let c = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
-                        counts[a * np + c] += 1;
-                    }
+                    None => counts[lost] += 1,
+                    Some(s) => counts[bins.index(s.wi)] += 1,
                 }
             }
             let expected: Vec<f64> = expected.iter().map(|p| p * n as f64).collect();
@@ -476,34 +458,16 @@ mod tests {
                     0.0
                 }
             };
-            let (nt, np, sub) = (30, 20, 10);
-            let mut expected = vec![0.0; nt * np];
-            for a in 0..nt {
-                for c in 0..np {
-                    let mut s = 0.0;
-                    for x in 0..sub {
-                        for y in 0..sub {
-                            let cos =
-                                1.0 - 2.0 * (a as f64 + (x as f64 + 0.5) / sub as f64) / nt as f64;
-                            let phi =
-                                2.0 * PI * (c as f64 + (y as f64 + 0.5) / sub as f64) / np as f64;
-                            s += density(direction(cos, phi));
-                        }
-                    }
-                    expected[a * np + c] = s / (sub * sub) as f64 * 4.0 * PI / (nt * np) as f64;
-                }
-            }
+            let bins = SphereBins { nt: 30, np: 20 };
+            let expected = bins.probabilities(10, density);
             let total: f64 = expected.iter().sum();
             assert!((total - 1.0).abs() < 3e-3, "∫ density = {total}");
             let n = 200_000;
-            let mut counts = vec![0u64; nt * np];
+            let mut counts = vec![0u64; bins.len()];
             let mut rng = Rng::from_keys(31, &[k as u64]);
             for _ in 0..n {
                 let s = b.sample_conserving(wo, &mut rng).expect("no path is lost");
-                let a = (((1.0 - s.wi.z) / 2.0 * nt as f64) as usize).min(nt - 1);
-                let phi = s.wi.y.atan2(s.wi.x).rem_euclid(2.0 * PI);
-                let c = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
-                counts[a * np + c] += 1;
+                counts[bins.index(s.wi)] += 1;
             }
             let expected: Vec<f64> = expected.iter().map(|p| p * n as f64).collect();
             let r = test.check(&counts, &expected).unwrap();

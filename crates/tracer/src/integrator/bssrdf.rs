@@ -142,10 +142,13 @@ impl BssrdfObject {
             && family.model() == ProfileModel::Tabulated
             && family.g().abs() <= SLAB_MAX_G;
         // The tabulated profile's angular coupling, unless the material turns it off
-        // (`angular_coupling = false`).
-        let bssrdf = SeparableBssrdf::from_family(family)
-            .with_angular_coupling(material.angular_coupling)
-            .with_oblique_shape(material.oblique_shape);
+        // (`angular_coupling = false`), with its oblique shape where the material turns it on
+        // (`oblique_shape = true`); neither table is built unless kept.
+        let bssrdf = SeparableBssrdf::from_family_with(
+            family,
+            material.angular_coupling,
+            material.oblique_shape,
+        );
         let rough = boundary_table(material).map(|table| RoughBoundary {
             roughness: material
                 .roughness
@@ -355,12 +358,14 @@ impl BssrdfObject {
         let (alpha_i, alpha_o) = (self.alpha_at(x_i), self.alpha_at(x_o));
         let w = self.profile(surface, medium, x_i, x_o, rng, counters);
         let t = self.coupling(&w, w_i, n_i, w_o, n_o);
-        let s = if self.rough.is_some() && (alpha_i > 0.0 || alpha_o > 0.0) {
-            let fresnel = self.transmission(cos_i, alpha_i) * self.transmission(cos_o, alpha_o);
-            w.rd * (fresnel / (self.pair_norm(alpha_i, alpha_o) * PI)) * t
-        } else {
-            self.bssrdf.combine(w.rd, t, cos_i, cos_o)
-        };
+        // Through a smooth boundary (α = 0) the transmissions and normalisation are
+        // SeparableBssrdf's own, so this is its `combine` bit for bit.
+        let angular = SeparableBssrdf::boundary_factor(
+            self.transmission(cos_i, alpha_i),
+            self.transmission(cos_o, alpha_o),
+            self.pair_norm(alpha_i, alpha_o),
+        );
+        let s = w.rd * angular * t;
         match (
             self.correction_along(x_i, w_i, n_i),
             self.correction_along(x_o, w_o, n_o),

@@ -251,6 +251,7 @@ impl EnvironmentMap {
 mod tests {
     use super::*;
     use crate::rng::Rng;
+    use crate::sphere_bins::SphereBins;
     use bssrdf_core::chi_square::ChiSquareTest;
 
     /// A `w × h` map of random texels in [0, 4) (a few black), for the tests.
@@ -324,35 +325,15 @@ mod tests {
         let test = ChiSquareTest::family(1e-4, checks.len() as u32);
         for (up, rotation) in checks {
             let m = random_map(12, 6, up, rotation);
-            let (nt, np) = (20, 40);
+            let bins = SphereBins { nt: 20, np: 40 };
             // Enough sub-cells that the texels' edges crossing a bin do not bias it.
-            let sub = 48;
-            let mut expected = vec![0.0; nt * np];
-            for a in 0..nt {
-                for b in 0..np {
-                    let mut s = 0.0;
-                    for c in 0..sub {
-                        for e in 0..sub {
-                            let cos =
-                                1.0 - 2.0 * (a as f64 + (c as f64 + 0.5) / sub as f64) / nt as f64;
-                            let sin = (1.0 - cos * cos).max(0.0).sqrt();
-                            let phi =
-                                2.0 * PI * (b as f64 + (e as f64 + 0.5) / sub as f64) / np as f64;
-                            s += m.pdf(DVec3::new(sin * phi.cos(), sin * phi.sin(), cos));
-                        }
-                    }
-                    expected[a * np + b] = s / (sub * sub) as f64 * 4.0 * PI / (nt * np) as f64;
-                }
-            }
+            let expected = bins.probabilities(48, |d| m.pdf(d));
             let n = 400_000;
-            let mut counts = vec![0u64; nt * np];
+            let mut counts = vec![0u64; bins.len()];
             let mut rng = Rng::from_keys(9, &[up as u64]);
             for _ in 0..n {
                 let (d, _, _) = m.sample(rng.uniform2()).unwrap();
-                let a = (((1.0 - d.z) / 2.0 * nt as f64) as usize).min(nt - 1);
-                let phi = d.y.atan2(d.x).rem_euclid(2.0 * PI);
-                let b = ((phi / (2.0 * PI) * np as f64) as usize).min(np - 1);
-                counts[a * np + b] += 1;
+                counts[bins.index(d)] += 1;
             }
             let expected: Vec<f64> = expected.iter().map(|p| p * n as f64).collect();
             let r = test.check(&counts, &expected).unwrap();
