@@ -103,9 +103,9 @@ pub fn speedup_comment(study: &str, summary: &[MethodSummary]) -> String {
          tracing. Path tracing is cheap here: the slab's albedos (0.91 to 0.995) give paths of \
          about 7 collisions, and next-event estimation through its index-matched boundary \
          gives it low variance. A BSSRDF's cost does not depend on albedo, a path tracer's \
-         does: on the veined marble block (albedo 0.999, η 1.3) Sone is 11 to 14 times faster \
-         than path tracing to the same error, though only 2 to 3 times on the same marble as a \
-         sphere (docs/curved-objects.md, \"Curved surfaces\"; \
+         does: on the veined marble block (albedo 0.999, η 1.3) Sone is 28 to 39 times faster \
+         than path tracing to the same error, and 17 to 19 times on the same marble as a \
+         sphere (docs/curved-objects.md, \"Probes and light on curved surfaces\"; \
          `het-bssrdf converge examples/scenes/marble.toml`).\n",
         slow.join(", ")
     )

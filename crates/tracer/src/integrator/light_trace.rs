@@ -313,7 +313,7 @@ impl<'s> LightTracer<'s> {
         }
         let camera = scene.camera();
         let width = camera.resolution().0;
-        for &x_o in set.iter() {
+        for (&x_o, axis) in set.found() {
             let Some(c) = camera.connect(x_o.p) else {
                 continue;
             };
@@ -323,7 +323,7 @@ impl<'s> LightTracer<'s> {
                 continue;
             }
             // The point's weight 1/p(x), only for the points the camera sees.
-            let Some(weight) = density.weight(&x_o) else {
+            let Some(weight) = density.weight(&x_o, axis) else {
                 continue;
             };
             let s = match self.roles {

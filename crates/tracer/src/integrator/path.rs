@@ -43,7 +43,7 @@ use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
-use crate::integrator::lighting::{LightSet, power_heuristic};
+use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;
 use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
@@ -361,19 +361,28 @@ enum Prev {
     /// added when the reflection was chosen ([`PathIntegrator::mirror_emission`]): an emitter
     /// reached next counts zero, so that it is not counted twice; the environment counts fully.
     MirrorCounted,
-    /// A vertex where light sampling was also done: direction pdf (solid angle).
-    Sampled { p: DVec3, pdf: f64 },
+    /// A vertex where light sampling was also done: direction pdf (solid angle), and the kind
+    /// of vertex (which lights its light sampling could have chosen: [`LightSet::at`]).
+    Sampled { p: DVec3, pdf: f64, at: Vertex },
 }
 
 impl Prev {
     /// The light-sampled vertex and its direction pdf, if any.
     fn sampled(self) -> Option<(DVec3, f64)> {
         match self {
-            Prev::Sampled { p, pdf } => Some((p, pdf)),
+            Prev::Sampled { p, pdf, .. } => Some((p, pdf)),
             Prev::Specular | Prev::MirrorCounted => None,
         }
     }
 }
+
+/// The MIS weight below which a BSSRDF probe point other than the carrier gathers light only
+/// by Russian roulette ([`PathIntegrator::subsurface`]). The points this skips are a tangent
+/// probe's on a smooth surface (weights near 0 under the projection heuristic of
+/// `het_estimate::probe`); on a body narrower than the probe spheres, where the balance
+/// heuristic gives every probe a third or so, a threshold of 1 (roulette on every point) raised
+/// a light-against-camera test's standard error 1.6× (`tests/reciprocity.rs`).
+const ROULETTE_MIS: f64 = 0.2;
 
 /// The integrator: a [`PixelEstimator`] over a scene.
 pub struct PathIntegrator<'s> {
@@ -381,7 +390,9 @@ pub struct PathIntegrator<'s> {
     method: Method,
     options: PathOptions,
     objects: Vec<ObjectKind<'s>>,
-    lights: LightSet,
+    /// The lights next-event estimation samples on surfaces and in media ([`LightSet::at`]).
+    surface_lights: LightSet,
+    medium_lights: LightSet,
     warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
     /// Defer the profile weight of a carrier that gathered no light ([`Deferred`]).
@@ -634,7 +645,8 @@ impl<'s> PathIntegrator<'s> {
             method,
             options,
             objects,
-            lights: LightSet::new(scene.lights()),
+            surface_lights: LightSet::at(scene.lights(), Vertex::Surface),
+            medium_lights: LightSet::at(scene.lights(), Vertex::Medium),
             warnings,
             strategy: LightStrategy::Mis,
             defer_weights: true,
@@ -818,8 +830,8 @@ impl<'s> PathIntegrator<'s> {
             if let Light::Environment(_) = light {
                 let w = match prev {
                     Prev::Specular | Prev::MirrorCounted => 1.0,
-                    Prev::Sampled { p, pdf } => {
-                        let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i);
+                    Prev::Sampled { p, pdf, at } => {
+                        let pl = light.pdf_li(p, ray.dir, p + ray.dir) * self.light_pdf(i, at);
                         self.strategy.hit_weight(pdf, pl)
                     }
                 };
@@ -839,8 +851,8 @@ impl<'s> PathIntegrator<'s> {
         match prev {
             Prev::Specular => le,
             Prev::MirrorCounted => Rgb::ZERO,
-            Prev::Sampled { p, pdf } => {
-                let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i);
+            Prev::Sampled { p, pdf, at } => {
+                let pl = light.pdf_li(p, ray.dir, hit.p) * self.light_pdf(i, at);
                 le * self.strategy.hit_weight(pdf, pl)
             }
         }
@@ -887,9 +899,17 @@ impl<'s> PathIntegrator<'s> {
         true
     }
 
-    fn light_pdf(&self, i: usize) -> f64 {
-        if self.lights.contains(i) {
-            self.lights.select_pdf()
+    fn lights(&self, at: Vertex) -> &LightSet {
+        match at {
+            Vertex::Surface => &self.surface_lights,
+            Vertex::Medium => &self.medium_lights,
+        }
+    }
+
+    fn light_pdf(&self, i: usize, at: Vertex) -> f64 {
+        let lights = self.lights(at);
+        if lights.contains(i) {
+            lights.select_pdf()
         } else {
             0.0
         }
@@ -907,6 +927,7 @@ impl<'s> PathIntegrator<'s> {
         origin_for: impl Fn(DVec3) -> DVec3,
         f_and_pdf: impl Fn(DVec3) -> (f64, f64),
         medium: Option<u32>,
+        at: Vertex,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Direct {
@@ -915,7 +936,8 @@ impl<'s> PathIntegrator<'s> {
         if self.strategy == LightStrategy::DirectionOnly {
             return Direct::NONE;
         }
-        let Some(i) = self.lights.select(u) else {
+        let lights = self.lights(at);
+        let Some(i) = lights.select(u) else {
             return Direct::NONE;
         };
         let light = &self.scene.lights()[i];
@@ -938,10 +960,10 @@ impl<'s> PathIntegrator<'s> {
             1.0
         } else {
             self.strategy
-                .nee_weight(ls.pdf * self.lights.select_pdf(), pdf_dir)
+                .nee_weight(ls.pdf * lights.select_pdf(), pdf_dir)
         };
         Direct {
-            l: ls.li * shadow.tr * (f * w / self.lights.select_pdf()),
+            l: ls.li * shadow.tr * (f * w / lights.select_pdf()),
             through_medium: shadow.through_medium,
             wi: ls.wi,
         }
@@ -1075,6 +1097,7 @@ impl<'s> PathIntegrator<'s> {
                 }
             },
             st.medium,
+            Vertex::Surface,
             rng,
             counters,
         );
@@ -1096,6 +1119,7 @@ impl<'s> PathIntegrator<'s> {
         st.prev = Prev::Sampled {
             p: hit.p,
             pdf: cos / std::f64::consts::PI,
+            at: Vertex::Surface,
         };
         self.go_on(hit.spawn_ray(wi), st, rng, counters)
     }
@@ -1239,6 +1263,7 @@ impl<'s> PathIntegrator<'s> {
                     )
                 },
                 st.medium,
+                Vertex::Surface,
                 rng,
                 counters,
             );
@@ -1258,6 +1283,7 @@ impl<'s> PathIntegrator<'s> {
                 st.prev = Prev::Sampled {
                     p: hit.p,
                     pdf: conserving_pdf(s.wi, s.pdf),
+                    at: Vertex::Surface,
                 };
                 Crossed::Stepped(Step::Continue(hit.spawn_ray(r)))
             }
@@ -1296,9 +1322,12 @@ impl<'s> PathIntegrator<'s> {
         if st.hero.is_none() && !grey {
             st.hero = Some(rng.below(3) as usize);
         }
+        // The vertex before the medium (`from` is its sampled part): a walk that leaves
+        // without scattering keeps it, with the lights its own light sampling could choose.
+        let before = st.prev;
         st.medium = Some(object);
         let interface = Interface::of(material);
-        let nee = interface.is_index_matched() && !self.lights.is_empty();
+        let nee = interface.is_index_matched() && !self.medium_lights.is_empty();
         let filter = self.options.scattering;
         self.settle(st, rng, counters);
         let (beta, r_u) = (st.beta, st.r_u);
@@ -1319,6 +1348,7 @@ impl<'s> PathIntegrator<'s> {
                         (f, f)
                     },
                     Some(object),
+                    Vertex::Medium,
                     rng,
                     &mut nee_counters,
                 );
@@ -1353,7 +1383,12 @@ impl<'s> PathIntegrator<'s> {
         st.order = order;
         // A scattering vertex without light sampling (η > 1) leaves nothing to weigh against.
         let prev = |last_scatter: Option<(DVec3, f64)>| match last_scatter {
-            Some((p, pdf)) if nee || !scattered => Prev::Sampled { p, pdf },
+            _ if !scattered => before,
+            Some((p, pdf)) if nee => Prev::Sampled {
+                p,
+                pdf,
+                at: Vertex::Medium,
+            },
             _ => Prev::Specular,
         };
         match end {
@@ -1477,12 +1512,54 @@ impl<'s> PathIntegrator<'s> {
             counters.probe_misses += 1;
             return Step::Stop;
         }
-        // Every hit gathers light; one, chosen uniformly, carries the path on (weight n). A
-        // hit's weight 1/p(x) is computed only where it is used (it gathers light, or carries
-        // the path): about half the hits on a one-sided lit object need neither.
-        let carrier = rng.below(set.len() as u32) as usize;
+        // Every hit may gather light (below); one carries the path on, chosen in proportion
+        // to its MIS weight m_k, so that the carried factor is (Σ m / m_k) times its estimator
+        // weight m_k/p_k: the probes' weights differ by orders of magnitude on a curved
+        // surface (module docs of `het_estimate::probe`), and a uniform choice (factor n)
+        // would make the indirect light as noisy as that spread.
+        let mut weights = [None; 3 * crate::integrator::probe::MAX_PROBE_HITS];
+        let mut total = 0.0;
+        for (k, (x_i, axis)) in set.found().enumerate() {
+            weights[k] = density.weigh(x_i, axis);
+            total += weights[k].map_or(0.0, |w| w.mis);
+        }
+        if total <= 0.0 {
+            return Step::Stop; // p(x) = 0 at every hit (a sphere's edge, or x_o itself)
+        }
+        let (carrier, carrier_mis) = {
+            let u = rng.uniform() * total;
+            let mut acc = 0.0;
+            let mut pick = (0, 1.0);
+            for (k, w) in weights[..set.len()].iter().enumerate() {
+                if let Some(w) = w {
+                    pick = (k, w.mis);
+                    acc += w.mis;
+                    if u < acc {
+                        break;
+                    }
+                }
+            }
+            pick
+        };
+        // The carrier's weight over the probability of choosing it.
+        let scale = total / carrier_mis;
         let mut next = None;
-        for (k, &x_i) in set.iter().enumerate() {
+        for (k, (&x_i, _)) in set.found().enumerate() {
+            // Russian roulette: a point other than the carrier whose MIS weight w_a(x) is below
+            // ROULETTE_MIS gathers with probability w_a / ROULETTE_MIS (and its weight divided
+            // by that). A tangent probe's hits on a smooth surface, whose MIS weights are near
+            // 0, then rarely cost a shadow ray and an estimate: on `marble-sphere.toml` a
+            // quarter less time at the same noise (docs/curved-objects.md).
+            let mut survival = 1.0;
+            match weights[k] {
+                Some(w) if k != carrier && w.mis < ROULETTE_MIS => {
+                    survival = w.mis / ROULETTE_MIS;
+                    if rng.uniform() >= survival {
+                        continue;
+                    }
+                }
+                _ => {}
+            }
             let alpha_i = b.alpha_at(&x_i);
             let ld = self.direct(
                 x_i.p,
@@ -1498,6 +1575,7 @@ impl<'s> PathIntegrator<'s> {
                     (b.entry_lobe(cos, alpha_i, alpha_o) * cos, pdf)
                 },
                 None,
+                Vertex::Surface,
                 rng,
                 counters,
             );
@@ -1515,12 +1593,12 @@ impl<'s> PathIntegrator<'s> {
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather, nothing to carry
             }
-            let Some(weight) = density.weight(&x_i) else {
+            let Some(weight) = weights[k].map(|w| w.weight / survival) else {
                 continue; // p(x) = 0 (a sphere's edge, or x_o itself): no contribution
             };
             if ld.is_zero() && self.defer_weights {
                 // Nothing to gather: the carrier owes its (costly) estimate.
-                next = Some((x_i, Err(weight * set.len() as f64)));
+                next = Some((x_i, Err(weight * scale)));
                 continue;
             }
             let pw = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
@@ -1530,7 +1608,7 @@ impl<'s> PathIntegrator<'s> {
                 st.l += st.beta * w * ld * b.coupling(&pw, w_light, n_light, -ray.dir, n_o);
             }
             if k == carrier {
-                next = Some((x_i, Ok((w * set.len() as f64, pw))));
+                next = Some((x_i, Ok((w * scale, pw))));
             }
         }
         let Some((x_i, w)) = next else {
@@ -1581,6 +1659,7 @@ impl<'s> PathIntegrator<'s> {
         st.prev = Prev::Sampled {
             p: x_i.p,
             pdf: cos / std::f64::consts::PI,
+            at: Vertex::Surface,
         };
         Step::Continue(x_i.spawn_ray(wi))
     }
