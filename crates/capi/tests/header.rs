@@ -30,3 +30,53 @@ fn header_is_up_to_date() {
         path.display()
     );
 }
+
+/// The header's description of `hb_material_new` names every profile model, scattering order
+/// and estimator the library accepts, and no other: the lists are the crates' own
+/// (`ProfileModel::ALL`, `Scattering::ALL`, `Estimator::ALL`), so adding an estimator without
+/// documenting it in the C API fails here.
+#[test]
+fn the_header_names_every_choice_the_library_accepts() {
+    use bssrdf_core::{ProfileModel, Scattering};
+    use het_estimate::Estimator;
+    let header =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("include/het_bssrdf.h"))
+            .expect("the header");
+    let doc = header
+        .split("hb_material_new(")
+        .next()
+        .and_then(|before| before.rsplit("/**").next())
+        .expect("the doc comment of hb_material_new")
+        .replace("\n * ", " ");
+    // The quoted names (`"name"`) in the parenthesis that follows `lead`.
+    let listed = |lead: &str| -> Vec<String> {
+        let start = doc
+            .find(lead)
+            .unwrap_or_else(|| panic!("`{lead}` in {doc}"))
+            + lead.len();
+        let list = &doc[start..start + doc[start..].find(')').expect("a closing parenthesis")];
+        let mut names: Vec<String> = list
+            .split("`\"")
+            .skip(1)
+            .filter_map(|s| s.split("\"`").next().map(str::to_string))
+            .collect();
+        names.sort();
+        names
+    };
+    let sorted = |mut v: Vec<&str>| {
+        v.sort();
+        v.into_iter().map(str::to_string).collect::<Vec<_>>()
+    };
+    assert_eq!(
+        listed("the profile `model` ("),
+        sorted(ProfileModel::ALL.iter().map(|m| m.name()).collect())
+    );
+    assert_eq!(
+        listed("(`scattering`: "),
+        sorted(Scattering::ALL.iter().map(|s| s.name()).collect())
+    );
+    assert_eq!(
+        listed("the estimator ("),
+        sorted(Estimator::ALL.iter().map(|e| e.name()).collect())
+    );
+}
