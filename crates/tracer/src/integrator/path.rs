@@ -45,6 +45,7 @@ use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;
+use crate::integrator::probe::Gathering;
 use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
 use crate::light::{Light, LightSample};
@@ -375,14 +376,6 @@ impl Prev {
         }
     }
 }
-
-/// The MIS weight below which a BSSRDF probe point other than the carrier gathers light only
-/// by Russian roulette ([`PathIntegrator::subsurface`]). The points this skips are a tangent
-/// probe's on a smooth surface (weights near 0 under the projection heuristic of
-/// `het_estimate::probe`); on a body narrower than the probe spheres, where the balance
-/// heuristic gives every probe a third or so, a threshold of 1 (roulette on every point) raised
-/// a light-against-camera test's standard error 1.6× (`tests/reciprocity.rs`).
-const ROULETTE_MIS: f64 = 0.2;
 
 /// The integrator: a [`PixelEstimator`] over a scene.
 pub struct PathIntegrator<'s> {
@@ -1512,54 +1505,16 @@ impl<'s> PathIntegrator<'s> {
             counters.probe_misses += 1;
             return Step::Stop;
         }
-        // Every hit may gather light (below); one carries the path on, chosen in proportion
-        // to its MIS weight m_k, so that the carried factor is (Σ m / m_k) times its estimator
-        // weight m_k/p_k: the probes' weights differ by orders of magnitude on a curved
-        // surface (module docs of `het_estimate::probe`), and a uniform choice (factor n)
-        // would make the indirect light as noisy as that spread.
-        let mut weights = [None; 3 * crate::integrator::probe::MAX_PROBE_HITS];
-        let mut total = 0.0;
-        for (k, (x_i, axis)) in set.found().enumerate() {
-            weights[k] = density.weigh(x_i, axis);
-            total += weights[k].map_or(0.0, |w| w.mis);
-        }
-        if total <= 0.0 {
+        // Every point may gather light; one carries the path on (see [`Gathering`]).
+        let Some(gathering) = Gathering::new(&set, &density, rng) else {
             return Step::Stop; // p(x) = 0 at every hit (a sphere's edge, or x_o itself)
-        }
-        let (carrier, carrier_mis) = {
-            let u = rng.uniform() * total;
-            let mut acc = 0.0;
-            let mut pick = (0, 1.0);
-            for (k, w) in weights[..set.len()].iter().enumerate() {
-                if let Some(w) = w {
-                    pick = (k, w.mis);
-                    acc += w.mis;
-                    if u < acc {
-                        break;
-                    }
-                }
-            }
-            pick
         };
-        // The carrier's weight over the probability of choosing it.
-        let scale = total / carrier_mis;
+        let (carrier, scale) = (gathering.carrier(), gathering.carrier_scale());
         let mut next = None;
         for (k, (&x_i, _)) in set.found().enumerate() {
-            // Russian roulette: a point other than the carrier whose MIS weight w_a(x) is below
-            // ROULETTE_MIS gathers with probability w_a / ROULETTE_MIS (and its weight divided
-            // by that). A tangent probe's hits on a smooth surface, whose MIS weights are near
-            // 0, then rarely cost a shadow ray and an estimate: on `marble-sphere.toml` a
-            // quarter less time at the same noise (docs/curved-objects.md).
-            let mut survival = 1.0;
-            match weights[k] {
-                Some(w) if k != carrier && w.mis < ROULETTE_MIS => {
-                    survival = w.mis / ROULETTE_MIS;
-                    if rng.uniform() >= survival {
-                        continue;
-                    }
-                }
-                _ => {}
-            }
+            let Some(weight) = gathering.weight_if_gathering(k, rng) else {
+                continue;
+            };
             let alpha_i = b.alpha_at(&x_i);
             let ld = self.direct(
                 x_i.p,
@@ -1593,9 +1548,6 @@ impl<'s> PathIntegrator<'s> {
             if ld.is_zero() && k != carrier {
                 continue; // nothing to gather, nothing to carry
             }
-            let Some(weight) = weights[k].map(|w| w.weight / survival) else {
-                continue; // p(x) = 0 (a sphere's edge, or x_o itself): no contribution
-            };
             if ld.is_zero() && self.defer_weights {
                 // Nothing to gather: the carrier owes its (costly) estimate.
                 next = Some((x_i, Err(weight * scale)));

@@ -122,3 +122,89 @@ pub fn probe_density_within(
 ) -> f64 {
     lib::probe_density_within(x_o, coeffs, &sampler.0, max_radius, x_i)
 }
+
+/// The MIS weight below which a probe point other than the carrier gathers light only by
+/// Russian roulette ([`Gathering::weight_if_gathering`]). The points this skips are a tangent
+/// probe's on a smooth surface (weights near 0 under the projection heuristic of
+/// [`het_estimate::probe`]); on a body narrower than the probe spheres, where the balance
+/// heuristic gives every probe a third or so, a threshold of 1 (roulette on every point)
+/// raised a light-against-camera test's standard error 1.6× (`tests/reciprocity.rs`).
+pub const ROULETTE_MIS: f64 = 0.2;
+
+/// How the points of one probe set are used at a BSSRDF vertex: every point may gather light,
+/// and one, the carrier, continues the path.
+///
+/// * The carrier is chosen in proportion to its MIS weight m_k, so that the path carries
+///   (Σ m / m_k) times its estimator weight: under the projection heuristic the points'
+///   weights differ by orders of magnitude on a curved surface, and a uniform choice (factor
+///   n) would make the indirect light as noisy as that spread.
+/// * A point other than the carrier whose MIS weight is below [`ROULETTE_MIS`] gathers with
+///   probability m / [`ROULETTE_MIS`] (its weight divided by that): a tangent probe's hits on
+///   a smooth surface then rarely cost a shadow ray and an estimate, which on
+///   `marble-sphere.toml` saved a fifth of the render's time at the same noise
+///   (docs/curved-objects.md, "Probes and light on curved surfaces").
+pub struct Gathering {
+    weights: [Option<lib::Weighed>; 3 * MAX_PROBE_HITS],
+    carrier: usize,
+    scale: f64,
+}
+
+impl Gathering {
+    /// Weighs every point of `set` with `density` and chooses the carrier (one uniform draw
+    /// from `rng`); `None` when no point has a weight.
+    pub fn new(set: &ProbePoints, density: &lib::ProbeDensity<'_>, rng: &mut Rng) -> Option<Self> {
+        let mut weights = [None; 3 * MAX_PROBE_HITS];
+        let mut total = 0.0;
+        for (k, (x_i, axis)) in set.found().enumerate() {
+            weights[k] = density.weigh(x_i, axis);
+            total += weights[k].map_or(0.0, |w| w.mis);
+        }
+        if total <= 0.0 {
+            return None;
+        }
+        let u = rng.uniform() * total;
+        let mut acc = 0.0;
+        let (mut carrier, mut mis) = (0, 1.0);
+        for (k, w) in weights[..set.len()].iter().enumerate() {
+            if let Some(w) = w {
+                (carrier, mis) = (k, w.mis);
+                acc += w.mis;
+                if u < acc {
+                    break;
+                }
+            }
+        }
+        Some(Self {
+            weights,
+            carrier,
+            scale: total / mis,
+        })
+    }
+
+    /// The index (in the set's order) of the point that continues the path.
+    pub fn carrier(&self) -> usize {
+        self.carrier
+    }
+
+    /// The carrier's factor beyond its own estimator weight: Σ m / m_carrier, the inverse of
+    /// the probability of choosing it.
+    pub fn carrier_scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// Point `k`'s estimator weight (an area, 1/p_a(x) times its MIS weight, divided by its
+    /// roulette survival probability) if it gathers light in this sample; `None` if it has no
+    /// weight or the roulette dropped it (one uniform draw from `rng` for a point below
+    /// [`ROULETTE_MIS`] that is not the carrier).
+    pub fn weight_if_gathering(&self, k: usize, rng: &mut Rng) -> Option<f64> {
+        let w = self.weights[k]?;
+        if k != self.carrier && w.mis < ROULETTE_MIS {
+            let survival = w.mis / ROULETTE_MIS;
+            if rng.uniform() >= survival {
+                return None;
+            }
+            return Some(w.weight / survival);
+        }
+        Some(w.weight)
+    }
+}
