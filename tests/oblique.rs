@@ -1,21 +1,21 @@
 //! Light arriving at an angle (docs/oblique-incidence.md): under the 4 × 4 quad of
 //! docs/shapes.md, 3 units above a half-space (σa 0.01, σs 1, η 1), most of the light the
-//! view receives entered obliquely. With the oblique shape (the default with the angular
-//! coupling) the BSSRDF render must be within 3 % (+ 3 SE) of the path tracer; without the
-//! coupling (and so without the oblique shape) it is 1.15× (docs/tabulated-profile.md), which
+//! view receives entered obliquely. With the oblique shape (`oblique_shape = true`, opt-in
+//! beside the angular coupling) the BSSRDF render must be within 3 % (+ 3 SE) of the path
+//! tracer; without the coupling and the shape it is 1.15× (docs/tabulated-profile.md), which
 //! the test must tell apart.
 
 use bssrdf_core::glam::DVec3;
-use bssrdf_core::{ProfileModel, Rgb, Scattering};
+use bssrdf_core::{ProfileModel, Rgb};
 use het_estimate::Coefficients;
 use tracer::camera::Camera;
 use tracer::field::MediumField;
 use tracer::geometry::primitives;
-use tracer::integrator::{Method, PathIntegrator, PathOptions};
+use tracer::integrator::Method;
 use tracer::light::Light;
-use tracer::render::{RenderOptions, render};
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};
 
+use crate::common::harness::render_multiple;
 use crate::common::shapes::{bssrdf, mean_se, ratio};
 
 /// The half-space under the quad, seen over the quad's footprint (8 × 8 pixels).
@@ -48,17 +48,8 @@ fn quad_scene(coupled: bool) -> Scene {
 
 /// Image means (red channel) over `seeds`, mean and standard error.
 fn measure(scene: &Scene, method: Method, spp: u32, seeds: std::ops::Range<u64>) -> (f64, f64) {
-    let integrator = PathIntegrator::new(
-        scene,
-        method,
-        PathOptions {
-            scattering: Scattering::Multiple,
-            max_depth: 8,
-        },
-    )
-    .unwrap();
     mean_se(seeds.map(|seed| {
-        let r = render(8, 8, &integrator, &RenderOptions::samples(spp, seed));
+        let r = render_multiple(scene, method, 8, spp, seed);
         let c = r.counters;
         assert!(c.capped == 0 && c.leaks * 10_000 <= c.paths, "{c:?}");
         r.pixels.iter().map(|p| p[0]).sum::<f64>() / r.pixels.len() as f64

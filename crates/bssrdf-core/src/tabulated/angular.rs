@@ -72,15 +72,7 @@ impl AngularCoupling {
     /// profile of a [`crate::ProfileFamily`] with the same [`Scattering`] counts them.
     pub fn new(eta: f64, scattering: Scattering) -> Self {
         let (single, multiple) = (scattering.includes_single(), scattering.includes_multiple());
-        let step = ANGULAR_ETAS[1] - ANGULAR_ETAS[0];
-        let last = ANGULAR_ETAS.len() - 1;
-        let pe = if eta.is_finite() {
-            ((eta - ANGULAR_ETAS[0]) / step).clamp(0.0, last as f64)
-        } else {
-            0.0
-        };
-        let q = (pe as usize).min(last - 1);
-        let f = pe - q as f64;
+        let (q, f) = super::grid::eta_bracket(&ANGULAR_ETAS, eta);
         let lo = Self::plane(q, single, multiple);
         let hi = Self::plane(q + 1, single, multiple);
         let t = lo

@@ -8,6 +8,22 @@ pub const ETAS: [f64; 13] = [
     1.0, 1.05, 1.1, 1.15, 1.2, 1.25, 1.3, 1.35, 1.4, 1.45, 1.5, 1.55, 1.6,
 ];
 
+/// The planes of an evenly spaced η grid (`etas`, at least two) that bracket `eta`, and the
+/// weight of the upper one: `(q, f)` with `eta ≈ (1 − f)·etas[q] + f·etas[q + 1]`, `eta`
+/// clamped to the grid (and the first plane for a non-finite `eta`). Used by the angular
+/// coupling's and the oblique shape's data, which are linear between their planes.
+pub fn eta_bracket(etas: &[f64], eta: f64) -> (usize, f64) {
+    let step = etas[1] - etas[0];
+    let last = etas.len() - 1;
+    let pe = if eta.is_finite() {
+        ((eta - etas[0]) / step).clamp(0.0, last as f64)
+    } else {
+        0.0
+    };
+    let q = (pe as usize).min(last - 1);
+    (q, pe - q as f64)
+}
+
 /// Number of albedo rows.
 pub const N_ALBEDO: usize = 40;
 /// Smallest tabulated `s = √(1 − α)` (α = 0.999975); larger albedos use this row.
@@ -142,4 +158,24 @@ pub fn centre(j: usize) -> f64 {
 pub fn annulus_area(j: usize) -> f64 {
     let (a, b) = (edge(j), edge(j + 1));
     std::f64::consts::PI * (b * b - a * a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bracketing planes and weight: inside, at the ends, outside (clamped), not finite.
+    #[test]
+    fn eta_bracket_finds_the_planes_around_eta() {
+        let etas = [1.0, 1.1, 1.2, 1.3];
+        let (q, f) = eta_bracket(&etas, 1.15);
+        assert!(q == 1 && (f - 0.5).abs() < 1e-12, "{q} {f}");
+        assert_eq!(eta_bracket(&etas, 1.0), (0, 0.0));
+        let (q, f) = eta_bracket(&etas, 1.3);
+        assert!(q == 2 && (f - 1.0).abs() < 1e-12, "{q} {f}");
+        assert_eq!(eta_bracket(&etas, 0.5), (0, 0.0));
+        let (q, f) = eta_bracket(&etas, 3.0);
+        assert!(q == 2 && (f - 1.0).abs() < 1e-12, "{q} {f}");
+        assert_eq!(eta_bracket(&etas, f64::NAN), (0, 0.0));
+    }
 }

@@ -112,15 +112,7 @@ impl ObliqueShape {
     /// the orders `scattering` selects.
     pub fn new(eta: f64, scattering: Scattering) -> Self {
         let (single, multiple) = (scattering.includes_single(), scattering.includes_multiple());
-        let step = OBLIQUE_ETAS[1] - OBLIQUE_ETAS[0];
-        let last = OBLIQUE_ETAS.len() - 1;
-        let pe = if eta.is_finite() {
-            ((eta - OBLIQUE_ETAS[0]) / step).clamp(0.0, last as f64)
-        } else {
-            0.0
-        };
-        let q = (pe as usize).min(last - 1);
-        let f = pe - q as f64;
+        let (q, f) = super::grid::eta_bracket(&OBLIQUE_ETAS, eta);
         let lo = Self::plane(q, single, multiple);
         let mix = |lo: &[f64], hi: Option<&[f64]>| -> Vec<f32> {
             match hi {
