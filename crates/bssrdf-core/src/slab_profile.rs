@@ -109,12 +109,54 @@ impl ProfileFamily {
         let reduced = self.reduced(sigma_a, sigma_s);
         reduced.albedo.is_some() && SlabTerm::is_half_space(reduced.sigma_tp, thickness)
     }
+
+    /// The thickness (length) from which [`ProfileFamily::slab_is_half_space`] holds for
+    /// absorption `sigma_a` and scattering `sigma_s`: 2 d_max / σt'. It grows as either
+    /// coefficient falls (σt' = σa + (1 − g) σs), so a renderer can bound, from a field's
+    /// smallest coefficients, how far it must look for an object's far side. `None` where no
+    /// thickness is the half-space: a model without a slab table, invalid input, a medium
+    /// that does not scatter.
+    pub fn half_space_thickness(&self, sigma_a: f64, sigma_s: f64) -> Option<f64> {
+        if self.model() != ProfileModel::Tabulated {
+            return None;
+        }
+        let (sigma_a, sigma_s) = validate_sigmas(sigma_a, sigma_s).ok()?;
+        let reduced = self.reduced(sigma_a, sigma_s);
+        reduced.albedo?;
+        let d = SlabTerm::half_space_thickness(reduced.sigma_tp);
+        d.is_finite().then_some(d)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::Scattering;
+
+    /// The thickness from which the shortcut holds is where the predicate turns, for any g,
+    /// and the bound a renderer takes from the smallest coefficients covers larger ones.
+    #[test]
+    fn the_half_space_thickness_is_where_the_shortcut_starts() {
+        for g in [0.0, 0.4, -0.3] {
+            let f = ProfileFamily::new(ProfileModel::Tabulated, Scattering::All, g, 1.3).unwrap();
+            for (sa, ss) in [
+                (0.002, 1.5),
+                (0.0, 2.19),
+                (3.0, 0.1),
+                (1e-6, 1e-6),
+                (1e6, 1e6),
+            ] {
+                let d = f.half_space_thickness(sa, ss).expect("scattering medium");
+                assert!(f.slab_is_half_space(sa, ss, d), "g {g}: {sa} {ss} at {d}");
+                assert!(!f.slab_is_half_space(sa, ss, d * 0.999), "g {g}: {sa} {ss}");
+                assert!(f.slab_is_half_space(2.0 * sa + 0.1, 1.5 * ss, d));
+            }
+            assert_eq!(f.half_space_thickness(0.5, 0.0), None);
+            assert_eq!(f.half_space_thickness(f64::NAN, 1.0), None);
+        }
+        let dipole = ProfileFamily::new(ProfileModel::Dipole, Scattering::All, 0.0, 1.3).unwrap();
+        assert_eq!(dipole.half_space_thickness(0.01, 1.0), None);
+    }
 
     /// The shortcut's predicate: from σt'·d = 2 d_max on (reduced coefficients), and not just
     /// below, where the slab still transmits. That the slab profile there *is* the half-space

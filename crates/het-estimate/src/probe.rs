@@ -61,6 +61,20 @@
 //! BSSRDF's standard error 2.3× (`tests/shapes.rs`). There the weights are the balance
 //! heuristic's.
 //!
+//! # Tangent probes by roulette
+//! Under the projection heuristic a tangent probe's hits on a smooth surface carry almost
+//! nothing (their weights go as `|n_g · a|⁴`, the fourth power of the surface's turn between
+//! x_o and x), yet each tangent probe costs a chord through the object's hierarchy. So where
+//! the projection heuristic applies, each tangent probe is traced only with probability
+//! [`TANGENT_PROBE_RATE`], and its hits' weights are divided by it
+//! ([`ProbeDensity::weigh`]): `E[Σ_hits f · w_a / (q_a p_a)] = ∫ f dA` as before, for any
+//! `q_a > 0`. Edges, corners and a sphere's horizon, where the tangent probes find what the
+//! normal probe cannot, keep their probes one time in four and so stay unbiased, at more
+//! variance there. On `marble-sphere.toml` (8 spp) this halved the rays traced (1.92 M to
+//! 0.96 M) and took the render's CPU time from 4.2 s to 2.7 s at 16 spp, with the ball's noise
+//! unchanged (relative 0.147 between two seeds); on the marble block, whose edges keep their
+//! tangent probes, 2.2 s to 1.8 s at noise 0.150 → 0.153 (docs/curved-objects.md).
+//!
 //! A renderer that continues a path from one of a set's points picks it in proportion to
 //! `w_a(x)` ([`ProbeDensity::weigh`]), not uniformly: the points' weights now differ by orders
 //! of magnitude, and the carried factor `Σ w / w_k` stays near the set's own estimate.
@@ -141,6 +155,9 @@ pub const PROBE_ENERGY_FRACTION: f64 = 0.999;
 pub const NARROW_SHARE: f64 = 0.9;
 /// Most intersections kept per probe chord.
 pub const MAX_PROBE_HITS: usize = 16;
+/// The probability with which each tangent probe is traced where the projection heuristic
+/// applies (module docs, "Tangent probes by roulette"); its hits' weights are divided by it.
+pub const TANGENT_PROBE_RATE: f64 = 0.25;
 
 /// Every intersection of a probe segment with the object being shaded: the one geometric
 /// query probe sampling needs. Implemented by the renderer over its own acceleration
@@ -592,6 +609,9 @@ pub struct ProbeDensity<'s> {
     /// The projection heuristic applies: the object is at least as wide as every probe
     /// sphere (module docs); the balance heuristic otherwise.
     projection: bool,
+    /// The probability that a tangent probe is traced: [`TANGENT_PROBE_RATE`] under the
+    /// projection heuristic, 1 under the balance heuristic.
+    tangent_rate: f64,
 }
 
 impl<'s> ProbeDensity<'s> {
@@ -614,6 +634,7 @@ impl<'s> ProbeDensity<'s> {
             frame: Frame::new(x_o.normal()),
             channels,
             projection,
+            tangent_rate: if projection { TANGENT_PROBE_RATE } else { 1.0 },
         }
     }
 
@@ -646,10 +667,21 @@ impl<'s> ProbeDensity<'s> {
         };
         let den = p[0] * g[0] + p[1] * g[1] + p[2] * g[2];
         let weight = g[a] / den;
+        let rate = self.rate(axis);
         (p[a] > 0.0 && weight > 0.0 && weight.is_finite()).then(|| Weighed {
-            weight,
-            mis: (p[a] * weight).min(1.0),
+            weight: weight / rate,
+            mis: (p[a] * weight).min(1.0) / rate,
         })
+    }
+
+    /// The probability that the probe along `axis` is traced at all (module docs, "Tangent
+    /// probes by roulette").
+    #[inline]
+    fn rate(&self, axis: ProbeAxis) -> f64 {
+        match axis {
+            ProbeAxis::N => 1.0,
+            ProbeAxis::S | ProbeAxis::T => self.tangent_rate,
+        }
     }
 
     /// The three axes' terms of `p(x_i)` (tangent s, tangent t, normal), each already divided
@@ -707,7 +739,8 @@ impl<'s> ProbeDensity<'s> {
 
     /// The three probes (one per axis of x_o's frame): calls `keep` on every point each
     /// probe's chord crosses, in order, until `keep` has returned true [`MAX_PROBE_HITS`]
-    /// times for that probe. Draws 3 uniform numbers per axis from `rng`.
+    /// times for that probe. Draws 3 uniform numbers per axis from `rng`, and one more before
+    /// each tangent probe that is traced with a probability below 1 (its roulette).
     fn trace<C: ProbeChords, U: UniformSource>(
         &self,
         chords: &C,
@@ -715,6 +748,10 @@ impl<'s> ProbeDensity<'s> {
         mut keep: impl FnMut(&C::Point, ProbeAxis) -> bool,
     ) {
         for axis in 0..3 {
+            let rate = self.rate(ProbeAxis::ALL[axis]);
+            if rate < 1.0 && rng.next_f64() >= rate {
+                continue;
+            }
             let ch = ((rng.next_f64() * 3.0) as usize).min(2);
             let (u_r, u_phi) = (rng.next_f64(), rng.next_f64());
             let Some(c) = self.channels.channel[ch] else {
@@ -816,11 +853,14 @@ pub fn axis_densities(
 /// A probe point's estimator weight and the MIS weight in it ([`ProbeDensity::weigh`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weighed {
-    /// `w_a(x) / p_a(x)` (an area): the point's term of the estimate is `f(x) · weight`.
+    /// `w_a(x) / (q_a p_a(x))` (an area), `q_a` the probability that the probe along `a` was
+    /// traced (module docs): the point's term of the estimate is `f(x) · weight`.
     pub weight: f64,
     /// `w_a(x)`, the share of the estimate at `x` that the probe along `a` carries (unitless,
-    /// in (0, 1]). Where the radial densities follow the profile, `f(x) · weight` is roughly
-    /// proportional to it: the points of one set are best chosen from in proportion to it.
+    /// in (0, 1]), divided like `weight` by the probability that the probe was traced (so
+    /// above 1 for some tangent probes' points). Where the radial densities follow the
+    /// profile, `f(x) · weight` is roughly proportional to it: the points of one set are best
+    /// chosen from in proportion to it.
     pub mis: f64,
 }
 
@@ -945,7 +985,7 @@ mod tests {
             let got: Vec<(DVec3, f64)> = weighted.iter().map(|&(x, w, _)| (x, w)).collect();
             assert_eq!(got, want, "set {k}");
             // Against the weight computed with nothing remembered, and the weights' bounds:
-            // the heuristic's weight over the probe's own density is in (0, 1] (1 for a point
+            // the heuristic's weight (without the roulette's 1/q_a) is in (0, 1] (1 for a point
             // only one probe can find: the slab's faces are perpendicular to no tangent here).
             for &(x, w, a) in &weighted {
                 let normal = if x.z > -1e-9 { DVec3::Z } else { DVec3::NEG_Z };
@@ -957,7 +997,8 @@ mod tests {
                     (w / again - 1.0).abs() < 1e-12,
                     "set {k}: {w} against {again}"
                 );
-                let share = w * fresh.axis_densities(&x)[a as usize];
+                // The weight carries 1/q_a, the tangent probes' roulette (module docs).
+                let share = w * fresh.rate(a) * fresh.axis_densities(&x)[a as usize];
                 assert!(
                     share > 0.0 && share <= 1.0 + 1e-12,
                     "set {k}: MIS weight {share}"
@@ -1203,6 +1244,34 @@ mod tests {
                 "channel {k}: mean {ms} against {mp}"
             );
         }
+    }
+
+    /// The tangent probes' roulette (module docs) keeps the estimate unbiased where they carry
+    /// most of it: on a sphere of radius 1 far inside the probe sphere (the projection
+    /// heuristic applies), `E[Σ weight] = 4π`, its area; every point whose normal leans more
+    /// towards a tangent than towards x_o's normal (most of the sphere) goes to the tangent
+    /// probes, so weights not divided by the rate would give about half the area.
+    #[test]
+    fn tangent_probes_by_roulette_keep_a_sphere_s_area() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        let c = Coefficients::grey(0.02, 1.0);
+        let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+        assert!(
+            sampler.probe_radius(c) > 2.0,
+            "the whole sphere lies within the probes"
+        );
+        let x_o = P(DVec3::ZERO, DVec3::Z);
+        let mut rng = SplitMix64::new(5);
+        let (mean, se) = mean_se(400_000, || {
+            probe(&UnitSphere, &x_o, c, &sampler, &mut rng)
+                .iter()
+                .map(|hit| hit.weight)
+                .sum()
+        });
+        let want = 4.0 * std::f64::consts::PI;
+        assert!((mean - want).abs() < 4.0 * se, "{mean} ± {se}, area {want}");
+        assert!(se < 0.01 * want, "test too weak: {mean} ± {se} of {want}");
     }
 
     /// `probe_within` estimates the same integral as `probe` (the slab closed form of the test

@@ -117,6 +117,19 @@ impl SlabTerm {
         thickness * sigma_t >= 2.0 * SLAB_THICKNESSES[SLAB_THICKNESSES.len() - 1]
     }
 
+    /// The smallest thickness (length) [`SlabTerm::is_half_space`] accepts at extinction
+    /// `sigma_t`, up to one rounding (+∞ for `sigma_t` = 0).
+    #[inline]
+    pub fn half_space_thickness(sigma_t: f64) -> f64 {
+        let d = 2.0 * SLAB_THICKNESSES[SLAB_THICKNESSES.len() - 1] / sigma_t;
+        // One ulp up where the quotient rounded down below the predicate.
+        if Self::is_half_space(sigma_t, d) {
+            d
+        } else {
+            d.next_up()
+        }
+    }
+
     /// The slab profile for extinction `sigma_t` (> 0), albedo `alpha` ∈ [0, 1], `eta` ∈ [1,
     /// 1.6] (clamped) and thickness `thickness` (length, ≥ 0, +∞ for the half-space).
     pub fn new(sigma_t: f64, alpha: f64, eta: f64, thickness: f64) -> Self {

@@ -393,6 +393,10 @@ pub struct PathIntegrator<'s> {
     /// Trace smooth dielectrics' mirror directions to the emitters they see
     /// ([`PathIntegrator::mirror_emission`]): the scene has a quad light.
     mirror_nee: bool,
+    /// Some object lets shadow rays through (a path-traced index-matched medium,
+    /// [`PathIntegrator::shadow`]); without one, a shadow ray from outside every medium is an
+    /// any-hit query.
+    shadows_cross_objects: bool,
 }
 
 /// How light sources are found: the two strategies of multiple importance sampling (Veach
@@ -633,6 +637,9 @@ impl<'s> PathIntegrator<'s> {
             });
         }
         let warnings = crate::integrator::warnings::scene_warnings(scene, method);
+        let shadows_cross_objects = objects.iter().any(|o| {
+            matches!(o, ObjectKind::Translucent { material, bssrdf: None, .. } if material.eta == 1.0)
+        });
         Ok(Self {
             scene,
             method,
@@ -644,6 +651,7 @@ impl<'s> PathIntegrator<'s> {
             strategy: LightStrategy::Mis,
             defer_weights: true,
             mirror_nee: scene.lights().iter().any(|l| matches!(l, Light::Quad(_))),
+            shadows_cross_objects,
         })
     }
 
@@ -973,6 +981,20 @@ impl<'s> PathIntegrator<'s> {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Transmission {
+        // From outside every medium, toward a light that is no object, past objects that
+        // all block: only whether anything is hit matters (pbrt-v4's `IntersectP`), without
+        // the closest hit's search and its hit record.
+        if medium.is_none() && seg.light_object.is_none() && !self.shadows_cross_objects {
+            let ray = Ray::with_range(seg.origin, seg.dir, 0.0, seg.t_max);
+            return if self.scene.geometry().occluded(&ray) {
+                Transmission::BLOCKED
+            } else {
+                Transmission {
+                    tr: Rgb::ONE,
+                    through_medium: false,
+                }
+            };
+        }
         let dir = seg.dir;
         let mut origin = seg.origin;
         let mut remaining = seg.t_max;
