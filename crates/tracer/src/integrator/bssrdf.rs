@@ -337,20 +337,20 @@ impl BssrdfObject {
         }
     }
 
-    /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs); 0
-    /// when either direction is behind its surface ([`facing_normal`]).
-    #[allow(clippy::too_many_arguments)]
+    /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs) of
+    /// the pair `incident` (x_i, ω_i) and `exitant` (x_o, ω_o); 0 when either direction is
+    /// behind its surface ([`facing_normal`]).
     pub fn eval(
         &self,
         surface: &ObjectSurface<'_>,
         medium: &MediumField,
-        x_i: &Hit,
-        w_i: DVec3,
-        x_o: &Hit,
-        w_o: DVec3,
+        incident: PairEnd<'_>,
+        exitant: PairEnd<'_>,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Rgb {
+        let PairEnd { hit: x_i, w: w_i } = incident;
+        let PairEnd { hit: x_o, w: w_o } = exitant;
         let (Some(n_i), Some(n_o)) = (facing_normal(x_i, w_i), facing_normal(x_o, w_o)) else {
             return Rgb::ZERO;
         };
@@ -376,6 +376,17 @@ impl BssrdfObject {
             _ => s,
         }
     }
+}
+
+/// One end of a BSSRDF pair: the surface point and the unit direction, pointing out of the
+/// medium, along which light crosses the boundary there (toward the light at x_i, toward the
+/// viewer at x_o).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairEnd<'h> {
+    /// The surface point.
+    pub hit: &'h Hit,
+    /// The direction outside the medium (unit).
+    pub w: DVec3,
 }
 
 /// The normal the BSSRDF measures the direction `w` (unit, pointing away from the surface)

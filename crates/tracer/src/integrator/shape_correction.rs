@@ -1088,6 +1088,15 @@ const MAX_TRACKING: u32 = 1_000_000;
 /// at most this much in the tally).
 const MIN_TRANSMITTANCE: f64 = 1e-9;
 
+/// Where a reversed walk starts ([`Walk::escape`]): at the boundary point `x_o`, along the
+/// direction `d` refracted into the medium, with the weight `w` of the Fresnel transmission
+/// there.
+struct Entry<'h> {
+    x_o: &'h Hit,
+    d: DVec3,
+    w: f64,
+}
+
 /// A walk's medium and which escapes count.
 struct Walk<'m> {
     medium: EscapeMedium<'m>,
@@ -1118,9 +1127,10 @@ impl Walk<'_> {
         let Some(d) = refract(-w_o, n, self.eta) else {
             return 0.0;
         };
+        let entry = Entry { x_o, d, w };
         match self.medium {
             EscapeMedium::Homogeneous { sigma_t, albedo } => {
-                self.escape_homogeneous(sigma_t, albedo, boundary, x_o, d, w, rng)
+                self.escape_homogeneous(sigma_t, albedo, boundary, entry, rng)
             }
             EscapeMedium::Field { field, channel } => {
                 let majorant = field.majorant()[channel];
@@ -1128,24 +1138,22 @@ impl Walk<'_> {
                     let c = field.at_point(p);
                     (c.sigma_a[channel] + c.sigma_s[channel], c.sigma_s[channel])
                 };
-                self.escape_tracked(&sigma, majorant, boundary, x_o, d, w, rng.next_u64())
+                self.escape_tracked(&sigma, majorant, boundary, entry, rng.next_u64())
             }
         }
     }
 
-    /// [`Walk::escape`] in a homogeneous medium, from `x_o` along the refracted `d` with
-    /// weight `w`.
-    #[allow(clippy::too_many_arguments)]
+    /// [`Walk::escape`] in a homogeneous medium of extinction `sigma_t` and single-scattering
+    /// `albedo`, from `entry`.
     fn escape_homogeneous(
         &self,
         sigma_t: f64,
         albedo: f64,
         boundary: &Boundary<'_>,
-        x_o: &Hit,
-        mut d: DVec3,
-        mut w: f64,
+        entry: Entry<'_>,
         rng: &mut Rng,
     ) -> f64 {
+        let Entry { x_o, mut d, mut w } = entry;
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
         let mut order = 0u32;
@@ -1197,8 +1205,8 @@ impl Walk<'_> {
         tally
     }
 
-    /// [`Walk::escape`] in a field `sigma(p) = (σt, σs)` bounded by `majorant`, from `x_o`
-    /// along the refracted `d` with weight `w`. At each vertex the chance of reaching the
+    /// [`Walk::escape`] in a field `sigma(p) = (σt, σs)` bounded by `majorant`, from `entry`.
+    /// At each vertex the chance of reaching the
     /// boundary is estimated by ratio tracking (the product of 1 − σt/σ̄ over tentative
     /// collisions, an unbiased estimate of the transmittance) and tallied; the walk then goes
     /// on by delta tracking: a real collision (probability σt/σ̄ at each tentative one)
@@ -1206,17 +1214,15 @@ impl Walk<'_> {
     /// ends otherwise (that escape was tallied already, in expectation). Step k draws its
     /// numbers from a generator keyed by (`key`, k), so that the walks in the body and under
     /// the plane stay in step however many tentative collisions each takes.
-    #[allow(clippy::too_many_arguments)]
     fn escape_tracked(
         &self,
         sigma: &impl Fn(DVec3) -> (f64, f64),
         majorant: f64,
         boundary: &Boundary<'_>,
-        x_o: &Hit,
-        mut d: DVec3,
-        mut w: f64,
+        entry: Entry<'_>,
         key: u64,
     ) -> f64 {
+        let Entry { x_o, mut d, mut w } = entry;
         let flight = |rng: &mut Rng| -(1.0 - rng.uniform()).ln() / majorant;
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
@@ -1330,6 +1336,7 @@ fn roulette(w: f64, u: f64) -> Option<f64> {
 mod tests {
     use super::*;
     use crate::geometry::{TriangleMesh, primitives};
+    use crate::integrator::bssrdf::PairEnd;
     use crate::render::NoObserver;
     use crate::scene::Translucent;
     use bssrdf_core::ProfileModel;
@@ -1748,10 +1755,8 @@ mod tests {
                     object: 0,
                 },
                 &field,
-                &x,
-                x.ns,
-                &x,
-                x.ns,
+                PairEnd { hit: &x, w: x.ns },
+                PairEnd { hit: &x, w: x.ns },
                 &mut Rng::from_keys(1, &[]),
                 &mut PathCounters::default(),
             );
@@ -1784,7 +1789,8 @@ mod tests {
         let mut counters = PathCounters::default();
         let mut eval = |b: &BssrdfObject, a: &Hit, wa, c: &Hit, wc| {
             let mut rng = Rng::from_keys(1, &[]);
-            b.eval(&surface, &field, a, wa, c, wc, &mut rng, &mut counters)
+            let (incident, exitant) = (PairEnd { hit: a, w: wa }, PairEnd { hit: c, w: wc });
+            b.eval(&surface, &field, incident, exitant, &mut rng, &mut counters)
         };
         let s = eval(&b, &x_i, w_i, &x_o, w_o);
         let swapped = eval(&b, &x_o, w_o, &x_i, w_i);
