@@ -33,6 +33,7 @@ use tracer::error::SceneError;
 use tracer::field::{Field, MediumField, PlanarProjection};
 use tracer::geometry::{Hit, Ray, primitives};
 use tracer::integrator::PathCounters;
+use tracer::integrator::profile_eval::eval_profile_channel;
 use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium, WalkStart};
 use tracer::light::Light;
 use tracer::render::Counters;
@@ -468,7 +469,7 @@ pub fn bssrdf_map(
                     c.record_estimate(&est.diagnostics);
                     let cf = est.coefficients;
                     let r = (x_o.p - x_i.p).length();
-                    sum += c.eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r);
+                    sum += eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r, &mut c);
                 }
                 *value = sum / (k * k) as f64;
             }

@@ -61,7 +61,8 @@ use crate::bsdf::{SMOOTH_ALPHA, TransmittanceTable, alpha_from_roughness};
 use crate::field::{Field, MediumField};
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
-use crate::integrator::probe::ProbeSampler;
+use crate::integrator::probe_gathering::ProbeSampler;
+use crate::integrator::profile_eval::{eval_profile, eval_slab_profile};
 use crate::rng::Rng;
 use crate::scene::Translucent;
 
@@ -77,7 +78,7 @@ pub(crate) struct BssrdfObject {
     /// (`bssrdf_core::separable`).
     bssrdf: SeparableBssrdf,
     /// The longest side of the object's bounding box: the extent the probe radii are drawn
-    /// within ([`super::probe::probe_within`]).
+    /// within ([`super::probe_gathering::probe_within`]).
     pub extent: f64,
     /// Weigh pairs by the slab profile of the local thickness (see the module docs): the
     /// material is `thickness_aware`, the family has a slab table (tabulated model) and
@@ -175,14 +176,14 @@ impl BssrdfObject {
 
     /// One probe set around `x_o` over `chords` (the object, or the shape correction's
     /// tangent plane), with the radii the renderers use on this object (at most its extent:
-    /// [`super::probe::probe_within`]).
+    /// [`super::probe_gathering::probe_within`]).
     pub(crate) fn probe_set<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,
         chords: &C,
         x_o: &Hit,
         coeffs: het_estimate::Coefficients,
         rng: &mut Rng,
-    ) -> crate::integrator::probe::ProbeSet {
+    ) -> crate::integrator::probe_gathering::ProbeSet {
         self.sampler
             .probe_chords(chords, x_o, coeffs, self.extent, rng)
     }
@@ -191,7 +192,7 @@ impl BssrdfObject {
     /// the density that weights each when the caller needs it.
     pub(crate) fn probe_points_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,
-        points: &mut crate::integrator::probe::ProbePoints,
+        points: &mut crate::integrator::probe_gathering::ProbePoints,
         chords: &C,
         x_o: &Hit,
         coeffs: het_estimate::Coefficients,
@@ -325,15 +326,15 @@ impl BssrdfObject {
     ) -> (Rgb, bool) {
         let r = (x_i.p - x_o.p).length();
         if !self.thickness_aware {
-            return (counters.eval_profile(&self.family, coeffs, r), true);
+            return (eval_profile(&self.family, coeffs, r, counters), true);
         }
         let d = 0.5 * (thickness(surface, x_i) + thickness(surface, x_o));
         match slab_pair(x_i, x_o, d) {
             Some((face, dist)) => (
-                counters.eval_slab_profile(&self.family, coeffs, d, face, dist),
+                eval_slab_profile(&self.family, coeffs, d, face, dist, counters),
                 face == SlabFace::Reflection,
             ),
-            None => (counters.eval_profile(&self.family, coeffs, r), true),
+            None => (eval_profile(&self.family, coeffs, r, counters), true),
         }
     }
 

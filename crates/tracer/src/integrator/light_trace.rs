@@ -305,7 +305,7 @@ impl<'s> LightTracer<'s> {
             geometry,
             object: x_i.object,
         };
-        let mut set = crate::integrator::probe::ProbePoints::new();
+        let mut set = crate::integrator::probe_gathering::ProbePoints::new();
         let density = b.probe_points_into(&mut set, &surface, &x_i, at_xi, rng);
         if set.is_empty() {
             counters.probe_misses += 1;

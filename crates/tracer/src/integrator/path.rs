@@ -11,7 +11,7 @@
 //!   shadow ray through a medium classifies its light as having entered one, so that both
 //!   strategies weight and classify the same light path alike (`docs/physics.md#path-tracer`);
 //! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
-//!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
+//!   ([`super::probe_gathering`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
 //!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
 //!
 //! Radiance is RGB, and every path carries all three channels. A grey medium is walked once
@@ -45,7 +45,7 @@ use crate::integrator::bssrdf::{BssrdfObject, PairEnd, PairWeight, facing_normal
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;
-use crate::integrator::probe::Gathering;
+use crate::integrator::probe_gathering::Gathering;
 use crate::integrator::shape_correction::ShapeCorrection;
 use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium, WalkStart};
 use crate::light::{Light, LightSample};
@@ -1454,7 +1454,7 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then incident points x_i from
-    /// probe rays ([`super::probe`]), and at each of them the estimated homogeneous
+    /// probe rays ([`super::probe_gathering`]), and at each of them the estimated homogeneous
     /// coefficients, the profile at r = |x_i − x_o|, and irradiance through pbrt-v4's
     /// normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
     /// (pbrt-v4 §11.4, `NormalizedFresnelBxDF`), times the tabulated profile's angular
@@ -1529,7 +1529,7 @@ impl<'s> PathIntegrator<'s> {
         self.continue_from(&v, x_i, carried, st)
     }
 
-    /// The incident points x_i of the BSSRDF vertex `v`, from probe rays ([`super::probe`]),
+    /// The incident points x_i of the BSSRDF vertex `v`, from probe rays ([`super::probe_gathering`]),
     /// each gathering light by next-event estimation (S_w, the shape correction's entry factor
     /// for the light's direction, the profile weight and the angular coupling), added to the
     /// path; and the carrier, the point the path continues from ([`Gathering`]), with its
@@ -1537,7 +1537,7 @@ impl<'s> PathIntegrator<'s> {
     fn gather(&self, v: &BssrdfVertex<'_>, st: &mut PathState<'_>) -> Option<(Hit, CarrierWeight)> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);
-        let mut set = crate::integrator::probe::ProbePoints::new();
+        let mut set = crate::integrator::probe_gathering::ProbePoints::new();
         let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, st.rng);
         st.counters.probe_sets += 1;
         if set.is_empty() {

@@ -78,6 +78,7 @@ use crate::geometry::{Geometry, Hit, ObjectSurface, Ray};
 use crate::integrator::bssrdf::BssrdfObject;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::preparation::PrepareObserver;
+use crate::integrator::profile_eval::eval_profile;
 use crate::integrator::walk::{reflect, refract};
 use crate::optical_size::light_reach;
 use crate::rng::Rng;
@@ -751,7 +752,7 @@ fn point_sums(
                 }
                 None => coeffs,
             };
-            b_half += counters.eval_profile(&bssrdf.family, c, r) * hit.weight;
+            b_half += eval_profile(&bssrdf.family, c, r, &mut counters) * hit.weight;
         }
     }
     Sums {
