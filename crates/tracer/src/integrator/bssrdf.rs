@@ -86,7 +86,7 @@ pub(crate) struct BssrdfObject {
     thickness_aware: bool,
     /// The shape correction c (module docs of [`super::shape_correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
-    pub correction: Option<super::shape_correction::ShapeCorrection>,
+    pub correction: Option<super::correction_factors::ShapeCorrection>,
     /// The rough boundary, when the material has one (module docs).
     rough: Option<RoughBoundary>,
 }

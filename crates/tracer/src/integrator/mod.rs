@@ -4,6 +4,7 @@
 //! the BSSRDF renderer's adjoint (light paths splatted to the camera), for reciprocity checks.
 
 mod bssrdf;
+mod correction_factors;
 pub mod counters;
 pub mod light_trace;
 pub mod lighting;
