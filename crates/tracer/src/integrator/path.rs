@@ -11,8 +11,9 @@
 //!   shadow ray through a medium classifies its light as having entered one, so that both
 //!   strategies weight and classify the same light path alike (`docs/physics.md#path-tracer`);
 //! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
-//!   ([`super::probe_gathering`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
-//!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
+//!   ([`super::probe_gathering`]), the estimator turns (x_i, x_o) into homogeneous
+//!   coefficients, the profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at
+//!   x_i.
 //!
 //! Radiance is RGB, and every path carries all three channels. A grey medium is walked once
 //! for all three. In a medium whose coefficients differ between channels the path uses
@@ -1529,11 +1530,12 @@ impl<'s> PathIntegrator<'s> {
         self.continue_from(&v, x_i, carried, st)
     }
 
-    /// The incident points x_i of the BSSRDF vertex `v`, from probe rays ([`super::probe_gathering`]),
-    /// each gathering light by next-event estimation (S_w, the shape correction's entry factor
-    /// for the light's direction, the profile weight and the angular coupling), added to the
-    /// path; and the carrier, the point the path continues from ([`Gathering`]), with its
-    /// weight. `None` when the probes found no point or none carries the path.
+    /// The incident points x_i of the BSSRDF vertex `v`, from probe rays
+    /// ([`super::probe_gathering`]), each gathering light by next-event estimation (S_w, the
+    /// shape correction's entry factor for the light's direction, the profile weight and the
+    /// angular coupling), added to the path; and the carrier, the point the path continues from
+    /// ([`Gathering`]), with its weight. `None` when the probes found no point or none carries
+    /// the path.
     fn gather(&self, v: &BssrdfVertex<'_>, st: &mut PathState<'_>) -> Option<(Hit, CarrierWeight)> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);

@@ -181,7 +181,9 @@ fn node_direction(n: DVec3, j: usize, k: usize) -> DVec3 {
 
 impl ShapeCorrection {
     /// Measures the correction for `object` rendered by `bssrdf` with `medium`.
-    /// `seed` keys every random number it draws.
+    /// `seed` keys every random number it draws. In three stages: the raw sums at sample
+    /// points ([`Build::measure`]), pooled over each point's neighbourhood ([`Build::pool`]),
+    /// then the fixed-point steps ([`Build::refine`]).
     pub fn build(
         bssrdf: &BssrdfObject,
         geometry: &Geometry,
@@ -194,79 +196,26 @@ impl ShapeCorrection {
         let mesh = geometry.mesh(object);
         let (lo, hi) = geometry.object_bounds(object);
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let walk_medium = walk_medium(medium);
         let h = sample_spacing(medium, bssrdf.family.g(), extent);
         let area = mesh.surface_area();
         let n_points = ((area / (h * h)).ceil() as usize).clamp(MIN_POINTS, MAX_POINTS);
-        // Triangle CDF by area.
-        let mut cdf = Vec::with_capacity(mesh.triangle_count());
-        let mut acc = 0.0;
-        for i in 0..mesh.triangle_count() {
-            let [a, b, c] = mesh.triangle_vertices(i);
-            acc += 0.5 * (b - a).cross(c - a).length();
-            cdf.push(acc);
-        }
-        let surface = ObjectSurface { geometry, object };
-        let key = |i: usize| PointKey {
+        let build = Build {
+            bssrdf,
+            surface: ObjectSurface { geometry, object },
+            medium,
+            walk_medium: walk_medium(medium),
             seed,
-            object: object as u64,
-            index: i as u64,
+            steps: Steps::new(observer),
         };
-        let grey = medium.is_grey();
         // Progress: the walks at each point, then (a faster stage) each fixed-point step's
         // responses.
-        let steps = Steps::new(observer);
         observer.stage("correction walks", n_points as u64);
-        // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
-        // c = 1 (the walks and probes in the body and under the plane agree but for what
-        // leaves that ball): no walks there (`None`).
-        let raw: Vec<(Hit, Coefficients, Option<Sums>)> = (0..n_points)
-            .into_par_iter()
-            .filter_map(|i| {
-                steps
-                    .step(|| {
-                        let mut rng = key(i).placement();
-                        let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
-                        let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                        // In a heterogeneous medium the light x_o sees may come from its most
-                        // translucent parts.
-                        let reach_of = if walk_medium.is_some() {
-                            medium.field_bounds().min
-                        } else {
-                            coeffs
-                        };
-                        let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
-                        let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
-                            point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, key(i))
-                        });
-                        Some((x_o, coeffs, sums))
-                    })
-                    .flatten()
-            })
-            .collect();
-        if steps.stopped() {
-            return None;
-        }
+        let raw = build.measure(n_points, extent)?;
         let hits: Vec<Hit> = raw.iter().map(|(x, _, _)| *x).collect();
         let points: Vec<DVec3> = hits.iter().map(|x| x.p).collect();
         let grid = Grid::new(&points, h, lo, hi);
         let weights = incident_weights(bssrdf.eta());
-        // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
-        // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
-        // bias, of order 1/(escapes per point), would not average out).
-        let pooled: Vec<Option<Sums>> = (0..raw.len())
-            .into_par_iter()
-            .map(|i| {
-                raw[i].2.as_ref()?;
-                let mut pooled = Sums::default();
-                grid.around(&hits, i, |j, w| {
-                    if let Some(sums) = &raw[j].2 {
-                        pooled.add_scaled(sums, w);
-                    }
-                });
-                Some(pooled.regularised())
-            })
-            .collect();
+        let pooled = Build::pool(&raw, &hits, &grid);
         let mut corr = Self {
             samples: hits
                 .iter()
@@ -281,56 +230,166 @@ impl ShapeCorrection {
             vertices: None,
             seconds: 0.0,
         };
-        // Where c varies on the scale of the profile (corners, edges), the incident side's
-        // factor differs from x_o's: iterate f ← √(f · T / B'), B' the body's response with
-        // the current factors at the incident points, T what it should be (module docs).
         observer.stage("correction steps", (raw.len() * ITERATIONS) as u64);
         for _ in 0..ITERATIONS {
-            let response: Vec<Option<Rgb>> = raw
-                .par_iter()
-                .enumerate()
-                .map(|(i, (x, coeffs, sums))| {
-                    steps
-                        .step(|| {
-                            sums.as_ref()?;
-                            Some(body_response(
-                                bssrdf,
-                                &surface,
-                                walk_medium,
-                                x,
-                                *coeffs,
-                                key(i),
-                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
-                            ))
-                        })
-                        .flatten()
-                })
-                .collect();
-            if steps.stopped() {
-                return None;
-            }
-            let updated: Vec<Directional> = (0..raw.len())
-                .into_par_iter()
-                .map(|i| {
-                    let Some(p) = &pooled[i] else {
-                        return Directional::ONE;
-                    };
-                    let mut b_prime = Rgb::ZERO;
-                    corr.grid.around(&hits, i, |j, w| {
-                        if let Some(r) = response[j] {
-                            b_prime += r * w;
-                        }
-                    });
-                    p.refine(&corr.samples[i].f, b_prime)
-                })
-                .collect();
-            for (s, f) in corr.samples.iter_mut().zip(updated) {
-                s.f = f;
-            }
+            build.refine(&mut corr, &raw, &hits, &pooled, &weights)?;
         }
         corr.vertices = corr.vertex_factors(mesh);
         corr.seconds = t0.elapsed().as_secs_f64();
         Some(corr)
+    }
+}
+
+/// The raw estimates at one sample point: the point, the medium's coefficients there, and its
+/// sums, `None` where the body holds the half-ball below it (c = 1 without walks).
+type RawPoint = (Hit, Coefficients, Option<Sums>);
+
+/// What the stages of [`ShapeCorrection::build`] read: the object measured, its BSSRDF, its
+/// medium and the one the walks go through ([`walk_medium`]), the seed of its random numbers
+/// and the steps its observer watches.
+struct Build<'a> {
+    bssrdf: &'a BssrdfObject,
+    surface: ObjectSurface<'a>,
+    medium: &'a MediumField,
+    walk_medium: Option<&'a MediumField>,
+    seed: u64,
+    steps: Steps<'a>,
+}
+
+impl Build<'_> {
+    /// The random numbers of sample point `i` ([`PointKey`]).
+    fn key(&self, i: usize) -> PointKey {
+        PointKey {
+            seed: self.seed,
+            object: self.surface.object as u64,
+            index: i as u64,
+        }
+    }
+
+    /// `n_points` sample points drawn uniformly by area on the object (of bounding-box extent
+    /// `extent`), with their raw sums; `None` when the observer stopped the build.
+    fn measure(&self, n_points: usize, extent: f64) -> Option<Vec<RawPoint>> {
+        let (geometry, object) = (self.surface.geometry, self.surface.object);
+        let (bssrdf, medium, walk_medium) = (self.bssrdf, self.medium, self.walk_medium);
+        let mesh = geometry.mesh(object);
+        // Triangle CDF by area.
+        let mut cdf = Vec::with_capacity(mesh.triangle_count());
+        let mut acc = 0.0;
+        for i in 0..mesh.triangle_count() {
+            let [a, b, c] = mesh.triangle_vertices(i);
+            acc += 0.5 * (b - a).cross(c - a).length();
+            cdf.push(acc);
+        }
+        let grey = medium.is_grey();
+        // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
+        // c = 1 (the walks and probes in the body and under the plane agree but for what
+        // leaves that ball): no walks there (`None`).
+        let raw: Vec<RawPoint> = (0..n_points)
+            .into_par_iter()
+            .filter_map(|i| {
+                self.steps
+                    .step(|| {
+                        let mut rng = self.key(i).placement();
+                        let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
+                        let coeffs = medium.at_surface(x_o.p, x_o.uv);
+                        // In a heterogeneous medium the light x_o sees may come from its most
+                        // translucent parts.
+                        let reach_of = if walk_medium.is_some() {
+                            medium.field_bounds().min
+                        } else {
+                            coeffs
+                        };
+                        let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
+                        let sums = (!contains_half_ball(&self.surface, &x_o, reach)).then(|| {
+                            let key = self.key(i);
+                            point_sums(bssrdf, &self.surface, &x_o, coeffs, walk_medium, grey, key)
+                        });
+                        Some((x_o, coeffs, sums))
+                    })
+                    .flatten()
+            })
+            .collect();
+        (!self.steps.stopped()).then_some(raw)
+    }
+
+    /// The raw sums of every point pooled over its neighbourhood in `grid` (built over the
+    /// points `hits`) and regularised ([`Sums::regularised`]); `None` for the points without
+    /// walks.
+    fn pool(raw: &[RawPoint], hits: &[Hit], grid: &Grid) -> Vec<Option<Sums>> {
+        // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
+        // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
+        // bias, of order 1/(escapes per point), would not average out).
+        (0..raw.len())
+            .into_par_iter()
+            .map(|i| {
+                raw[i].2.as_ref()?;
+                let mut pooled = Sums::default();
+                grid.around(hits, i, |j, w| {
+                    if let Some(sums) = &raw[j].2 {
+                        pooled.add_scaled(sums, w);
+                    }
+                });
+                Some(pooled.regularised())
+            })
+            .collect()
+    }
+
+    /// One fixed-point step of `corr` (module docs): where c varies on the scale of the
+    /// profile (corners, edges), the incident side's factor differs from x_o's, so f ← √(f ·
+    /// T / B'), B' the body's response with the current factors at the incident points, T what
+    /// it should be. `raw` and `pooled` are the points' sums, `hits` the points (the grid's),
+    /// `weights` the incident light's ([`incident_weights`]); `None` when the observer stopped
+    /// the build.
+    fn refine(
+        &self,
+        corr: &mut ShapeCorrection,
+        raw: &[RawPoint],
+        hits: &[Hit],
+        pooled: &[Option<Sums>],
+        weights: &[f64; DIRECTIONS],
+    ) -> Option<()> {
+        let response: Vec<Option<Rgb>> = raw
+            .par_iter()
+            .enumerate()
+            .map(|(i, (x, coeffs, sums))| {
+                self.steps
+                    .step(|| {
+                        sums.as_ref()?;
+                        Some(body_response(
+                            self.bssrdf,
+                            &self.surface,
+                            self.walk_medium,
+                            x,
+                            *coeffs,
+                            self.key(i),
+                            |x_i| corr.at(x_i.p, x_i.ns).incident_mean(weights),
+                        ))
+                    })
+                    .flatten()
+            })
+            .collect();
+        if self.steps.stopped() {
+            return None;
+        }
+        let updated: Vec<Directional> = (0..raw.len())
+            .into_par_iter()
+            .map(|i| {
+                let Some(p) = &pooled[i] else {
+                    return Directional::ONE;
+                };
+                let mut b_prime = Rgb::ZERO;
+                corr.grid.around(hits, i, |j, w| {
+                    if let Some(r) = response[j] {
+                        b_prime += r * w;
+                    }
+                });
+                p.refine(&corr.samples[i].f, b_prime)
+            })
+            .collect();
+        for (s, f) in corr.samples.iter_mut().zip(updated) {
+            s.f = f;
+        }
+        Some(())
     }
 }
 
