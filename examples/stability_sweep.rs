@@ -312,11 +312,12 @@ below keeps a value finite where the formula has a removable singularity or leav
 * `integrator/walk.rs`: at most `MAX_COLLISIONS` = 1e8 collisions per walk (counted as \
   `capped`); a walk that finds no boundary is counted as a `leak` and terminated; a boundary seen \
   from the wrong side is stepped over (counted as `wrong_side`).
-* `integrator/probe.rs`: one probe chord per axis; radii at or beyond the channel's r_max (99.9 % \
-  of its profile's energy) are rejected; at most 16 crossings per chord (`MAX_PROBE_HITS`); a \
-  hit whose density is 0 or not finite is dropped; a channel contributes to the density only \
-  within its own r_max; channels whose r_max is 0 or not finite are skipped; where x_o's \
-  coefficients do not scatter, the field's maximum shapes the probes.
+* `integrator/probe_gathering.rs` (over het-estimate's `probe.rs`): one probe chord per axis; \
+  radii at or beyond the channel's r_max (99.9 % of its profile's energy) are rejected; at most 16 \
+  crossings per chord (`MAX_PROBE_HITS`); a hit whose density is 0 or not finite is dropped; a \
+  channel contributes to the density only within its own r_max; channels whose r_max is 0 or not \
+  finite are skipped; where x_o's coefficients do not scatter, the field's maximum shapes the \
+  probes.
 * `volume.rs`: a majorant that is NaN or ≤ 0 means no collisions (pass); the constant-medium \
   transmittance exp(−σt·d) is 0 when σt·d is not finite; ratio tracking plays Russian roulette \
   below a running transmittance of 0.1.

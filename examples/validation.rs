@@ -22,7 +22,7 @@ use bssrdf_core::{ProfileFamily, ProfileModel, RadialProfile, Scattering};
 use experiments::beam::{BeamSetup, BeamTexture, PhotonBudget, trace_photons};
 use het_bssrdf::{bssrdf_core, tracer};
 use tracer::integrator::Method;
-use tracer::integrator::probe::PROBE_ENERGY_FRACTION;
+use tracer::integrator::probe_gathering::PROBE_ENERGY_FRACTION;
 
 fn row(name: &str, got: (f64, f64), want: f64) {
     let z = (got.0 - want) / got.1;

@@ -9,7 +9,7 @@ use glam::DVec3;
 use tracer::camera::Camera;
 use tracer::field::{ArtistMap, Field, InvertAt, MediumField};
 use tracer::geometry::primitives;
-use tracer::integrator::probe::PROBE_ENERGY_FRACTION;
+use tracer::integrator::probe_gathering::PROBE_ENERGY_FRACTION;
 use tracer::integrator::{Method, PathOptions};
 use tracer::light::Light;
 use tracer::scene::{Material, RenderSettings, Scene, SceneBuilder, Translucent};

@@ -75,7 +75,8 @@ fn bssrdf_render_of_a_half_space_matches_the_dipole_closed_form() {
     let alpha = sigma_s / (sigma_a + sigma_s);
     let root = (3.0 * (1.0 - alpha)).sqrt();
     let r_tot = 0.5 * alpha * (-root).exp() * (1.0 + (-4.0 / 3.0 * a * root).exp());
-    let want = r_tot / std::f64::consts::PI * tracer::integrator::probe::PROBE_ENERGY_FRACTION;
+    let want =
+        r_tot / std::f64::consts::PI * tracer::integrator::probe_gathering::PROBE_ENERGY_FRACTION;
     for name in ["jensen-out", "endpoints", "segment", "sone"] {
         let method = Method::bssrdf(name.parse().unwrap(), Some(ProfileModel::Dipole));
         let (m, se) = mean_and_se(&scene, method, Scattering::Multiple, 64, 8);
@@ -191,7 +192,7 @@ fn probe_estimator_integrates_the_surface_inside_the_probe_sphere() {
     // (solid-angle sampling: area density cos α / (4π |x|²)). The sphere is small against the
     // mean free path so that the tangent probes contribute as much as the normal one.
     use tracer::geometry::Ray;
-    use tracer::integrator::probe::{ProbeSampler, probe};
+    use tracer::integrator::probe_gathering::{ProbeSampler, probe};
     use tracer::rng::Rng;
     let medium = MediumField::homogeneous(Coefficients::grey(1.25, 7.5)).unwrap();
     let scene = SceneBuilder::new(
@@ -286,7 +287,7 @@ fn probe_points_on_a_plane_pass_chi_square_against_the_radial_density() {
     // (from the density, integrated independently by the midpoint rule); significance 1e-4.
     use bssrdf_core::ProfileTable;
     use tracer::geometry::Ray;
-    use tracer::integrator::probe::{PROBE_ENERGY_FRACTION, ProbeSampler, probe};
+    use tracer::integrator::probe_gathering::{PROBE_ENERGY_FRACTION, ProbeSampler, probe};
     use tracer::rng::Rng;
     let (sa, ss) = (0.05, 1.0);
     let scene = half_space_scene(sa, ss, DVec3::Z, 1.0);

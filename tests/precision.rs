@@ -13,7 +13,7 @@ use het_estimate::pattern::{BinaryPattern, Check, Stripe};
 use het_estimate::{CoefficientField, Coefficients, Estimator};
 use tracer::field::{Axis, Field, MediumField, PlanarProjection};
 use tracer::geometry::{Geometry, Hit, ObjectSurface, Ray, TriangleMesh, primitives};
-use tracer::integrator::probe::{ProbeSampler, probe};
+use tracer::integrator::probe_gathering::{ProbeSampler, probe};
 use tracer::rng::Rng;
 
 /// Standard errors allowed in the statistical checks (fixed seeds).

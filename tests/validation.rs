@@ -72,7 +72,7 @@ fn diffuse_transfer(
     use glam::DVec3;
     use tracer::geometry::Ray;
     use tracer::integrator::PathCounters;
-    use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
+    use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium, WalkStart};
     use tracer::rng::Rng;
     use tracer::scene::Material;
     use tracer::volume::ChannelView;
@@ -100,15 +100,14 @@ fn diffuse_transfer(
         let u = rng.uniform2();
         let dir = direction_about(DVec3::NEG_Z, u[0].sqrt(), std::f64::consts::TAU * u[1]);
         let mut order = 0;
-        if let WalkEnd::Exited { hit, .. } = walk.walk(
-            entry.spawn_origin(dir),
+        let from = WalkStart {
+            origin: entry.spawn_origin(dir),
             dir,
-            None,
-            &mut order,
-            &mut rng,
-            &mut counters,
-            |_, _, _, _| {},
-        ) && hit.ng.z > 0.5
+            last_scatter: None,
+        };
+        if let WalkEnd::Exited { hit, .. } =
+            walk.walk(from, &mut order, &mut rng, &mut counters, |_, _, _, _| {})
+            && hit.ng.z > 0.5
             && (hit.p.x - to[0]).hypot(hit.p.y - to[1]) < radius
         {
             hits += 1;

@@ -33,7 +33,8 @@ use tracer::error::SceneError;
 use tracer::field::{Field, MediumField, PlanarProjection};
 use tracer::geometry::{Hit, Ray, primitives};
 use tracer::integrator::PathCounters;
-use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium};
+use tracer::integrator::profile_eval::eval_profile_channel;
+use tracer::integrator::walk::{Interface, WalkEnd, WalkMedium, WalkStart};
 use tracer::light::Light;
 use tracer::render::Counters;
 use tracer::rng::Rng;
@@ -349,15 +350,12 @@ pub fn trace_photons(
                     let mut rng = Rng::from_keys(seed, &[0xbea, k]);
                     let mut order = 0;
                     c.paths += 1;
-                    let end = walk.walk(
-                        entry.spawn_origin(dir),
+                    let from = WalkStart {
+                        origin: entry.spawn_origin(dir),
                         dir,
-                        None,
-                        &mut order,
-                        &mut rng,
-                        &mut c,
-                        |_, _, _, _| {},
-                    );
+                        last_scatter: None,
+                    };
+                    let end = walk.walk(from, &mut order, &mut rng, &mut c, |_, _, _, _| {});
                     if let WalkEnd::Exited { hit, .. } = end
                         && hit.ng.z > 0.5
                     {
@@ -471,7 +469,7 @@ pub fn bssrdf_map(
                     c.record_estimate(&est.diagnostics);
                     let cf = est.coefficients;
                     let r = (x_o.p - x_i.p).length();
-                    sum += c.eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r);
+                    sum += eval_profile_channel(&family, cf.sigma_a[0], cf.sigma_s[0], r, &mut c);
                 }
                 *value = sum / (k * k) as f64;
             }

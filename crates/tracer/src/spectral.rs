@@ -21,7 +21,7 @@
 //! `r_u` get identical updates in the medium). The path tracer divides β by the mean of r_u
 //! over the channels: f_c / ((1/3) Σ_k p_k), the one-sample balance heuristic over the three
 //! channels as sampling techniques (Vea97 §9.2.4) — the hero being chosen uniformly. Only ratios
-//! between the channels of q matter, so [`sample_hero`] rescales it when its largest channel
+//! between the channels of q matter, so [`HeroTracking`] rescales it when its largest channel
 //! leaves [1e-100, 1e100], and the product over any number of collisions neither overflows nor
 //! underflows in the channel that counts. The path tracer's use, and what next-event estimation does: `integrator/path.rs`
 //! and `docs/physics.md#spectral-mis`.
@@ -41,6 +41,17 @@ pub trait SpectralMedium {
     fn coefficients(&self, p: DVec3) -> (Rgb, Rgb);
     /// A per-channel majorant σ̄ ≥ σa(x) + σs(x) for every point of the medium.
     fn majorant(&self) -> Rgb;
+}
+
+impl<M: SpectralMedium + ?Sized> SpectralMedium for &M {
+    #[inline]
+    fn coefficients(&self, p: DVec3) -> (Rgb, Rgb) {
+        (**self).coefficients(p)
+    }
+    #[inline]
+    fn majorant(&self) -> Rgb {
+        (**self).majorant()
+    }
 }
 
 /// All three channels of a scene's [`MediumField`] as a [`SpectralMedium`] (the path tracer's
@@ -91,6 +102,11 @@ pub struct HeroTracking<M> {
 }
 
 impl<M: SpectralMedium> FreeFlight for HeroTracking<M> {
+    /// The next real interaction along `origin + t·dir`, `t ∈ (0, t_max)`, by delta tracking
+    /// with the majorant of the hero's channel, multiplying `weight` by each channel's density
+    /// ratio to the hero's (see the module docs), rescaled when its largest channel leaves
+    /// [1e-100, 1e100]. The hero's own channel is multiplied by 1 at every step, so it stays
+    /// positive. `t_max` may be infinite only where the hero surely collides.
     #[inline]
     fn sample_flight(
         &self,
@@ -101,16 +117,39 @@ impl<M: SpectralMedium> FreeFlight for HeroTracking<M> {
         counters: &mut TrackingCounters,
         weight: &mut Rgb,
     ) -> Interaction {
-        sample_hero(
-            &self.medium,
-            self.hero,
-            origin,
-            dir,
-            t_max,
-            rng,
-            counters,
-            weight,
-        )
+        let hero = self.hero;
+        let majorant = self.medium.majorant();
+        let m_h = majorant[hero];
+        if m_h.is_nan() || m_h <= 0.0 {
+            // The hero sees vacuum: it passes with probability 1; the other channels'
+            // densities of passing are their majorant transmittances.
+            fold_majorant(weight, majorant, hero, t_max);
+            return Interaction::Pass;
+        }
+        let mut t = 0.0;
+        loop {
+            t += unit_exponential(rng) / m_h;
+            counters.delta_steps += 1;
+            if t >= t_max {
+                fold_majorant(weight, majorant, hero, t_max);
+                return Interaction::Pass;
+            }
+            let (sigma_a, sigma_s) = self.medium.coefficients(origin + t * dir);
+            let xi = rng.uniform() * m_h;
+            if xi < sigma_a[hero] {
+                return Interaction::Absorb { t };
+            }
+            if xi < sigma_a[hero] + sigma_s[hero] {
+                // σs,h > xi − σa,h ≥ 0 here.
+                *weight *= sigma_s * (1.0 / sigma_s[hero]);
+                fold_majorant(weight, majorant, hero, t);
+                return Interaction::Scatter { t };
+            }
+            // A null collision: σn,h ≥ σ̄_h − xi > 0.
+            let sigma_n = (majorant - sigma_a - sigma_s).map(|s| s.max(0.0));
+            *weight *= sigma_n * (1.0 / sigma_n[hero]);
+            normalise(weight);
+        }
     }
 }
 
@@ -143,56 +182,6 @@ fn fold_majorant(weight: &mut Rgb, majorant: Rgb, hero: usize, t: f64) {
         }
     }
     normalise(weight);
-}
-
-/// The next real interaction along `origin + t·dir`, `t ∈ (0, t_max)`, by delta tracking with
-/// the majorant of channel `hero`, multiplying `weight` by each channel's density ratio to the
-/// hero's (see the module docs), rescaled when its largest channel leaves [1e-100, 1e100].
-/// The hero's own channel is multiplied by 1 at every step, so it stays positive. `t_max` may be infinite only
-/// where the hero surely collides.
-#[allow(clippy::too_many_arguments)]
-pub fn sample_hero<M: SpectralMedium + ?Sized>(
-    medium: &M,
-    hero: usize,
-    origin: DVec3,
-    dir: DVec3,
-    t_max: f64,
-    rng: &mut Rng,
-    counters: &mut TrackingCounters,
-    weight: &mut Rgb,
-) -> Interaction {
-    let majorant = medium.majorant();
-    let m_h = majorant[hero];
-    if m_h.is_nan() || m_h <= 0.0 {
-        // The hero sees vacuum: it passes with probability 1; the other channels' densities
-        // of passing are their majorant transmittances.
-        fold_majorant(weight, majorant, hero, t_max);
-        return Interaction::Pass;
-    }
-    let mut t = 0.0;
-    loop {
-        t += unit_exponential(rng) / m_h;
-        counters.delta_steps += 1;
-        if t >= t_max {
-            fold_majorant(weight, majorant, hero, t_max);
-            return Interaction::Pass;
-        }
-        let (sigma_a, sigma_s) = medium.coefficients(origin + t * dir);
-        let xi = rng.uniform() * m_h;
-        if xi < sigma_a[hero] {
-            return Interaction::Absorb { t };
-        }
-        if xi < sigma_a[hero] + sigma_s[hero] {
-            // σs,h > xi − σa,h ≥ 0 here.
-            *weight *= sigma_s * (1.0 / sigma_s[hero]);
-            fold_majorant(weight, majorant, hero, t);
-            return Interaction::Scatter { t };
-        }
-        // A null collision: σn,h ≥ σ̄_h − xi > 0.
-        let sigma_n = (majorant - sigma_a - sigma_s).map(|s| s.max(0.0));
-        *weight *= sigma_n * (1.0 / sigma_n[hero]);
-        normalise(weight);
-    }
 }
 
 #[cfg(test)]
@@ -253,9 +242,7 @@ mod tests {
         for _ in 0..n {
             let hero = rng.below(3) as usize;
             let mut w = Rgb::ONE;
-            let i = sample_hero(
-                &m,
-                hero,
+            let i = HeroTracking { medium: &m, hero }.sample_flight(
                 DVec3::ZERO,
                 DVec3::X,
                 t_max,
@@ -300,16 +287,11 @@ mod tests {
         let mut counters = TrackingCounters::default();
         let mut w = Rgb::ONE;
         for _ in 0..100_000 {
-            let i = sample_hero(
-                &m,
-                1,
-                DVec3::ZERO,
-                DVec3::X,
-                0.9,
-                &mut rng,
-                &mut counters,
-                &mut w,
-            );
+            let i = HeroTracking {
+                medium: &m,
+                hero: 1,
+            }
+            .sample_flight(DVec3::ZERO, DVec3::X, 0.9, &mut rng, &mut counters, &mut w);
             if matches!(i, Interaction::Absorb { .. }) {
                 continue;
             }
@@ -324,16 +306,11 @@ mod tests {
             right: (Rgb::new(0.0, 1.0, 0.0), Rgb::ZERO),
         };
         let mut w = Rgb::ONE;
-        let i = sample_hero(
-            &vacuum,
-            0,
-            DVec3::ZERO,
-            DVec3::X,
-            2.0,
-            &mut rng,
-            &mut counters,
-            &mut w,
-        );
+        let i = HeroTracking {
+            medium: &vacuum,
+            hero: 0,
+        }
+        .sample_flight(DVec3::ZERO, DVec3::X, 2.0, &mut rng, &mut counters, &mut w);
         assert_eq!(i, Interaction::Pass);
         assert_eq!(w, Rgb::new(1.0, (-2.0f64).exp(), 1.0));
     }

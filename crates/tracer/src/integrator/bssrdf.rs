@@ -61,7 +61,8 @@ use crate::bsdf::{SMOOTH_ALPHA, TransmittanceTable, alpha_from_roughness};
 use crate::field::{Field, MediumField};
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::counters::PathCounters;
-use crate::integrator::probe::ProbeSampler;
+use crate::integrator::probe_gathering::ProbeSampler;
+use crate::integrator::profile_eval::{eval_profile, eval_slab_profile};
 use crate::rng::Rng;
 use crate::scene::Translucent;
 
@@ -77,7 +78,7 @@ pub(crate) struct BssrdfObject {
     /// (`bssrdf_core::separable`).
     bssrdf: SeparableBssrdf,
     /// The longest side of the object's bounding box: the extent the probe radii are drawn
-    /// within ([`super::probe::probe_within`]).
+    /// within ([`super::probe_gathering::probe_within`]).
     pub extent: f64,
     /// Weigh pairs by the slab profile of the local thickness (see the module docs): the
     /// material is `thickness_aware`, the family has a slab table (tabulated model) and
@@ -90,7 +91,7 @@ pub(crate) struct BssrdfObject {
     far_side_reach: f64,
     /// The shape correction c (module docs of [`super::shape_correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
-    pub correction: Option<super::shape_correction::ShapeCorrection>,
+    pub correction: Option<super::correction_factors::ShapeCorrection>,
     /// The rough boundary, when the material has one (module docs).
     rough: Option<RoughBoundary>,
 }
@@ -190,14 +191,14 @@ impl BssrdfObject {
 
     /// One probe set around `x_o` over `chords` (the object, or the shape correction's
     /// tangent plane), with the radii the renderers use on this object (at most its extent:
-    /// [`super::probe::probe_within`]).
+    /// [`super::probe_gathering::probe_within`]).
     pub(crate) fn probe_set<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,
         chords: &C,
         x_o: &Hit,
         coeffs: het_estimate::Coefficients,
         rng: &mut Rng,
-    ) -> crate::integrator::probe::ProbeSet {
+    ) -> crate::integrator::probe_gathering::ProbeSet {
         self.sampler
             .probe_chords(chords, x_o, coeffs, self.extent, rng)
     }
@@ -206,7 +207,7 @@ impl BssrdfObject {
     /// the density that weights each when the caller needs it.
     pub(crate) fn probe_points_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
         &self,
-        points: &mut crate::integrator::probe::ProbePoints,
+        points: &mut crate::integrator::probe_gathering::ProbePoints,
         chords: &C,
         x_o: &Hit,
         coeffs: het_estimate::Coefficients,
@@ -340,33 +341,33 @@ impl BssrdfObject {
     ) -> (Rgb, bool) {
         let r = (x_i.p - x_o.p).length();
         if !self.thickness_aware {
-            return (counters.eval_profile(&self.family, coeffs, r), true);
+            return (eval_profile(&self.family, coeffs, r, counters), true);
         }
         let reach = self.far_side_reach;
         let d = 0.5 * (thickness(surface, x_i, reach) + thickness(surface, x_o, reach));
         match slab_pair(x_i, x_o, d) {
             Some((face, dist)) => (
-                counters.eval_slab_profile(&self.family, coeffs, d, face, dist),
+                eval_slab_profile(&self.family, coeffs, d, face, dist, counters),
                 face == SlabFace::Reflection,
             ),
-            None => (counters.eval_profile(&self.family, coeffs, r), true),
+            None => (eval_profile(&self.family, coeffs, r, counters), true),
         }
     }
 
-    /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs); 0
-    /// when either direction is behind its surface ([`facing_normal`]).
-    #[allow(clippy::too_many_arguments)]
+    /// The full S(x_i, ω_i; x_o, ω_o) (1/(length²·sr), per channel; see the module docs) of
+    /// the pair `incident` (x_i, ω_i) and `exitant` (x_o, ω_o); 0 when either direction is
+    /// behind its surface ([`facing_normal`]).
     pub fn eval(
         &self,
         surface: &ObjectSurface<'_>,
         medium: &MediumField,
-        x_i: &Hit,
-        w_i: DVec3,
-        x_o: &Hit,
-        w_o: DVec3,
+        incident: PairEnd<'_>,
+        exitant: PairEnd<'_>,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Rgb {
+        let PairEnd { hit: x_i, w: w_i } = incident;
+        let PairEnd { hit: x_o, w: w_o } = exitant;
         let (Some(n_i), Some(n_o)) = (facing_normal(x_i, w_i), facing_normal(x_o, w_o)) else {
             return Rgb::ZERO;
         };
@@ -392,6 +393,17 @@ impl BssrdfObject {
             _ => s,
         }
     }
+}
+
+/// One end of a BSSRDF pair: the surface point and the unit direction, pointing out of the
+/// medium, along which light crosses the boundary there (toward the light at x_i, toward the
+/// viewer at x_o).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PairEnd<'h> {
+    /// The surface point.
+    pub hit: &'h Hit,
+    /// The direction outside the medium (unit).
+    pub w: DVec3,
 }
 
 /// The normal the BSSRDF measures the direction `w` (unit, pointing away from the surface)

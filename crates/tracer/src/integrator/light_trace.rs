@@ -53,7 +53,7 @@ use rayon::prelude::*;
 
 use crate::film::Film;
 use crate::geometry::{Hit, ObjectSurface, Ray, offset_ray_origin};
-use crate::integrator::bssrdf::facing_normal;
+use crate::integrator::bssrdf::{PairEnd, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::{Method, PathIntegrator, PathOptions, RenderError};
 use crate::light::{Light, uniform_sphere};
@@ -305,7 +305,7 @@ impl<'s> LightTracer<'s> {
             geometry,
             object: x_i.object,
         };
-        let mut set = crate::integrator::probe::ProbePoints::new();
+        let mut set = crate::integrator::probe_gathering::ProbePoints::new();
         let density = b.probe_points_into(&mut set, &surface, &x_i, at_xi, rng);
         if set.is_empty() {
             counters.probe_misses += 1;
@@ -326,24 +326,22 @@ impl<'s> LightTracer<'s> {
             let Some(weight) = density.weight(&x_o, axis) else {
                 continue;
             };
+            let (light_end, camera_end) =
+                (PairEnd { hit: &x_i, w: w_i }, PairEnd { hit: &x_o, w: w_o });
             let s = match self.roles {
                 Roles::Physical => b.eval(
                     &surface,
                     &material.medium,
-                    &x_i,
-                    w_i,
-                    &x_o,
-                    w_o,
+                    light_end,
+                    camera_end,
                     rng,
                     counters,
                 ),
                 Roles::Swapped => b.eval(
                     &surface,
                     &material.medium,
-                    &x_o,
-                    w_o,
-                    &x_i,
-                    w_i,
+                    camera_end,
+                    light_end,
                     rng,
                     counters,
                 ),

@@ -4,6 +4,7 @@
 //! the BSSRDF renderer's adjoint (light paths splatted to the camera), for reciprocity checks.
 
 mod bssrdf;
+mod correction_factors;
 pub mod counters;
 pub mod light_trace;
 pub mod lighting;
@@ -11,7 +12,8 @@ mod method;
 pub mod path;
 pub mod plan;
 pub mod preparation;
-pub mod probe;
+pub mod probe_gathering;
+pub mod profile_eval;
 mod shape_correction;
 pub mod walk;
 pub mod warnings;

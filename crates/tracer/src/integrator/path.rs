@@ -11,8 +11,9 @@
 //!   shadow ray through a medium classifies its light as having entered one, so that both
 //!   strategies weight and classify the same light path alike (`docs/physics.md#path-tracer`);
 //! * [`Method::Bssrdf`]: an incident point x_i is importance-sampled with probe rays
-//!   ([`super::probe`]), the estimator turns (x_i, x_o) into homogeneous coefficients, the
-//!   profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at x_i.
+//!   ([`super::probe_gathering`]), the estimator turns (x_i, x_o) into homogeneous
+//!   coefficients, the profile is evaluated at r = |x_i − x_o|, and irradiance is gathered at
+//!   x_i.
 //!
 //! Radiance is RGB, and every path carries all three channels. A grey medium is walked once
 //! for all three. In a medium whose coefficients differ between channels the path uses
@@ -41,13 +42,13 @@ use het_estimate::{CoefficientField, Estimator};
 use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
-use crate::integrator::bssrdf::{BssrdfObject, facing_normal};
+use crate::integrator::bssrdf::{BssrdfObject, PairEnd, PairWeight, facing_normal};
+use crate::integrator::correction_factors::ShapeCorrection;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;
-use crate::integrator::probe::Gathering;
-use crate::integrator::shape_correction::ShapeCorrection;
-use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium};
+use crate::integrator::probe_gathering::Gathering;
+use crate::integrator::walk::{Crossing, Interface, WalkEnd, WalkMedium, WalkStart};
 use crate::light::{Light, LightSample};
 use crate::render::{Counters, PixelEstimator};
 use crate::rng::Rng;
@@ -337,6 +338,17 @@ impl Direct {
     };
 }
 
+/// A vertex next-event estimation samples lights from ([`PathIntegrator::direct`]).
+#[derive(Debug, Clone, Copy)]
+struct LightVertex {
+    /// Where the light is sampled from.
+    p: DVec3,
+    /// The translucent object the vertex lies in, where its shadow rays start (path tracing).
+    medium: Option<u32>,
+    /// The kind of vertex: which lights it may choose ([`LightSet::at`]).
+    at: Vertex,
+}
+
 /// What a shadow segment lets through.
 #[derive(Debug, Clone, Copy)]
 struct Transmission {
@@ -351,6 +363,17 @@ impl Transmission {
         tr: Rgb::ZERO,
         through_medium: false,
     };
+}
+
+/// A translucent object a path walks in (path tracing).
+#[derive(Clone, Copy)]
+struct MediumObject<'a> {
+    /// The object's index.
+    object: u32,
+    /// Its material.
+    material: &'a Translucent,
+    /// The medium has the same coefficients in every channel (one walk carries all three).
+    grey: bool,
 }
 
 /// The previous vertex of a path, for MIS when the path hits an emitter by chance.
@@ -451,7 +474,11 @@ impl LightStrategy {
     }
 }
 
-struct PathState {
+/// One camera path being traced: the per-path context every shading step of
+/// [`PathIntegrator::li`] takes. What the path has gathered and carries, where it is and the
+/// vertex it comes from, and the random stream it draws from and the counters it records into.
+struct PathState<'r> {
+    /// Radiance gathered so far.
     l: Rgb,
     /// Throughput per channel, divided by the mean of `r_u` (spectral MIS).
     beta: Rgb,
@@ -470,6 +497,10 @@ struct PathState {
     /// A factor of `beta` not evaluated yet: the BSSRDF profile weight of the point the path
     /// continued from, deferred because that point gathered no light (see [`Deferred`]).
     deferred: Option<Deferred>,
+    /// The path's random numbers.
+    rng: &'r mut Rng,
+    /// The render's counters (of this row).
+    counters: &'r mut PathCounters,
 }
 
 /// The profile weight `R(x_i, x_o)·scale` of a BSSRDF continuation, owed to `beta`.
@@ -496,7 +527,7 @@ struct Deferred {
     n_o: DVec3,
 }
 
-impl PathState {
+impl PathState<'_> {
     /// Adds `contribution` if the scattering-order filter lets this path's light through.
     fn add(&mut self, contribution: Rgb, order: u32, entered: bool, filter: Scattering) {
         if !entered || filter.counts(order) {
@@ -528,6 +559,36 @@ fn carried(beta: Rgb, r_u: Rgb, q: Rgb) -> (Rgb, Rgb) {
     } else {
         (Rgb::ZERO, Rgb::ONE)
     }
+}
+
+/// A BSSRDF vertex being shaded ([`PathIntegrator::subsurface`]): the object, and its exitant
+/// side, which every incident point pairs with.
+struct BssrdfVertex<'a> {
+    /// The object's material.
+    material: &'a Translucent,
+    /// Its BSSRDF.
+    b: &'a BssrdfObject,
+    /// Its surface (the probes' and the estimator's).
+    surface: ObjectSurface<'a>,
+    /// The exitant point x_o.
+    x_o: &'a Hit,
+    /// The direction ω_o toward the viewer (unit).
+    w_o: DVec3,
+    /// The normal S measures ω_o against ([`facing_normal`]).
+    n_o: DVec3,
+    /// The boundary's roughness α at x_o (0 where it is smooth).
+    alpha_o: f64,
+}
+
+/// The profile weight of the incident point a BSSRDF vertex continues from (the carrier,
+/// [`PathIntegrator::gather`]).
+enum CarrierWeight {
+    /// Evaluated: the factor `R·weight·scale` of `beta` (per channel), and the pair's weight for
+    /// the angular coupling.
+    Evaluated(Rgb, PairWeight),
+    /// Owed, the carrier having gathered no light ([`Deferred`]): the scale of the profile
+    /// weight still to be evaluated.
+    Owed(f64),
 }
 
 /// What a path did at a rough boundary met from outside
@@ -757,6 +818,8 @@ impl<'s> PathIntegrator<'s> {
             medium: None,
             prev: Prev::Specular,
             deferred: None,
+            rng,
+            counters,
         };
         let mut ray = ray;
         let mut arrived = None;
@@ -772,7 +835,7 @@ impl<'s> PathIntegrator<'s> {
                     None => {
                         let le = self.escaped(&ray, st.prev);
                         if !le.is_zero() {
-                            self.settle(&mut st, rng, counters);
+                            self.settle(&mut st);
                             st.add(st.beta * le, st.order, st.entered, filter);
                         }
                         break;
@@ -783,8 +846,8 @@ impl<'s> PathIntegrator<'s> {
                 ObjectKind::Translucent { .. } if st.medium.is_some() => {
                     // Another medium met from inside one: only where two objects touch
                     // (overlaps are refused at load). Step over its face.
-                    counters.wrong_side += 1;
-                    self.go_on(hit.spawn_ray(ray.dir), &mut st, rng, counters)
+                    st.counters.wrong_side += 1;
+                    self.go_on(hit.spawn_ray(ray.dir), &mut st)
                 }
                 ObjectKind::Translucent {
                     material,
@@ -792,19 +855,26 @@ impl<'s> PathIntegrator<'s> {
                     grey,
                     ..
                 } => match bssrdf {
-                    None => self.volumetric(&hit, &ray, material, *grey, &mut st, rng, counters),
-                    Some(b) => self.subsurface(&hit, &ray, material, b, &mut st, rng, counters),
+                    None => {
+                        let medium = MediumObject {
+                            object: hit.object,
+                            material,
+                            grey: *grey,
+                        };
+                        self.volumetric(&hit, &ray, medium, &mut st)
+                    }
+                    Some(b) => self.subsurface(&hit, &ray, material, b, &mut st),
                 },
                 ObjectKind::Opaque => match &self.scene.objects()[hit.object as usize].material {
                     Material::Emissive { .. } => {
                         let le = self.emitted(&hit, &ray, st.prev);
                         if !le.is_zero() {
-                            self.settle(&mut st, rng, counters);
+                            self.settle(&mut st);
                             st.add(st.beta * le, st.order, st.entered, filter);
                         }
                         Step::Stop
                     }
-                    Material::Diffuse(d) => self.diffuse(&hit, &ray, d, &mut st, rng, counters),
+                    Material::Diffuse(d) => self.diffuse(&hit, &ray, d, &mut st),
                     Material::Translucent(_) => unreachable!("translucent objects are prepared"),
                 },
             };
@@ -815,7 +885,7 @@ impl<'s> PathIntegrator<'s> {
             }
             if depth + 1 >= RR_DEPTH {
                 let q = st.beta.max_component().min(0.95);
-                if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                if q.is_nan() || q <= 0.0 || st.rng.uniform() >= q {
                     break;
                 }
                 st.beta /= q;
@@ -872,15 +942,7 @@ impl<'s> PathIntegrator<'s> {
     /// uniform one then gives every path the same value (the white furnaces stay exact).
     /// Skipped without quad lights, and under [`LightStrategy::DirectionOnly`] (which counts
     /// lights hit by chance only).
-    fn mirror_emission(
-        &self,
-        hit: &Hit,
-        dir: DVec3,
-        r: f64,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
-    ) -> bool {
+    fn mirror_emission(&self, hit: &Hit, dir: DVec3, r: f64, st: &mut PathState<'_>) -> bool {
         if !self.mirror_nee || self.strategy == LightStrategy::DirectionOnly || r <= 0.0 {
             return false;
         }
@@ -888,7 +950,7 @@ impl<'s> PathIntegrator<'s> {
         if let Some(h) = self.scene.geometry().intersect(&ray) {
             let le = self.emitted(&h, &ray, Prev::Specular);
             if !le.is_zero() {
-                self.settle(st, rng, counters);
+                self.settle(st);
                 st.add(
                     st.beta * le * r,
                     st.order,
@@ -916,19 +978,16 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
-    /// Next-event estimation from `p`: one light chosen uniformly, its sample weighted by
-    /// `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction sampler's
-    /// pdf), times the shadow ray's transmittance per channel (the ray starts inside `medium`,
-    /// if any). Returns radiance (before path weight) and whether the shadow ray crossed a
-    /// medium.
-    #[allow(clippy::too_many_arguments)]
+    /// Next-event estimation from the vertex `v`: one light chosen uniformly, its sample
+    /// weighted by `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction
+    /// sampler's pdf), times the transmittance per channel of the shadow ray from
+    /// `origin_for(wi)`. Returns radiance (before path weight) and whether the shadow ray
+    /// crossed a medium.
     fn direct(
         &self,
-        p: DVec3,
+        v: LightVertex,
         origin_for: impl Fn(DVec3) -> DVec3,
         f_and_pdf: impl Fn(DVec3) -> (f64, f64),
-        medium: Option<u32>,
-        at: Vertex,
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Direct {
@@ -937,12 +996,12 @@ impl<'s> PathIntegrator<'s> {
         if self.strategy == LightStrategy::DirectionOnly {
             return Direct::NONE;
         }
-        let lights = self.lights(at);
+        let lights = self.lights(v.at);
         let Some(i) = lights.select(u) else {
             return Direct::NONE;
         };
         let light = &self.scene.lights()[i];
-        let Some(ls) = light.sample_li(p, u2) else {
+        let Some(ls) = light.sample_li(v.p, u2) else {
             return Direct::NONE;
         };
         let (f, pdf_dir) = f_and_pdf(ls.wi);
@@ -953,7 +1012,7 @@ impl<'s> PathIntegrator<'s> {
         let Some(seg) = ShadowSegment::toward(origin, &ls) else {
             return Direct::NONE;
         };
-        let shadow = self.shadow(&seg, medium, rng, counters);
+        let shadow = self.shadow(&seg, v.medium, rng, counters);
         if shadow.tr.is_zero() {
             return Direct::NONE;
         }
@@ -1075,15 +1134,7 @@ impl<'s> PathIntegrator<'s> {
 
     /// A diffuse surface: NEE plus cosine-weighted continuation. Inside a medium the shadow
     /// ray starts in it and the continuation walks on in it.
-    fn diffuse(
-        &self,
-        hit: &Hit,
-        ray: &Ray,
-        material: &Diffuse,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
-    ) -> Step {
+    fn diffuse(&self, hit: &Hit, ray: &Ray, material: &Diffuse, st: &mut PathState<'_>) -> Step {
         let n = if hit.ns.dot(ray.dir) < 0.0 {
             hit.ns
         } else {
@@ -1100,7 +1151,11 @@ impl<'s> PathIntegrator<'s> {
             }
         };
         let ld = self.direct(
-            hit.p,
+            LightVertex {
+                p: hit.p,
+                medium: st.medium,
+                at: Vertex::Surface,
+            },
             |wi| hit.spawn_origin(wi),
             |wi| {
                 let c = wi.dot(n);
@@ -1111,13 +1166,11 @@ impl<'s> PathIntegrator<'s> {
                     (0.0, 0.0)
                 }
             },
-            st.medium,
-            Vertex::Surface,
-            rng,
-            counters,
+            st.rng,
+            st.counters,
         );
         if !ld.l.is_zero() {
-            self.settle(st, rng, counters);
+            self.settle(st);
         }
         // Light whose shadow ray crossed a medium has entered one, as the cosine-sampled path
         // through the same medium will have (`entered` set with no scattering added).
@@ -1127,7 +1180,7 @@ impl<'s> PathIntegrator<'s> {
             st.entered || ld.through_medium,
             self.options.scattering,
         );
-        let Some((wi, cos)) = cosine_continuation(n, rng) else {
+        let Some((wi, cos)) = cosine_continuation(n, st.rng) else {
             return Step::Stop;
         };
         st.beta *= albedo * shape(wi);
@@ -1136,52 +1189,48 @@ impl<'s> PathIntegrator<'s> {
             pdf: cos / std::f64::consts::PI,
             at: Vertex::Surface,
         };
-        self.go_on(hit.spawn_ray(wi), st, rng, counters)
+        self.go_on(hit.spawn_ray(wi), st)
     }
 
     /// Continues a path along `ray`: outside any medium, the caller traces it; inside one, the
     /// walk carries it to the boundary or to the next surface in the medium.
-    fn go_on(
-        &self,
-        ray: Ray,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
-    ) -> Step {
+    fn go_on(&self, ray: Ray, st: &mut PathState<'_>) -> Step {
         let Some(object) = st.medium else {
             return Step::Continue(ray);
         };
         let ObjectKind::Translucent { material, grey, .. } = &self.objects[object as usize] else {
             unreachable!("a path's medium is a translucent object");
         };
-        let from = st.prev.sampled();
-        self.traverse(
-            object, material, *grey, ray.origin, ray.dir, from, st, rng, counters,
-        )
+        let medium = MediumObject {
+            object,
+            material,
+            grey: *grey,
+        };
+        let from = WalkStart {
+            origin: ray.origin,
+            dir: ray.dir,
+            last_scatter: st.prev.sampled(),
+        };
+        self.traverse(medium, from, st)
     }
 
-    /// Path tracing inside a translucent object hit at `hit` by `ray`: refraction in, then the
-    /// walk ([`Self::traverse`]).
-    #[allow(clippy::too_many_arguments)]
+    /// Path tracing inside the translucent object `medium` hit at `hit` by `ray`: refraction
+    /// in, then the walk ([`Self::traverse`]).
     fn volumetric(
         &self,
         hit: &Hit,
         ray: &Ray,
-        material: &Translucent,
-        grey: bool,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
+        medium: MediumObject<'_>,
+        st: &mut PathState<'_>,
     ) -> Step {
+        let material = medium.material;
         let interface = Interface::of(material);
         if ray.dir.dot(hit.ng) >= 0.0 {
             // Arrived from inside (a camera inside the object): pass the face.
             return Step::Continue(hit.spawn_ray(ray.dir));
         }
         let dir = match interface.rough_alpha(hit) {
-            Some(alpha) => match self
-                .rough_boundary(hit, ray.dir, hit.ng, alpha, &interface, st, rng, counters)
-            {
+            Some(alpha) => match self.rough_boundary(hit, ray.dir, hit.ng, alpha, &interface, st) {
                 Crossed::Entered(t) => t,
                 Crossed::Stepped(step) => return step,
             },
@@ -1193,9 +1242,9 @@ impl<'s> PathIntegrator<'s> {
                     let cos_i = (-ray.dir.dot(hit.ng)).clamp(0.0, 1.0);
                     let r = bssrdf_core::fresnel::dielectric(cos_i, material.eta);
                     let mirror = crate::integrator::walk::reflect(ray.dir, hit.ng);
-                    self.mirror_emission(hit, mirror, r, st, rng, counters)
+                    self.mirror_emission(hit, mirror, r, st)
                 };
-                match interface.cross(ray.dir, hit.ng, rng) {
+                match interface.cross(ray.dir, hit.ng, st.rng) {
                     Crossing::Reflect(r) => {
                         st.prev = if counted {
                             Prev::MirrorCounted
@@ -1213,22 +1262,16 @@ impl<'s> PathIntegrator<'s> {
         // Through an index-matched boundary the direction is unchanged: the vertex before the
         // entry still is the one an unscattered exit is weighed against (its light sample saw
         // through the medium).
-        let from = if interface.is_index_matched() {
-            st.prev.sampled()
-        } else {
-            None
-        };
-        self.traverse(
-            hit.object,
-            material,
-            grey,
-            hit.spawn_origin(dir),
+        let from = WalkStart {
+            origin: hit.spawn_origin(dir),
             dir,
-            from,
-            st,
-            rng,
-            counters,
-        )
+            last_scatter: if interface.is_index_matched() {
+                st.prev.sampled()
+            } else {
+                None
+            },
+        };
+        self.traverse(medium, from, st)
     }
 
     /// A rough boundary met from outside at `hit` by a ray travelling along `dir`, about the
@@ -1238,7 +1281,6 @@ impl<'s> PathIntegrator<'s> {
     /// highlights of lights on a rough surface), then a sampled crossing. Returns the
     /// transmitted direction, or the step taken when the path was reflected (on, with the
     /// sample's density for MIS) or lost.
-    #[allow(clippy::too_many_arguments)]
     #[inline(never)] // out of the smooth boundaries' path
     fn rough_boundary(
         &self,
@@ -1247,9 +1289,7 @@ impl<'s> PathIntegrator<'s> {
         n: DVec3,
         alpha: f64,
         interface: &Interface<'_>,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
+        st: &mut PathState<'_>,
     ) -> Crossed {
         let frame = Frame::new(n);
         let wo = frame.to_local(-dir);
@@ -1265,7 +1305,11 @@ impl<'s> PathIntegrator<'s> {
         };
         if albedo > 0.0 {
             let ld = self.direct(
-                hit.p,
+                LightVertex {
+                    p: hit.p,
+                    medium: st.medium,
+                    at: Vertex::Surface,
+                },
                 |wi| hit.spawn_origin(wi),
                 |wi| {
                     let l = frame.to_local(wi);
@@ -1277,13 +1321,11 @@ impl<'s> PathIntegrator<'s> {
                         conserving_pdf(l, bsdf.pdf(wo, l)),
                     )
                 },
-                st.medium,
-                Vertex::Surface,
-                rng,
-                counters,
+                st.rng,
+                st.counters,
             );
             if !ld.l.is_zero() {
-                self.settle(st, rng, counters);
+                self.settle(st);
             }
             st.add(
                 st.beta * ld.l,
@@ -1292,7 +1334,7 @@ impl<'s> PathIntegrator<'s> {
                 self.options.scattering,
             );
         }
-        match interface.cross_rough(dir, n, alpha, rng) {
+        match interface.cross_rough(dir, n, alpha, st.rng) {
             (Crossing::Transmit(t), _) => Crossed::Entered(t),
             (Crossing::Reflect(r), Some(s)) => {
                 st.prev = Prev::Sampled {
@@ -1314,37 +1356,29 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
-    /// The volumetric random walk in `object` from `start` along `dir` (see [`super::walk`]),
-    /// with next-event estimation at every counted scattering vertex through an index-matched
-    /// boundary. `from` is the light-sampled vertex the walk starts from (a diffuse surface
-    /// inside the medium), for MIS if the walk leaves or reaches an emitter unscattered. A path
-    /// entering its first chromatic medium picks its hero channel here; a chromatic medium is
-    /// walked with hero tracking, its density ratios carried into `beta` and `r_u` (spectral
-    /// MIS, [`carried`]).
-    #[allow(clippy::too_many_arguments)]
-    fn traverse(
-        &self,
-        object: u32,
-        material: &Translucent,
-        grey: bool,
-        start: DVec3,
-        dir: DVec3,
-        from: Option<(DVec3, f64)>,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
-    ) -> Step {
+    /// The volumetric random walk in `medium` from `from` (see [`super::walk`]), with
+    /// next-event estimation at every counted scattering vertex through an index-matched
+    /// boundary. `from.last_scatter` is the light-sampled vertex the walk starts from (a
+    /// diffuse surface inside the medium), for MIS if the walk leaves or reaches an emitter
+    /// unscattered. A path entering its first chromatic medium picks its hero channel here; a
+    /// chromatic medium is walked with hero tracking, its density ratios carried into `beta`
+    /// and `r_u` (spectral MIS, [`carried`]).
+    fn traverse(&self, medium: MediumObject<'_>, from: WalkStart, st: &mut PathState<'_>) -> Step {
+        let MediumObject {
+            object,
+            material,
+            grey,
+        } = medium;
         if st.hero.is_none() && !grey {
-            st.hero = Some(rng.below(3) as usize);
+            st.hero = Some(st.rng.below(3) as usize);
         }
         // The vertex before the medium (`from` is its sampled part): a walk that leaves
         // without scattering keeps it, with the lights its own light sampling could choose.
         let before = st.prev;
         st.medium = Some(object);
-        let interface = Interface::of(material);
-        let nee = interface.is_index_matched() && !self.medium_lights.is_empty();
+        let nee = Interface::of(material).is_index_matched() && !self.medium_lights.is_empty();
         let filter = self.options.scattering;
-        self.settle(st, rng, counters);
+        self.settle(st);
         let (beta, r_u) = (st.beta, st.r_u);
         let mut added = Rgb::ZERO;
         let mut scattered = false;
@@ -1356,14 +1390,16 @@ impl<'s> PathIntegrator<'s> {
             if nee && filter.counts(k) {
                 let g = material.g;
                 let ld = self.direct(
-                    p,
+                    LightVertex {
+                        p,
+                        medium: Some(object),
+                        at: Vertex::Medium,
+                    },
                     |_| p,
                     |wi| {
                         let f = bssrdf_core::hg::phase(d_in.dot(wi), g);
                         (f, f)
                     },
-                    Some(object),
-                    Vertex::Medium,
                     rng,
                     &mut nee_counters,
                 );
@@ -1373,26 +1409,23 @@ impl<'s> PathIntegrator<'s> {
                 }
             }
         };
+        let (rng, counters) = (&mut *st.rng, &mut *st.counters);
         let end = match st.hero {
             Some(hero) if !grey => {
                 let flight = HeroTracking {
                     medium: SpectralView::new(&material.medium),
                     hero,
                 };
-                self.walk_with(
-                    object, material, &flight, start, dir, from, &mut order, &mut q, rng, counters,
-                    on_scatter,
-                )
+                self.walk_in(medium, &flight)
+                    .walk_carrying(from, &mut order, &mut q, rng, counters, on_scatter)
             }
             _ => {
                 let flight = ChannelView::new(&material.medium, 0);
-                self.walk_with(
-                    object, material, &flight, start, dir, from, &mut order, &mut q, rng, counters,
-                    on_scatter,
-                )
+                self.walk_in(medium, &flight)
+                    .walk_carrying(from, &mut order, &mut q, rng, counters, on_scatter)
             }
         };
-        counters.merge(&nee_counters);
+        st.counters.merge(&nee_counters);
         st.l += added;
         st.carry(q);
         st.order = order;
@@ -1428,50 +1461,37 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
-    /// The walk of [`Self::traverse`] in `object` with the free-flight sampler `flight`
-    /// ([`WalkMedium::walk_carrying`]), `q` collecting the walk's density ratios.
-    #[allow(clippy::too_many_arguments)]
-    fn walk_with<M: FreeFlight>(
-        &self,
-        object: u32,
-        material: &Translucent,
-        flight: &M,
-        start: DVec3,
-        dir: DVec3,
-        from: Option<(DVec3, f64)>,
-        order: &mut u32,
-        q: &mut Rgb,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
-        on_scatter: impl FnMut(DVec3, DVec3, u32, Rgb, &mut Rng),
-    ) -> WalkEnd {
+    /// The walk of [`Self::traverse`] in `medium` with the free-flight sampler `flight`.
+    fn walk_in<'a, M: FreeFlight>(
+        &'a self,
+        medium: MediumObject<'a>,
+        flight: &'a M,
+    ) -> WalkMedium<'a, M> {
         WalkMedium {
             geometry: self.scene.geometry(),
-            object,
+            object: medium.object,
             medium: flight,
-            g: material.g,
-            interface: Interface::of(material),
+            g: medium.material.g,
+            interface: Interface::of(medium.material),
         }
-        .walk_carrying(start, dir, from, order, q, rng, counters, on_scatter)
     }
 
     /// The BSSRDF at x_o = `hit`: Fresnel reflection (η > 1), then incident points x_i from
-    /// probe rays ([`super::probe`]), and at each of them the estimated homogeneous
+    /// probe rays ([`super::probe_gathering`]), and at each of them the estimated homogeneous
     /// coefficients, the profile at r = |x_i − x_o|, and irradiance through pbrt-v4's
     /// normalised Fresnel lobe S_w(ω_i) = (1 − F_r(cos θ_i)) / (c π), c = 1 − 2 C1(1/η)
     /// (pbrt-v4 §11.4, `NormalizedFresnelBxDF`), times the tabulated profile's angular
     /// coupling where it applies ([`BssrdfObject::coupling`]). The path continues from one of
-    /// the x_i with a cosine-sampled direction.
-    #[allow(clippy::too_many_arguments)]
+    /// the x_i with a cosine-sampled direction. In three steps: the exit through the boundary
+    /// here, gathering at the incident points ([`Self::gather`]) and the continuation
+    /// ([`Self::continue_from`]).
     fn subsurface(
         &self,
         hit: &Hit,
         ray: &Ray,
         material: &Translucent,
         b: &BssrdfObject,
-        st: &mut PathState,
-        rng: &mut Rng,
-        counters: &mut PathCounters,
+        st: &mut PathState<'_>,
     ) -> Step {
         if ray.dir.dot(hit.ng) >= 0.0 {
             return Step::Continue(hit.spawn_ray(ray.dir));
@@ -1489,7 +1509,7 @@ impl<'s> PathIntegrator<'s> {
             Some(alpha) => {
                 let interface = Interface::of(material);
                 if let Crossed::Stepped(step) =
-                    self.rough_boundary(hit, ray.dir, n_o, alpha, &interface, st, rng, counters)
+                    self.rough_boundary(hit, ray.dir, n_o, alpha, &interface, st)
                 {
                     return step;
                 }
@@ -1498,8 +1518,8 @@ impl<'s> PathIntegrator<'s> {
                 let cos_o = (-ray.dir.dot(n_o)).clamp(0.0, 1.0);
                 let r = bssrdf_core::fresnel::dielectric(cos_o, material.eta);
                 let mirror = crate::integrator::walk::reflect(ray.dir, n_o);
-                let counted = self.mirror_emission(hit, mirror, r, st, rng, counters);
-                if rng.uniform() < r {
+                let counted = self.mirror_emission(hit, mirror, r, st);
+                if st.rng.uniform() < r {
                     st.prev = if counted {
                         Prev::MirrorCounted
                     } else {
@@ -1514,32 +1534,56 @@ impl<'s> PathIntegrator<'s> {
         if let Some(f_o) = b.correction_along(hit, -ray.dir, n_o) {
             st.beta *= f_o; // the shape correction's exit factor
         }
-        let object = hit.object;
-        let surface = ObjectSurface {
-            geometry: self.scene.geometry(),
-            object,
+        let v = BssrdfVertex {
+            material,
+            b,
+            surface: ObjectSurface {
+                geometry: self.scene.geometry(),
+                object: hit.object,
+            },
+            x_o: hit,
+            w_o: -ray.dir,
+            n_o,
+            alpha_o,
         };
-        let at_xo = material.medium.coefficients(hit);
-        let mut set = crate::integrator::probe::ProbePoints::new();
-        let density = b.probe_points_into(&mut set, &surface, hit, at_xo, rng);
-        counters.probe_sets += 1;
-        if set.is_empty() {
-            counters.probe_misses += 1;
+        let Some((x_i, carried)) = self.gather(&v, st) else {
             return Step::Stop;
-        }
-        // Every point may gather light; one carries the path on (see [`Gathering`]).
-        let Some(gathering) = Gathering::new(&set, &density, rng) else {
-            return Step::Stop; // p(x) = 0 at every hit (a sphere's edge, or x_o itself)
         };
+        self.continue_from(&v, x_i, carried, st)
+    }
+
+    /// The incident points x_i of the BSSRDF vertex `v`, from probe rays
+    /// ([`super::probe_gathering`]), each gathering light by next-event estimation (S_w, the
+    /// shape correction's entry factor for the light's direction, the profile weight and the
+    /// angular coupling), added to the path; and the carrier, the point the path continues from
+    /// ([`Gathering`]), with its weight. `None` when the probes found no point or none carries
+    /// the path.
+    fn gather(&self, v: &BssrdfVertex<'_>, st: &mut PathState<'_>) -> Option<(Hit, CarrierWeight)> {
+        let (material, b, hit) = (v.material, v.b, v.x_o);
+        let at_xo = material.medium.coefficients(hit);
+        let mut set = crate::integrator::probe_gathering::ProbePoints::new();
+        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, st.rng);
+        st.counters.probe_sets += 1;
+        if set.is_empty() {
+            st.counters.probe_misses += 1;
+            return None;
+        }
+        // Every point may gather light; one carries the path on (see [`Gathering`]). None
+        // when p(x) = 0 at every hit (a sphere's edge, or x_o itself).
+        let gathering = Gathering::new(&set, &density, st.rng)?;
         let (carrier, scale) = (gathering.carrier(), gathering.carrier_scale());
         let mut next = None;
         for (k, (&x_i, _)) in set.found().enumerate() {
-            let Some(weight) = gathering.weight_if_gathering(k, rng) else {
+            let Some(weight) = gathering.weight_if_gathering(k, st.rng) else {
                 continue;
             };
             let alpha_i = b.alpha_at(&x_i);
             let ld = self.direct(
-                x_i.p,
+                LightVertex {
+                    p: x_i.p,
+                    medium: None,
+                    at: Vertex::Surface,
+                },
                 |wi| x_i.spawn_origin(wi),
                 |wi| {
                     // S_w · cos against the continuation's pdf (cosine about the shading
@@ -1549,12 +1593,10 @@ impl<'s> PathIntegrator<'s> {
                     };
                     let cos = wi.dot(n);
                     let pdf = wi.dot(x_i.ns).max(0.0) / std::f64::consts::PI;
-                    (b.entry_lobe(cos, alpha_i, alpha_o) * cos, pdf)
+                    (b.entry_lobe(cos, alpha_i, v.alpha_o) * cos, pdf)
                 },
-                None,
-                Vertex::Surface,
-                rng,
-                counters,
+                st.rng,
+                st.counters,
             );
             // The shape correction's entry factor for the light's direction, and the direction
             // and normal the angular coupling reads.
@@ -1572,38 +1614,50 @@ impl<'s> PathIntegrator<'s> {
             }
             if ld.is_zero() && self.defer_weights {
                 // Nothing to gather: the carrier owes its (costly) estimate.
-                next = Some((x_i, Err(weight * scale)));
+                next = Some((x_i, CarrierWeight::Owed(weight * scale)));
                 continue;
             }
-            let pw = b.profile(&surface, &material.medium, &x_i, hit, rng, counters);
+            let pw = b.profile(&v.surface, &material.medium, &x_i, hit, st.rng, st.counters);
             let w = pw.rd * weight;
-            self.settle(st, rng, counters);
+            self.settle(st);
             if !ld.is_zero() {
-                st.l += st.beta * w * ld * b.coupling(&pw, w_light, n_light, -ray.dir, n_o);
+                st.l += st.beta * w * ld * b.coupling(&pw, w_light, n_light, v.w_o, v.n_o);
             }
             if k == carrier {
-                next = Some((x_i, Ok((w * scale, pw))));
+                next = Some((x_i, CarrierWeight::Evaluated(w * scale, pw)));
             }
         }
-        let Some((x_i, w)) = next else {
-            return Step::Stop;
-        };
-        let carried = match w {
-            Ok((w, pw)) => {
+        next
+    }
+
+    /// The path's continuation from the carrier `x_i` of the BSSRDF vertex `v`, whose weight is
+    /// `carried`: a cosine-sampled direction about x_i's shading normal, weighted by S_w, the
+    /// shape correction's entry factor and the angular coupling (now, or with the profile
+    /// weight when that is owed, [`Deferred`]).
+    fn continue_from(
+        &self,
+        v: &BssrdfVertex<'_>,
+        x_i: Hit,
+        carried: CarrierWeight,
+        st: &mut PathState<'_>,
+    ) -> Step {
+        let b = v.b;
+        let carried = match carried {
+            CarrierWeight::Evaluated(w, pw) => {
                 st.beta *= w;
                 Ok(pw)
             }
-            Err(scale) => {
+            CarrierWeight::Owed(scale) => {
                 // One factor is owed at a time: settle an older one first. The new one is
                 // owed once the continuation's direction is known (below).
-                self.settle(st, rng, counters);
+                self.settle(st);
                 Err(scale)
             }
         };
         if st.beta.is_zero() {
             return Step::Stop;
         }
-        let Some((wi, cos)) = cosine_continuation(x_i.ns, rng) else {
+        let Some((wi, cos)) = cosine_continuation(x_i.ns, st.rng) else {
             return Step::Stop;
         };
         if facing_normal(&x_i, wi).is_none() {
@@ -1611,22 +1665,22 @@ impl<'s> PathIntegrator<'s> {
             return Step::Stop;
         }
         // S_w·cos / (cos/π) = (1 − F(cos)) / c.
-        st.beta *= b.entry_lobe(cos, b.alpha_at(&x_i), alpha_o) * std::f64::consts::PI;
+        st.beta *= b.entry_lobe(cos, b.alpha_at(&x_i), v.alpha_o) * std::f64::consts::PI;
         if let Some(f_i) = b.correction_along(&x_i, wi, x_i.ns) {
             st.beta *= f_i; // the shape correction's entry factor for the continuation
         }
         // The angular coupling for the continuation: now, or when the owed weight is settled.
         match carried {
-            Ok(pw) => st.beta *= b.coupling(&pw, wi, x_i.ns, -ray.dir, n_o),
+            Ok(pw) => st.beta *= b.coupling(&pw, wi, x_i.ns, v.w_o, v.n_o),
             Err(scale) => {
                 st.deferred = Some(Deferred {
-                    object,
+                    object: v.surface.object,
                     x_i,
-                    x_o: *hit,
+                    x_o: *v.x_o,
                     scale,
                     w_i: wi,
-                    w_o: -ray.dir,
-                    n_o,
+                    w_o: v.w_o,
+                    n_o: v.n_o,
                 })
             }
         }
@@ -1639,7 +1693,7 @@ impl<'s> PathIntegrator<'s> {
     }
 
     /// Evaluates the path's deferred profile weight, if any, into `beta` (see [`Deferred`]).
-    fn settle(&self, st: &mut PathState, rng: &mut Rng, counters: &mut PathCounters) {
+    fn settle(&self, st: &mut PathState<'_>) {
         let Some(d) = st.deferred.take() else {
             return;
         };
@@ -1650,7 +1704,14 @@ impl<'s> PathIntegrator<'s> {
             geometry: self.scene.geometry(),
             object: d.object,
         };
-        let pw = b.profile(&surface, &material.medium, &d.x_i, &d.x_o, rng, counters);
+        let pw = b.profile(
+            &surface,
+            &material.medium,
+            &d.x_i,
+            &d.x_o,
+            st.rng,
+            st.counters,
+        );
         st.beta *= pw.rd * d.scale * b.coupling(&pw, d.w_i, d.x_i.ns, d.w_o, d.n_o);
     }
 
@@ -1694,10 +1755,8 @@ impl<'s> PathIntegrator<'s> {
         Some(b.eval(
             &surface,
             &material.medium,
-            x_i,
-            w_i,
-            x_o,
-            w_o,
+            PairEnd { hit: x_i, w: w_i },
+            PairEnd { hit: x_o, w: w_o },
             rng,
             &mut counters,
         ))

@@ -76,8 +76,12 @@ use rayon::prelude::*;
 use crate::field::MediumField;
 use crate::geometry::{Geometry, Hit, ObjectSurface, Ray};
 use crate::integrator::bssrdf::BssrdfObject;
+use crate::integrator::correction_factors::{
+    DIRECTIONS, Directional, Grid, MU_NODES, PHI_NODES, Sample, ShapeCorrection, mu_weights,
+};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::preparation::PrepareObserver;
+use crate::integrator::profile_eval::eval_profile;
 use crate::integrator::walk::{reflect, refract};
 use crate::optical_size::light_reach;
 use crate::rng::Rng;
@@ -166,23 +170,6 @@ impl<'a> Steps<'a> {
     }
 }
 
-/// One sample point of the correction.
-#[derive(Debug, Clone, Copy)]
-struct Sample {
-    p: DVec3,
-    n: DVec3,
-    f: Directional,
-}
-
-/// Exit cosines μ at which the walks start (the factor is linear in μ between them and
-/// constant beyond).
-pub const MU_NODES: [f64; 5] = [0.1, 0.325, 0.55, 0.775, 1.0];
-/// Exit azimuths per cosine, equally spaced in the tangent frame of the shading normal
-/// (`het_estimate::frame::orthonormal_basis`); the factor is periodic-linear between them.
-pub const PHI_NODES: usize = 6;
-/// Directions per point: [`MU_NODES`] × [`PHI_NODES`], index `j · PHI_NODES + k`.
-pub const DIRECTIONS: usize = MU_NODES.len() * PHI_NODES;
-
 /// The direction outside the medium of node `(j, k)` about the unit normal `n`.
 fn node_direction(n: DVec3, j: usize, k: usize) -> DVec3 {
     let (t, b) = orthonormal_basis(n);
@@ -192,164 +179,11 @@ fn node_direction(n: DVec3, j: usize, k: usize) -> DVec3 {
     (n * mu + (t * phi.cos() + b * phi.sin()) * s).normalize()
 }
 
-/// The correction's directional factor f(ω) at one surface point, per channel, at the
-/// direction nodes ([`DIRECTIONS`]): S is scaled by f(x_i, ω_i)·f(x_o, ω_o).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Directional(pub [Rgb; DIRECTIONS]);
-
-impl Directional {
-    /// No correction.
-    pub const ONE: Directional = Directional([Rgb::ONE; DIRECTIONS]);
-
-    /// ⟨f⟩ over uniform incident light, per channel ([`incident_weights`]).
-    #[inline]
-    pub fn incident_mean(&self, weights: &[f64; DIRECTIONS]) -> Rgb {
-        let mut m = Rgb::ZERO;
-        for (f, w) in self.0.iter().zip(weights) {
-            m += *f * *w;
-        }
-        m
-    }
-
-    /// f along the unit direction `w` outside the medium, about the unit normal `n` (the
-    /// shading normal the correction was sampled about).
-    #[inline]
-    pub fn along(&self, w: DVec3, n: DVec3) -> Rgb {
-        let (t, b) = orthonormal_basis(n);
-        let mu = w.dot(n).clamp(0.0, 1.0);
-        let phi = w.dot(b).atan2(w.dot(t)).rem_euclid(TAU);
-        self.at(mu, phi)
-    }
-
-    /// f at exit cosine `mu` and azimuth `phi` ∈ [0, 2π).
-    #[inline]
-    pub fn at(&self, mu: f64, phi: f64) -> Rgb {
-        let x = phi / TAU * PHI_NODES as f64;
-        let k0 = (x as usize).min(PHI_NODES - 1);
-        let k1 = (k0 + 1) % PHI_NODES;
-        let s = (x - k0 as f64).clamp(0.0, 1.0);
-        let row =
-            |j: usize| self.0[j * PHI_NODES + k0] * (1.0 - s) + self.0[j * PHI_NODES + k1] * s;
-        let [(j0, w0), (j1, w1)] = mu_weights(mu);
-        row(j0) * w0 + row(j1) * w1
-    }
-}
-
-/// The correction of one object: sample points and a uniform grid over them.
-#[derive(Debug)]
-pub(crate) struct ShapeCorrection {
-    samples: Vec<Sample>,
-    grid: Grid,
-    /// f at the mesh's vertices and its triangles, when no edge is longer than h: a lookup is
-    /// then a barycentric interpolation ([`ShapeCorrection::at_hit`]) instead of a
-    /// neighbourhood query.
-    vertices: Option<(Vec<Directional>, Vec<[u32; 3]>)>,
-    /// Wall time of the build (s).
-    seconds: f64,
-}
-
-/// A uniform grid over sample points, for Gaussian-weighted neighbourhood sums.
-#[derive(Debug)]
-struct Grid {
-    /// Gaussian width h (length); neighbours within 2h count.
-    h: f64,
-    lo: DVec3,
-    cell: f64,
-    dims: [usize; 3],
-    /// CSR: points of cell k are `order[start[k]..start[k + 1]]`.
-    start: Vec<u32>,
-    order: Vec<u32>,
-}
-
-impl Grid {
-    fn new(points: &[DVec3], h: f64, lo: DVec3, hi: DVec3) -> Self {
-        let cell = 2.0 * h;
-        let lo = lo - DVec3::splat(cell);
-        let span = hi + DVec3::splat(cell) - lo;
-        let dims = [0, 1, 2].map(|k| ((span[k] / cell).ceil() as usize).clamp(1, 256));
-        let cell_of = |p: DVec3| -> usize {
-            let q = [0, 1, 2].map(|k| (((p[k] - lo[k]) / cell) as usize).min(dims[k] - 1));
-            (q[2] * dims[1] + q[1]) * dims[0] + q[0]
-        };
-        let n_cells = dims[0] * dims[1] * dims[2];
-        let mut start = vec![0u32; n_cells + 1];
-        for &p in points {
-            start[cell_of(p) + 1] += 1;
-        }
-        for k in 0..n_cells {
-            start[k + 1] += start[k];
-        }
-        let mut fill = start.clone();
-        let mut order = vec![0u32; points.len()];
-        for (i, &p) in points.iter().enumerate() {
-            let k = cell_of(p);
-            order[fill[k] as usize] = i as u32;
-            fill[k] += 1;
-        }
-        Self {
-            h,
-            lo,
-            cell,
-            dims,
-            start,
-            order,
-        }
-    }
-
-    /// [`Grid::for_each_near`] about `hits[i]`, the grid being built over `hits`' positions.
-    #[inline]
-    fn around(&self, hits: &[Hit], i: usize, f: impl FnMut(usize, f64)) {
-        self.for_each_near(hits[i].p, hits[i].ns, |j| hits[j].p, |j| hits[j].ns, f)
-    }
-
-    /// Calls `f(i, w)` for every point i within 2h of `p` whose normal faces like `n`, with
-    /// the weight w = exp(−d²/2h²)·(n·n_i)²; `position(i)` and `normal(i)` read the points.
-    #[inline]
-    fn for_each_near(
-        &self,
-        p: DVec3,
-        n: DVec3,
-        position: impl Fn(usize) -> DVec3,
-        normal: impl Fn(usize) -> DVec3,
-        mut f: impl FnMut(usize, f64),
-    ) {
-        let q = [0, 1, 2].map(|k| ((p[k] - self.lo[k]) / self.cell).floor() as i64);
-        let inv = 1.0 / (2.0 * self.h * self.h);
-        let cut = 4.0 * self.h * self.h;
-        for dz in -1..=1 {
-            let z = q[2] + dz;
-            if z < 0 || z >= self.dims[2] as i64 {
-                continue;
-            }
-            for dy in -1..=1 {
-                let y = q[1] + dy;
-                if y < 0 || y >= self.dims[1] as i64 {
-                    continue;
-                }
-                for dx in -1..=1 {
-                    let x = q[0] + dx;
-                    if x < 0 || x >= self.dims[0] as i64 {
-                        continue;
-                    }
-                    let k = ((z as usize * self.dims[1]) + y as usize) * self.dims[0] + x as usize;
-                    for &i in &self.order[self.start[k] as usize..self.start[k + 1] as usize] {
-                        let i = i as usize;
-                        let d2 = (position(i) - p).length_squared();
-                        let facing = normal(i).dot(n);
-                        if d2 > cut || facing <= 0.0 {
-                            continue;
-                        }
-                        f(i, (-d2 * inv).exp() * facing * facing);
-                    }
-                }
-            }
-        }
-    }
-}
-
 impl ShapeCorrection {
     /// Measures the correction for `object` rendered by `bssrdf` with `medium`.
-    /// `seed` keys every random number it draws.
+    /// `seed` keys every random number it draws. In three stages: the raw sums at sample
+    /// points ([`Build::measure`]), pooled over each point's neighbourhood ([`Build::pool`]),
+    /// then the fixed-point steps ([`Build::refine`]).
     pub fn build(
         bssrdf: &BssrdfObject,
         geometry: &Geometry,
@@ -362,79 +196,26 @@ impl ShapeCorrection {
         let mesh = geometry.mesh(object);
         let (lo, hi) = geometry.object_bounds(object);
         let extent = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let walk_medium = walk_medium(medium);
         let h = sample_spacing(medium, bssrdf.family.g(), extent);
         let area = mesh.surface_area();
         let n_points = ((area / (h * h)).ceil() as usize).clamp(MIN_POINTS, MAX_POINTS);
-        // Triangle CDF by area.
-        let mut cdf = Vec::with_capacity(mesh.triangle_count());
-        let mut acc = 0.0;
-        for i in 0..mesh.triangle_count() {
-            let [a, b, c] = mesh.triangle_vertices(i);
-            acc += 0.5 * (b - a).cross(c - a).length();
-            cdf.push(acc);
-        }
-        let surface = ObjectSurface { geometry, object };
-        let key = |i: usize| PointKey {
+        let build = Build {
+            bssrdf,
+            surface: ObjectSurface { geometry, object },
+            medium,
+            walk_medium: walk_medium(medium),
             seed,
-            object: object as u64,
-            index: i as u64,
+            steps: Steps::new(observer),
         };
-        let grey = medium.is_grey();
         // Progress: the walks at each point, then (a faster stage) each fixed-point step's
         // responses.
-        let steps = Steps::new(observer);
         observer.stage("correction walks", n_points as u64);
-        // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
-        // c = 1 (the walks and probes in the body and under the plane agree but for what
-        // leaves that ball): no walks there (`None`).
-        let raw: Vec<(Hit, Coefficients, Option<Sums>)> = (0..n_points)
-            .into_par_iter()
-            .filter_map(|i| {
-                steps
-                    .step(|| {
-                        let mut rng = key(i).placement();
-                        let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
-                        let coeffs = medium.at_surface(x_o.p, x_o.uv);
-                        // In a heterogeneous medium the light x_o sees may come from its most
-                        // translucent parts.
-                        let reach_of = if walk_medium.is_some() {
-                            medium.field_bounds().min
-                        } else {
-                            coeffs
-                        };
-                        let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
-                        let sums = (!contains_half_ball(&surface, &x_o, reach)).then(|| {
-                            point_sums(bssrdf, &surface, &x_o, coeffs, walk_medium, grey, key(i))
-                        });
-                        Some((x_o, coeffs, sums))
-                    })
-                    .flatten()
-            })
-            .collect();
-        if steps.stopped() {
-            return None;
-        }
+        let raw = build.measure(n_points, extent)?;
         let hits: Vec<Hit> = raw.iter().map(|(x, _, _)| *x).collect();
         let points: Vec<DVec3> = hits.iter().map(|x| x.p).collect();
         let grid = Grid::new(&points, h, lo, hi);
         let weights = incident_weights(bssrdf.eta());
-        // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
-        // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
-        // bias, of order 1/(escapes per point), would not average out).
-        let pooled: Vec<Option<Sums>> = (0..raw.len())
-            .into_par_iter()
-            .map(|i| {
-                raw[i].2.as_ref()?;
-                let mut pooled = Sums::default();
-                grid.around(&hits, i, |j, w| {
-                    if let Some(sums) = &raw[j].2 {
-                        pooled.add_scaled(sums, w);
-                    }
-                });
-                Some(pooled.regularised())
-            })
-            .collect();
+        let pooled = Build::pool(&raw, &hits, &grid);
         let mut corr = Self {
             samples: hits
                 .iter()
@@ -449,131 +230,166 @@ impl ShapeCorrection {
             vertices: None,
             seconds: 0.0,
         };
-        // Where c varies on the scale of the profile (corners, edges), the incident side's
-        // factor differs from x_o's: iterate f ← √(f · T / B'), B' the body's response with
-        // the current factors at the incident points, T what it should be (module docs).
         observer.stage("correction steps", (raw.len() * ITERATIONS) as u64);
         for _ in 0..ITERATIONS {
-            let response: Vec<Option<Rgb>> = raw
-                .par_iter()
-                .enumerate()
-                .map(|(i, (x, coeffs, sums))| {
-                    steps
-                        .step(|| {
-                            sums.as_ref()?;
-                            Some(body_response(
-                                bssrdf,
-                                &surface,
-                                walk_medium,
-                                x,
-                                *coeffs,
-                                key(i),
-                                |x_i| corr.at(x_i.p, x_i.ns).incident_mean(&weights),
-                            ))
-                        })
-                        .flatten()
-                })
-                .collect();
-            if steps.stopped() {
-                return None;
-            }
-            let updated: Vec<Directional> = (0..raw.len())
-                .into_par_iter()
-                .map(|i| {
-                    let Some(p) = &pooled[i] else {
-                        return Directional::ONE;
-                    };
-                    let mut b_prime = Rgb::ZERO;
-                    corr.grid.around(&hits, i, |j, w| {
-                        if let Some(r) = response[j] {
-                            b_prime += r * w;
-                        }
-                    });
-                    p.refine(&corr.samples[i].f, b_prime)
-                })
-                .collect();
-            for (s, f) in corr.samples.iter_mut().zip(updated) {
-                s.f = f;
-            }
+            build.refine(&mut corr, &raw, &hits, &pooled, &weights)?;
         }
         corr.vertices = corr.vertex_factors(mesh);
         corr.seconds = t0.elapsed().as_secs_f64();
         Some(corr)
     }
+}
 
-    /// f at every vertex of `mesh` (the neighbourhood query at the vertex, about its
-    /// area-weighted normal), when the mesh is fine enough for barycentric interpolation to
-    /// follow f: no edge longer than h.
-    fn vertex_factors(
-        &self,
-        mesh: &crate::geometry::TriangleMesh,
-    ) -> Option<(Vec<Directional>, Vec<[u32; 3]>)> {
-        let h = self.grid.h;
-        let mut normals = vec![DVec3::ZERO; mesh.positions.len()];
-        for (i, tri) in mesh.triangles.iter().enumerate() {
+/// The raw estimates at one sample point: the point, the medium's coefficients there, and its
+/// sums, `None` where the body holds the half-ball below it (c = 1 without walks).
+type RawPoint = (Hit, Coefficients, Option<Sums>);
+
+/// What the stages of [`ShapeCorrection::build`] read: the object measured, its BSSRDF, its
+/// medium and the one the walks go through ([`walk_medium`]), the seed of its random numbers
+/// and the steps its observer watches.
+struct Build<'a> {
+    bssrdf: &'a BssrdfObject,
+    surface: ObjectSurface<'a>,
+    medium: &'a MediumField,
+    walk_medium: Option<&'a MediumField>,
+    seed: u64,
+    steps: Steps<'a>,
+}
+
+impl Build<'_> {
+    /// The random numbers of sample point `i` ([`PointKey`]).
+    fn key(&self, i: usize) -> PointKey {
+        PointKey {
+            seed: self.seed,
+            object: self.surface.object as u64,
+            index: i as u64,
+        }
+    }
+
+    /// `n_points` sample points drawn uniformly by area on the object (of bounding-box extent
+    /// `extent`), with their raw sums; `None` when the observer stopped the build.
+    fn measure(&self, n_points: usize, extent: f64) -> Option<Vec<RawPoint>> {
+        let (geometry, object) = (self.surface.geometry, self.surface.object);
+        let (bssrdf, medium, walk_medium) = (self.bssrdf, self.medium, self.walk_medium);
+        let mesh = geometry.mesh(object);
+        // Triangle CDF by area.
+        let mut cdf = Vec::with_capacity(mesh.triangle_count());
+        let mut acc = 0.0;
+        for i in 0..mesh.triangle_count() {
             let [a, b, c] = mesh.triangle_vertices(i);
-            if (b - a).length() > h || (c - b).length() > h || (a - c).length() > h {
-                return None;
-            }
-            let n = (b - a).cross(c - a);
-            for &v in tri {
-                normals[v as usize] += n;
-            }
+            acc += 0.5 * (b - a).cross(c - a).length();
+            cdf.push(acc);
         }
-        let f = mesh
-            .positions
-            .par_iter()
-            .zip(&normals)
-            .map(|(&p, n)| self.at(p, n.normalize_or_zero()))
+        let grey = medium.is_grey();
+        // Points whose body holds the half-ball of HALF_BALL diffusion lengths below them have
+        // c = 1 (the walks and probes in the body and under the plane agree but for what
+        // leaves that ball): no walks there (`None`).
+        let raw: Vec<RawPoint> = (0..n_points)
+            .into_par_iter()
+            .filter_map(|i| {
+                self.steps
+                    .step(|| {
+                        let mut rng = self.key(i).placement();
+                        let x_o = sample_surface(geometry, object, &cdf, acc, extent, &mut rng)?;
+                        let coeffs = medium.at_surface(x_o.p, x_o.uv);
+                        // In a heterogeneous medium the light x_o sees may come from its most
+                        // translucent parts.
+                        let reach_of = if walk_medium.is_some() {
+                            medium.field_bounds().min
+                        } else {
+                            coeffs
+                        };
+                        let reach = HALF_BALL * light_reach(reach_of, bssrdf.family.g()).0;
+                        let sums = (!contains_half_ball(&self.surface, &x_o, reach)).then(|| {
+                            let key = self.key(i);
+                            point_sums(bssrdf, &self.surface, &x_o, coeffs, walk_medium, grey, key)
+                        });
+                        Some((x_o, coeffs, sums))
+                    })
+                    .flatten()
+            })
             .collect();
-        Some((f, mesh.triangles.clone()))
+        (!self.steps.stopped()).then_some(raw)
     }
 
-    /// f at a hit on the object: barycentric interpolation of the vertices' f where the mesh
-    /// is fine enough, else the neighbourhood query ([`ShapeCorrection::at`]).
-    #[inline]
-    pub fn at_hit(&self, hit: &Hit) -> Directional {
-        match &self.vertices {
-            Some((f, tris)) if (hit.prim as usize) < tris.len() => {
-                let [i0, i1, i2] = tris[hit.prim as usize];
-                let (b1, b2) = (hit.bary.x, hit.bary.y);
-                let b0 = 1.0 - b1 - b2;
-                let (f0, f1, f2) = (&f[i0 as usize].0, &f[i1 as usize].0, &f[i2 as usize].0);
-                Directional(std::array::from_fn(|d| {
-                    f0[d] * b0 + f1[d] * b1 + f2[d] * b2
-                }))
-            }
-            _ => self.at(hit.p, hit.ns),
+    /// The raw sums of every point pooled over its neighbourhood in `grid` (built over the
+    /// points `hits`) and regularised ([`Sums::regularised`]); `None` for the points without
+    /// walks.
+    fn pool(raw: &[RawPoint], hits: &[Hit], grid: &Grid) -> Vec<Option<Sums>> {
+        // Pool the raw sums over each point's neighbourhood before dividing: a ratio of sums
+        // over a few hundred walks, not a mean of per-point ratios over a few dozen (whose
+        // bias, of order 1/(escapes per point), would not average out).
+        (0..raw.len())
+            .into_par_iter()
+            .map(|i| {
+                raw[i].2.as_ref()?;
+                let mut pooled = Sums::default();
+                grid.around(hits, i, |j, w| {
+                    if let Some(sums) = &raw[j].2 {
+                        pooled.add_scaled(sums, w);
+                    }
+                });
+                Some(pooled.regularised())
+            })
+            .collect()
+    }
+
+    /// One fixed-point step of `corr` (module docs): where c varies on the scale of the
+    /// profile (corners, edges), the incident side's factor differs from x_o's, so f ← √(f ·
+    /// T / B'), B' the body's response with the current factors at the incident points, T what
+    /// it should be. `raw` and `pooled` are the points' sums, `hits` the points (the grid's),
+    /// `weights` the incident light's ([`incident_weights`]); `None` when the observer stopped
+    /// the build.
+    fn refine(
+        &self,
+        corr: &mut ShapeCorrection,
+        raw: &[RawPoint],
+        hits: &[Hit],
+        pooled: &[Option<Sums>],
+        weights: &[f64; DIRECTIONS],
+    ) -> Option<()> {
+        let response: Vec<Option<Rgb>> = raw
+            .par_iter()
+            .enumerate()
+            .map(|(i, (x, coeffs, sums))| {
+                self.steps
+                    .step(|| {
+                        sums.as_ref()?;
+                        Some(body_response(
+                            self.bssrdf,
+                            &self.surface,
+                            self.walk_medium,
+                            x,
+                            *coeffs,
+                            self.key(i),
+                            |x_i| corr.at(x_i.p, x_i.ns).incident_mean(weights),
+                        ))
+                    })
+                    .flatten()
+            })
+            .collect();
+        if self.steps.stopped() {
+            return None;
         }
-    }
-
-    /// What the build did: sample points, spacing h and wall time (s), for the render's notes.
-    pub fn summary(&self) -> (usize, f64, f64) {
-        (self.samples.len(), self.grid.h, self.seconds)
-    }
-
-    /// f at a surface point: the Gaussian-weighted mean of the samples within 2h whose normals
-    /// face like `n`; 1 where none is near.
-    pub fn at(&self, p: DVec3, n: DVec3) -> Directional {
-        let mut sum = [Rgb::ZERO; DIRECTIONS];
-        let mut wsum = 0.0;
-        self.grid.for_each_near(
-            p,
-            n,
-            |i| self.samples[i].p,
-            |i| self.samples[i].n,
-            |i, w| {
-                for (acc, f) in sum.iter_mut().zip(self.samples[i].f.0) {
-                    *acc += f * w;
-                }
-                wsum += w;
-            },
-        );
-        if wsum > 0.0 {
-            Directional(sum.map(|v| v * (1.0 / wsum)))
-        } else {
-            Directional::ONE
+        let updated: Vec<Directional> = (0..raw.len())
+            .into_par_iter()
+            .map(|i| {
+                let Some(p) = &pooled[i] else {
+                    return Directional::ONE;
+                };
+                let mut b_prime = Rgb::ZERO;
+                corr.grid.around(hits, i, |j, w| {
+                    if let Some(r) = response[j] {
+                        b_prime += r * w;
+                    }
+                });
+                p.refine(&corr.samples[i].f, b_prime)
+            })
+            .collect();
+        for (s, f) in corr.samples.iter_mut().zip(updated) {
+            s.f = f;
         }
+        Some(())
     }
 }
 
@@ -751,7 +567,7 @@ fn point_sums(
                 }
                 None => coeffs,
             };
-            b_half += counters.eval_profile(&bssrdf.family, c, r) * hit.weight;
+            b_half += eval_profile(&bssrdf.family, c, r, &mut counters) * hit.weight;
         }
     }
     Sums {
@@ -933,23 +749,6 @@ fn incident_weights(eta: f64) -> [f64; DIRECTIONS] {
     weights.map(|w| w / den)
 }
 
-/// Linear interpolation in μ between [`MU_NODES`] (constant beyond them), as two (node,
-/// weight) pairs.
-#[inline]
-fn mu_weights(mu: f64) -> [(usize, f64); 2] {
-    let last = MU_NODES.len() - 1;
-    if mu <= MU_NODES[0] {
-        return [(0, 1.0), (0, 0.0)];
-    }
-    for j in 1..=last {
-        if mu <= MU_NODES[j] {
-            let t = (mu - MU_NODES[j - 1]) / (MU_NODES[j] - MU_NODES[j - 1]);
-            return [(j - 1, 1.0 - t), (j, t)];
-        }
-    }
-    [(last, 1.0), (last, 0.0)]
-}
-
 /// The tangent plane at x_o as a surface for probe chords: the half-space reference.
 struct TangentPlane {
     p0: DVec3,
@@ -1088,6 +887,15 @@ const MAX_TRACKING: u32 = 1_000_000;
 /// at most this much in the tally).
 const MIN_TRANSMITTANCE: f64 = 1e-9;
 
+/// Where a reversed walk starts ([`Walk::escape`]): at the boundary point `x_o`, along the
+/// direction `d` refracted into the medium, with the weight `w` of the Fresnel transmission
+/// there.
+struct Entry<'h> {
+    x_o: &'h Hit,
+    d: DVec3,
+    w: f64,
+}
+
 /// A walk's medium and which escapes count.
 struct Walk<'m> {
     medium: EscapeMedium<'m>,
@@ -1118,9 +926,10 @@ impl Walk<'_> {
         let Some(d) = refract(-w_o, n, self.eta) else {
             return 0.0;
         };
+        let entry = Entry { x_o, d, w };
         match self.medium {
             EscapeMedium::Homogeneous { sigma_t, albedo } => {
-                self.escape_homogeneous(sigma_t, albedo, boundary, x_o, d, w, rng)
+                self.escape_homogeneous(sigma_t, albedo, boundary, entry, rng)
             }
             EscapeMedium::Field { field, channel } => {
                 let majorant = field.majorant()[channel];
@@ -1128,24 +937,22 @@ impl Walk<'_> {
                     let c = field.at_point(p);
                     (c.sigma_a[channel] + c.sigma_s[channel], c.sigma_s[channel])
                 };
-                self.escape_tracked(&sigma, majorant, boundary, x_o, d, w, rng.next_u64())
+                self.escape_tracked(&sigma, majorant, boundary, entry, rng.next_u64())
             }
         }
     }
 
-    /// [`Walk::escape`] in a homogeneous medium, from `x_o` along the refracted `d` with
-    /// weight `w`.
-    #[allow(clippy::too_many_arguments)]
+    /// [`Walk::escape`] in a homogeneous medium of extinction `sigma_t` and single-scattering
+    /// `albedo`, from `entry`.
     fn escape_homogeneous(
         &self,
         sigma_t: f64,
         albedo: f64,
         boundary: &Boundary<'_>,
-        x_o: &Hit,
-        mut d: DVec3,
-        mut w: f64,
+        entry: Entry<'_>,
         rng: &mut Rng,
     ) -> f64 {
+        let Entry { x_o, mut d, mut w } = entry;
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
         let mut order = 0u32;
@@ -1197,8 +1004,8 @@ impl Walk<'_> {
         tally
     }
 
-    /// [`Walk::escape`] in a field `sigma(p) = (σt, σs)` bounded by `majorant`, from `x_o`
-    /// along the refracted `d` with weight `w`. At each vertex the chance of reaching the
+    /// [`Walk::escape`] in a field `sigma(p) = (σt, σs)` bounded by `majorant`, from `entry`.
+    /// At each vertex the chance of reaching the
     /// boundary is estimated by ratio tracking (the product of 1 − σt/σ̄ over tentative
     /// collisions, an unbiased estimate of the transmittance) and tallied; the walk then goes
     /// on by delta tracking: a real collision (probability σt/σ̄ at each tentative one)
@@ -1206,17 +1013,15 @@ impl Walk<'_> {
     /// ends otherwise (that escape was tallied already, in expectation). Step k draws its
     /// numbers from a generator keyed by (`key`, k), so that the walks in the body and under
     /// the plane stay in step however many tentative collisions each takes.
-    #[allow(clippy::too_many_arguments)]
     fn escape_tracked(
         &self,
         sigma: &impl Fn(DVec3) -> (f64, f64),
         majorant: f64,
         boundary: &Boundary<'_>,
-        x_o: &Hit,
-        mut d: DVec3,
-        mut w: f64,
+        entry: Entry<'_>,
         key: u64,
     ) -> f64 {
+        let Entry { x_o, mut d, mut w } = entry;
         let flight = |rng: &mut Rng| -(1.0 - rng.uniform()).ln() / majorant;
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
@@ -1330,6 +1135,7 @@ fn roulette(w: f64, u: f64) -> Option<f64> {
 mod tests {
     use super::*;
     use crate::geometry::{TriangleMesh, primitives};
+    use crate::integrator::bssrdf::PairEnd;
     use crate::render::NoObserver;
     use crate::scene::Translucent;
     use bssrdf_core::ProfileModel;
@@ -1748,10 +1554,8 @@ mod tests {
                     object: 0,
                 },
                 &field,
-                &x,
-                x.ns,
-                &x,
-                x.ns,
+                PairEnd { hit: &x, w: x.ns },
+                PairEnd { hit: &x, w: x.ns },
                 &mut Rng::from_keys(1, &[]),
                 &mut PathCounters::default(),
             );
@@ -1784,7 +1588,8 @@ mod tests {
         let mut counters = PathCounters::default();
         let mut eval = |b: &BssrdfObject, a: &Hit, wa, c: &Hit, wc| {
             let mut rng = Rng::from_keys(1, &[]);
-            b.eval(&surface, &field, a, wa, c, wc, &mut rng, &mut counters)
+            let (incident, exitant) = (PairEnd { hit: a, w: wa }, PairEnd { hit: c, w: wc });
+            b.eval(&surface, &field, incident, exitant, &mut rng, &mut counters)
         };
         let s = eval(&b, &x_i, w_i, &x_o, w_o);
         let swapped = eval(&b, &x_o, w_o, &x_i, w_i);

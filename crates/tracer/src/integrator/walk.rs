@@ -220,6 +220,20 @@ pub enum WalkEnd {
     Leaked,
 }
 
+/// Where a walk starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WalkStart {
+    /// A point inside the medium: the entry hit's `spawn_origin(dir)`, or a point just off a
+    /// surface inside it.
+    pub origin: DVec3,
+    /// The unit direction of travel.
+    pub dir: DVec3,
+    /// The vertex the walk starts from, as [`WalkEnd::Exited`] reports it if no event happens
+    /// (its point and the direction's pdf there, for MIS); `None` when entering through the
+    /// boundary.
+    pub last_scatter: Option<(DVec3, f64)>,
+}
+
 /// One object's medium as the walk sees it.
 pub struct WalkMedium<'a, M: FreeFlight> {
     /// The scene geometry.
@@ -236,19 +250,13 @@ pub struct WalkMedium<'a, M: FreeFlight> {
 }
 
 impl<M: FreeFlight> WalkMedium<'_, M> {
-    /// Walks from `start`, a point inside the medium (the entry hit's `spawn_origin(dir)`, or
-    /// a point just off a surface inside it), along the unit direction `dir`, until the path
-    /// leaves, meets another object's surface, is absorbed or is capped. `last_scatter` is the
-    /// vertex the walk starts from, as reported by [`WalkEnd::Exited`] if no event happens
-    /// (`None` when entering through the boundary). `order` counts real scattering events and
-    /// is incremented at each one; `on_scatter(p, dir_in, order, rng)` is called at every real
-    /// scattering vertex before the new direction is sampled (next-event estimation goes there).
-    #[allow(clippy::too_many_arguments)]
+    /// Walks from `from` until the path leaves, meets another object's surface, is absorbed
+    /// or is capped. `order` counts real scattering events and is incremented at each one;
+    /// `on_scatter(p, dir_in, order, rng)` is called at every real scattering vertex before the
+    /// new direction is sampled (next-event estimation goes there).
     pub fn walk(
         &self,
-        start: DVec3,
-        dir: DVec3,
-        last_scatter: Option<(DVec3, f64)>,
+        from: WalkStart,
         order: &mut u32,
         rng: &mut Rng,
         counters: &mut PathCounters,
@@ -256,9 +264,7 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
     ) -> WalkEnd {
         let mut weight = Rgb::ONE;
         self.walk_carrying(
-            start,
-            dir,
-            last_scatter,
+            from,
             order,
             &mut weight,
             rng,
@@ -271,20 +277,20 @@ impl<M: FreeFlight> WalkMedium<'_, M> {
     /// multiplies ([`FreeFlight`]: unchanged for one channel, the density ratios to the hero
     /// for hero tracking, up to a common factor); `on_scatter` also receives the weight at the
     /// scattering vertex.
-    #[allow(clippy::too_many_arguments)]
     pub fn walk_carrying(
         &self,
-        start: DVec3,
-        dir: DVec3,
-        mut last_scatter: Option<(DVec3, f64)>,
+        from: WalkStart,
         order: &mut u32,
         weight: &mut Rgb,
         rng: &mut Rng,
         counters: &mut PathCounters,
         mut on_scatter: impl FnMut(DVec3, DVec3, u32, Rgb, &mut Rng),
     ) -> WalkEnd {
-        let mut origin = start;
-        let mut d = dir;
+        let WalkStart {
+            mut origin,
+            dir: mut d,
+            mut last_scatter,
+        } = from;
         let mut collisions = 0u64;
         let cap = collision_cap();
         let mut tracking = TrackingCounters::default();
@@ -582,10 +588,13 @@ mod tests {
             let (mut wa, mut wb) = (Rgb::ONE, Rgb::ONE);
             let mut order = 0;
             let mut counters = PathCounters::default();
+            let from = WalkStart {
+                origin: start,
+                dir: DVec3::NEG_Z,
+                last_scatter: None,
+            };
             let end = walk.walk_carrying(
-                start,
-                DVec3::NEG_Z,
-                None,
+                from,
                 &mut order,
                 &mut wa,
                 &mut a,

@@ -1,6 +1,7 @@
-//! Probe-ray sampling of incident points on the tracer's objects: the library's sampler
-//! ([`het_estimate::probe`], which documents the technique and its density) over the
-//! per-object BVH.
+//! The tracer's side of probe-ray sampling: incident points on the tracer's objects by the
+//! library's sampler ([`het_estimate::probe`], which documents the technique and its density)
+//! over the per-object BVH ([`ObjectSurface`]'s probe chords), and how a BSSRDF vertex uses
+//! the points it found ([`Gathering`]: which gather light, which carries the path on).
 
 use bssrdf_core::ProfileFamily;
 use glam::DVec3;
