@@ -41,8 +41,99 @@ use std::sync::Arc;
 use bssrdf_core::Rgb;
 use glam::DVec3;
 
+use serde::Deserialize;
+
+use super::Light;
 use crate::distribution::PiecewiseConstant2D;
+use crate::error::SceneError;
 use crate::field::{Axis, Texture};
+use crate::scene::desc::{AxisDesc, DescContext, RgbDesc};
+
+/// `[[light]]` with `type = "environment"`: a constant `radiance`, or an image `filename`
+/// with its `scale`, `rotation` and `up` ([`EnvironmentMap`]).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Constant radiance (W/(sr·m²)), without `filename`.
+    pub radiance: Option<RgbDesc>,
+    /// An equirectangular image of the radiance (`.exr` or Radiance `.hdr`; linear), relative
+    /// to the scene file.
+    pub filename: Option<String>,
+    /// With `filename`: per-channel multiplier of the texels (default 1).
+    pub scale: Option<RgbDesc>,
+    /// With `filename`: turn of the map about its up axis in DEGREES, counter-clockwise seen
+    /// from above (default 0).
+    pub rotation: Option<f64>,
+    /// With `filename`: the map's up axis, `"x" | "y" | "z"` (default z).
+    pub up: Option<AxisDesc>,
+}
+
+impl EnvironmentDesc {
+    /// The environment light: read from the image `filename` (through `cx`), or constant
+    /// (`radiance`; `scale`, `rotation` and `up` then refused).
+    pub fn build(self, cx: &dyn DescContext) -> Result<Light, SceneError> {
+        let Some(rel) = &self.filename else {
+            let Some(radiance) = self.radiance else {
+                return Err(cx.invalid(
+                    "",
+                    "an environment light needs `radiance` (constant) or `filename` (an image)"
+                        .into(),
+                ));
+            };
+            for (name, given) in [
+                ("scale", self.scale.is_some()),
+                ("rotation", self.rotation.is_some()),
+                ("up", self.up.is_some()),
+            ] {
+                if given {
+                    return Err(cx.invalid(
+                        name,
+                        format!("`{name}` applies to an environment map (`filename`)"),
+                    ));
+                }
+            }
+            return Light::environment(Rgb(radiance.0))
+                .map_err(|e| cx.invalid(e.key(), e.to_string()));
+        };
+        if self.radiance.is_some() {
+            return Err(cx.invalid(
+                "radiance",
+                "give `radiance` (constant) or `filename` (an image), not both; `scale` \
+                 multiplies the image"
+                    .into(),
+            ));
+        }
+        let ext = std::path::Path::new(rel)
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if !matches!(ext.as_deref(), Some("exr" | "hdr")) {
+            return Err(cx.invalid(
+                "filename",
+                format!(
+                    "`{rel}`: an environment map is an `.exr` or Radiance `.hdr` image \
+                     (linear radiance)"
+                ),
+            ));
+        }
+        let texture = cx.texture("filename", rel, true)?;
+        let map = EnvironmentMap::new(
+            Arc::new(texture),
+            Rgb(self.scale.map_or([1.0; 3], |s| s.0)),
+            Axis::from(self.up.unwrap_or(AxisDesc::Z)),
+            self.rotation.unwrap_or(0.0),
+        )
+        .map_err(|e| {
+            let sub = match e {
+                EnvironmentError::BadRotation(_) => "rotation",
+                _ => "scale",
+            };
+            cx.invalid(sub, e.to_string())
+        })?;
+        Ok(Light::environment_map(map))
+    }
+}
 
 /// The bilinear filter's average over one texel, per neighbour offset −1, 0, +1 (module docs).
 const TEXEL_AVERAGE: [f64; 3] = [0.125, 0.75, 0.125];

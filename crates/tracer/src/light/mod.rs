@@ -14,15 +14,50 @@
 
 pub mod environment;
 
-pub use environment::{EnvironmentError, EnvironmentMap};
+pub use environment::{EnvironmentDesc, EnvironmentError, EnvironmentMap};
 
 use std::f64::consts::PI;
 use std::sync::Arc;
 
 use bssrdf_core::Rgb;
 use glam::DVec3;
+use serde::Deserialize;
 
+use crate::error::SceneError;
 use crate::geometry::Hit;
+use crate::scene::desc::{DescContext, RgbDesc, exact, tagged};
+
+tagged!(
+    /// `[[light]]` in a scene file: its kind's description. Each converts itself to a
+    /// [`Light`] ([`LightDesc::build`]).
+    pub enum LightDesc for "light" {
+        /// `type = "directional"`.
+        "directional" => Directional(DirectionalDesc),
+        /// `type = "point"`.
+        "point" => Point(PointDesc),
+        /// `type = "quad"`.
+        "quad" => Quad(QuadDesc),
+        /// `type = "environment"`.
+        "environment" => Environment(EnvironmentDesc),
+        /// `type = "beam"`.
+        "beam" => Beam(BeamDesc),
+    }
+);
+
+impl LightDesc {
+    /// The light described; `cx` reads an environment map's image and names the keys of
+    /// invalid values.
+    pub fn build(self, cx: &dyn DescContext) -> Result<Light, SceneError> {
+        let light = match self {
+            LightDesc::Directional(d) => Light::try_from(d),
+            LightDesc::Point(d) => Light::try_from(d),
+            LightDesc::Quad(d) => Light::try_from(d),
+            LightDesc::Environment(d) => return d.build(cx),
+            LightDesc::Beam(d) => Light::try_from(d),
+        };
+        light.map_err(|e| cx.invalid(e.key(), e.to_string()))
+    }
+}
 
 /// A light source.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,6 +84,26 @@ pub struct DirectionalLight {
     pub irradiance: Rgb,
 }
 
+/// `[[light]]` with `type = "directional"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Direction the light TRAVELS.
+    #[serde(deserialize_with = "exact")]
+    pub direction: [f64; 3],
+    /// Irradiance on a surface perpendicular to the light.
+    pub irradiance: RgbDesc,
+}
+
+impl TryFrom<DirectionalDesc> for Light {
+    type Error = LightError;
+    fn try_from(d: DirectionalDesc) -> Result<Light, LightError> {
+        Light::directional(d.direction.into(), Rgb(d.irradiance.0))
+    }
+}
+
 /// Isotropic point light.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointLight {
@@ -56,6 +111,26 @@ pub struct PointLight {
     pub position: DVec3,
     /// Radiant intensity (per steradian).
     pub intensity: Rgb,
+}
+
+/// `[[light]]` with `type = "point"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Position.
+    #[serde(deserialize_with = "exact")]
+    pub position: [f64; 3],
+    /// Intensity (W/sr).
+    pub intensity: RgbDesc,
+}
+
+impl TryFrom<PointDesc> for Light {
+    type Error = LightError;
+    fn try_from(d: PointDesc) -> Result<Light, LightError> {
+        Light::point(d.position.into(), Rgb(d.intensity.0))
+    }
 }
 
 /// A one-sided parallelogram `corner + s·edge_u + t·edge_v`, `s, t ∈ [0, 1]`, emitting
@@ -88,6 +163,37 @@ impl QuadLight {
             self.corner + self.edge_u + self.edge_v,
             self.corner + self.edge_v,
         ]
+    }
+}
+
+/// `[[light]]` with `type = "quad"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// A corner.
+    #[serde(deserialize_with = "exact")]
+    pub corner: [f64; 3],
+    /// First edge.
+    #[serde(deserialize_with = "exact")]
+    pub edge_u: [f64; 3],
+    /// Second edge; light leaves on the side of edge_u × edge_v.
+    #[serde(deserialize_with = "exact")]
+    pub edge_v: [f64; 3],
+    /// Radiance.
+    pub radiance: RgbDesc,
+}
+
+impl TryFrom<QuadDesc> for Light {
+    type Error = LightError;
+    fn try_from(d: QuadDesc) -> Result<Light, LightError> {
+        Light::quad(
+            d.corner.into(),
+            d.edge_u.into(),
+            d.edge_v.into(),
+            Rgb(d.radiance.0),
+        )
     }
 }
 
@@ -150,6 +256,29 @@ pub struct BeamLight {
     pub power: Rgb,
 }
 
+/// `[[light]]` with `type = "beam"`.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BeamDesc {
+    #[serde(rename = "type")]
+    _type: String,
+    /// Start point.
+    #[serde(deserialize_with = "exact")]
+    pub origin: [f64; 3],
+    /// Direction of travel.
+    #[serde(deserialize_with = "exact")]
+    pub direction: [f64; 3],
+    /// Power.
+    pub power: RgbDesc,
+}
+
+impl TryFrom<BeamDesc> for Light {
+    type Error = LightError;
+    fn try_from(d: BeamDesc) -> Result<Light, LightError> {
+        Light::beam(d.origin.into(), d.direction.into(), Rgb(d.power.0))
+    }
+}
+
 /// A sample of incident light at a point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightSample {
@@ -194,6 +323,17 @@ pub enum LightError {
     /// Quad edges that are zero or parallel.
     #[error("the quad's edges are zero or parallel (area 0)")]
     DegenerateQuad,
+}
+
+impl LightError {
+    /// The scene file's key (below the light's table) that holds the invalid value.
+    pub fn key(&self) -> &'static str {
+        match self {
+            LightError::BadDirection(w) | LightError::NonFinite(w) => w,
+            LightError::BadValue { what, .. } => what,
+            LightError::DegenerateQuad => "edge_v",
+        }
+    }
 }
 
 fn check_rgb(what: &'static str, v: Rgb) -> Result<Rgb, LightError> {

@@ -180,20 +180,7 @@ pub(crate) fn validate_material(m: &Material) -> Result<(), (String, String)> {
     match m {
         Material::Translucent(t) => validate_translucent(t),
         Material::Diffuse(d) => {
-            let (lo, hi) = (d.albedo.min(), d.albedo.max());
-            if !(rgb_ok(lo) && rgb_ok(hi) && hi.max_component() <= 1.0) {
-                return Err((
-                    "albedo".into(),
-                    if d.albedo.is_constant() {
-                        format!("albedo must be in [0, 1], got {:?}", hi.0)
-                    } else {
-                        format!(
-                            "albedo must be in [0, 1] everywhere, but it reaches {:?}",
-                            hi.0
-                        )
-                    },
-                ));
-            }
+            validate_albedo(&d.albedo)?;
             match &d.roughness {
                 Some(r) => validate_roughness(r),
                 None => Ok(()),
@@ -215,8 +202,27 @@ pub(crate) fn validate_material(m: &Material) -> Result<(), (String, String)> {
     }
 }
 
+/// Checks a diffuse `albedo` field: within [0, 1] everywhere.
+pub(crate) fn validate_albedo(albedo: &crate::field::Field) -> Result<(), (String, String)> {
+    let (lo, hi) = (albedo.min(), albedo.max());
+    if !(rgb_ok(lo) && rgb_ok(hi) && hi.max_component() <= 1.0) {
+        return Err((
+            "albedo".into(),
+            if albedo.is_constant() {
+                format!("albedo must be in [0, 1], got {:?}", hi.0)
+            } else {
+                format!(
+                    "albedo must be in [0, 1] everywhere, but it reaches {:?}",
+                    hi.0
+                )
+            },
+        ));
+    }
+    Ok(())
+}
+
 fn validate_translucent(t: &Translucent) -> Result<(), (String, String)> {
-    validate_translucent_scalars(t)?;
+    validate_translucent_scalars(t.g, t.eta, t.unit_scale)?;
     if let Some(r) = &t.roughness {
         validate_roughness(r)?;
     }
@@ -247,21 +253,22 @@ pub(crate) fn validate_roughness(r: &crate::field::Field) -> Result<(), (String,
 
 /// Checks a translucent material's `g`, `eta` and `unit_scale` with the bounds every profile
 /// and estimator accepts (`bssrdf_core::error`), so that no method can reject them later.
-pub(crate) fn validate_translucent_scalars(t: &Translucent) -> Result<(), (String, String)> {
-    check_g(t.g).map_err(|e| ("g".to_string(), format!("|g| must be < 1: {e}")))?;
-    check_eta(t.eta).map_err(|e| {
+pub(crate) fn validate_translucent_scalars(
+    g: f64,
+    eta: f64,
+    unit_scale: f64,
+) -> Result<(), (String, String)> {
+    check_g(g).map_err(|e| ("g".to_string(), format!("|g| must be < 1: {e}")))?;
+    check_eta(eta).map_err(|e| {
         (
             "eta".to_string(),
             format!("eta (n_medium / n_outside): {e}"),
         )
     })?;
-    if !(t.unit_scale.is_finite() && t.unit_scale > 0.0) {
+    if !(unit_scale.is_finite() && unit_scale > 0.0) {
         return Err((
             "unit_scale".into(),
-            format!(
-                "unit_scale must be finite and positive, got {}",
-                t.unit_scale
-            ),
+            format!("unit_scale must be finite and positive, got {unit_scale}"),
         ));
     }
     Ok(())

@@ -1,9 +1,93 @@
-//! The raw scene description: what the TOML file says, before validation. Each section or
-//! array element with a `type` key is read in two steps (the `type`, then the struct of that
-//! type) so that serde's errors keep their position in the file.
+//! The typed scene description: what the TOML file says, one type per kind of camera,
+//! material, field, light and shape, before validation. Each section or array element with a
+//! `type` key is read in two steps (the `type`, then the struct of that kind: [`Tagged`]) so
+//! that serde's errors keep their position in the file. The lights' descriptions live beside
+//! the lights ([`crate::light::LightDesc`]), and each converts itself to its runtime type.
 
 use serde::Deserialize;
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+
+use crate::error::SceneError;
+use crate::field::{Axis, Filter, PlanarProjection, Texture, Wrap};
+
+/// A description read by its `type` key: one struct per kind, chosen before it is read so
+/// that serde's errors keep their position in the file (a `#[serde(tag = "type")]` enum
+/// buffers the table and loses it). Implemented by the crate's `tagged!` macro, which declares
+/// the enum of a section's kinds.
+pub trait Tagged: Sized {
+    /// What the descriptions describe (`"light"`), for messages.
+    const WHAT: &'static str;
+    /// The kinds, as the `type` key spells them.
+    const KINDS: &'static [&'static str];
+    /// The description of `kind` read from `d`, or `None` for a kind not in [`Tagged::KINDS`].
+    fn from_kind<'de, D: Deserializer<'de>>(kind: &str, d: D) -> Option<Result<Self, D::Error>>;
+}
+
+/// Declares an enum of descriptions, one variant per `type`, and its [`Tagged`] impl:
+/// `tagged!(/** doc */ pub enum LightDesc for "light" { "point" => Point(PointDesc), … })`.
+macro_rules! tagged {
+    (
+        $(#[$doc:meta])* $vis:vis enum $name:ident for $what:literal {
+            $($(#[$vdoc:meta])* $kind:literal => $variant:ident($ty:ty)),* $(,)?
+        }
+    ) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, PartialEq)]
+        $vis enum $name {
+            $($(#[$vdoc])* $variant($ty),)*
+        }
+        impl $crate::scene::desc::Tagged for $name {
+            const WHAT: &'static str = $what;
+            const KINDS: &'static [&'static str] = &[$($kind),*];
+            fn from_kind<'de, D: serde::Deserializer<'de>>(
+                kind: &str,
+                d: D,
+            ) -> Option<Result<Self, D::Error>> {
+                match kind {
+                    $($kind => Some(<$ty as serde::Deserialize>::deserialize(d).map($name::$variant)),)*
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+pub(crate) use tagged;
+
+/// What converting a description may ask of the loader: its files (named relative to the
+/// scene file) and errors that name the description's keys, file and line.
+pub trait DescContext {
+    /// An invalid value at `sub`, a key below the description (`""`: the description itself).
+    fn invalid(&self, sub: &str, message: String) -> SceneError;
+    /// The image at `rel` (relative to the scene file), named by the key `sub`, decoded
+    /// (`linear`: 8/16-bit values are data, not sRGB) and recorded as an input of the scene.
+    fn texture(&self, sub: &str, rel: &str, linear: bool) -> Result<Texture, SceneError>;
+}
+
+/// A description whose keys do not hold together: the key at fault below the description
+/// (`None`: the description itself) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DescError {
+    /// The key below the description (`"width"`), or `None` for the description itself.
+    pub key: Option<&'static str>,
+    /// What is wrong, and what is accepted.
+    pub message: String,
+}
+
+impl DescError {
+    pub(crate) fn at(key: &'static str, message: impl Into<String>) -> Self {
+        Self {
+            key: Some(key),
+            message: message.into(),
+        }
+    }
+
+    pub(crate) fn here(message: impl Into<String>) -> Self {
+        Self {
+            key: None,
+            message: message.into(),
+        }
+    }
+}
 
 /// A colour or coefficient: a number (grey) or `[r, g, b]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,7 +136,7 @@ fn rgb_from_seq<'de, A: SeqAccess<'de>>(
 
 /// Exactly `N` elements: serde's fixed-size arrays silently ignore extra elements, so that
 /// `min = [-2, -2, -2, 5]` would load as `[-2, -2, -2]`.
-fn exact<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
+pub(crate) fn exact<'de, D: Deserializer<'de>, T: Deserialize<'de>, const N: usize>(
     d: D,
 ) -> Result<[T; N], D::Error> {
     let v: Vec<T> = Vec::deserialize(d)?;
@@ -123,7 +207,8 @@ pub enum FieldKind {
     Image,
 }
 
-/// A field table. Which keys apply depends on `type`; the loader rejects the others.
+/// A field table as written: every kind's keys, each optional. [`TypedField::try_from`] keeps
+/// those of its `type` and refuses the others.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FieldTable {
@@ -202,6 +287,255 @@ pub enum FilterDesc {
     Bilinear,
 }
 
+impl FieldKind {
+    /// The kind as `type` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            FieldKind::Constant => "constant",
+            FieldKind::Stripe => "stripe",
+            FieldKind::Check => "check",
+            FieldKind::Image => "image",
+        }
+    }
+
+    /// The keys a table of this kind takes, besides `type`.
+    pub fn keys(self) -> &'static [&'static str] {
+        match self {
+            FieldKind::Constant => &["value"],
+            FieldKind::Stripe => &["width", "angle", "values", "axis", "origin"],
+            FieldKind::Check => &["width", "values", "axis", "origin"],
+            FieldKind::Image => &[
+                "texture", "mapping", "axis", "origin", "size", "wrap", "filter", "scale",
+            ],
+        }
+    }
+}
+
+impl FieldTable {
+    /// The first key given that `self.kind` does not take.
+    fn foreign_key(&self) -> Option<&'static str> {
+        let FieldTable {
+            kind,
+            value,
+            width,
+            angle,
+            values,
+            axis,
+            origin,
+            texture,
+            mapping,
+            size,
+            wrap,
+            filter,
+            scale,
+        } = self;
+        [
+            ("value", value.is_some()),
+            ("width", width.is_some()),
+            ("angle", angle.is_some()),
+            ("values", values.is_some()),
+            ("axis", axis.is_some()),
+            ("origin", origin.is_some()),
+            ("texture", texture.is_some()),
+            ("mapping", mapping.is_some()),
+            ("size", size.is_some()),
+            ("wrap", wrap.is_some()),
+            ("filter", filter.is_some()),
+            ("scale", scale.is_some()),
+        ]
+        .into_iter()
+        .find(|(k, given)| *given && !kind.keys().contains(k))
+        .map(|(k, _)| k)
+    }
+}
+
+/// A field table with its `type` applied: the keys of its kind, defaults filled in.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TypedField {
+    /// `type = "constant"`: the value.
+    Constant(RgbDesc),
+    /// `type = "stripe"`.
+    Stripe(StripeDesc),
+    /// `type = "check"`.
+    Check(CheckDesc),
+    /// `type = "image"`.
+    Image(ImageDesc),
+}
+
+/// A planar projection: the axis projected along and the origin (scene units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProjectionDesc {
+    /// Projection axis (default z).
+    pub axis: AxisDesc,
+    /// Projection origin (default `[0, 0, 0]`).
+    pub origin: [f64; 3],
+}
+
+/// A stripe field: bands of two values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StripeDesc {
+    /// Band width (scene units).
+    pub width: f64,
+    /// Angle θ in DEGREES (default 0); bands vary along (cos θ, sin θ) in the (s, t) plane.
+    pub angle: f64,
+    /// The two values.
+    pub values: [RgbDesc; 2],
+    /// How points map to the (s, t) plane.
+    pub projection: ProjectionDesc,
+}
+
+/// A check field: square cells of two values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckDesc {
+    /// Cell side (scene units).
+    pub width: f64,
+    /// The two values.
+    pub values: [RgbDesc; 2],
+    /// How points map to the (s, t) plane.
+    pub projection: ProjectionDesc,
+}
+
+/// An image field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ImageDesc {
+    /// The `[[texture]]` name.
+    pub texture: String,
+    /// How points find their texel.
+    pub mapping: ImageMappingDesc,
+    /// Wrap mode (default repeat).
+    pub wrap: WrapDesc,
+    /// Filter (default bilinear).
+    pub filter: FilterDesc,
+    /// Per-channel multiplier of the texel values (default 1).
+    pub scale: RgbDesc,
+}
+
+/// An image field's mapping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ImageMappingDesc {
+    /// Planar projection of an image of world size `[W, H]` (scene units).
+    Planar {
+        /// The projection.
+        projection: ProjectionDesc,
+        /// World size of the image.
+        size: [f64; 2],
+    },
+    /// The mesh's texture coordinates.
+    Uv,
+}
+
+impl TryFrom<FieldTable> for TypedField {
+    type Error = DescError;
+
+    /// Keeps the keys of the table's kind: a key of another kind, or a missing required key,
+    /// is an error naming it and the kind's keys.
+    fn try_from(t: FieldTable) -> Result<Self, DescError> {
+        let kind = t.kind.name();
+        if let Some(k) = t.foreign_key() {
+            return Err(DescError::at(
+                k,
+                format!(
+                    "`{k}` does not apply to a `{kind}` field (its keys: {})",
+                    t.kind.keys().join(", ")
+                ),
+            ));
+        }
+        let need = |k: &str| DescError::here(format!("a `{kind}` field needs `{k}`"));
+        let projection = ProjectionDesc {
+            axis: t.axis.unwrap_or(AxisDesc::Z),
+            origin: t.origin.unwrap_or([0.0; 3]),
+        };
+        Ok(match t.kind {
+            FieldKind::Constant => TypedField::Constant(t.value.ok_or_else(|| need("value"))?),
+            FieldKind::Stripe => TypedField::Stripe(StripeDesc {
+                width: t.width.ok_or_else(|| need("width"))?,
+                angle: t.angle.unwrap_or(0.0),
+                values: t.values.ok_or_else(|| need("values"))?,
+                projection,
+            }),
+            FieldKind::Check => TypedField::Check(CheckDesc {
+                width: t.width.ok_or_else(|| need("width"))?,
+                values: t.values.ok_or_else(|| need("values"))?,
+                projection,
+            }),
+            FieldKind::Image => {
+                let texture = t.texture.clone().ok_or_else(|| need("texture"))?;
+                TypedField::Image(ImageDesc {
+                    texture,
+                    mapping: image_mapping(&t, projection)?,
+                    wrap: t.wrap.unwrap_or(WrapDesc::Repeat),
+                    filter: t.filter.unwrap_or(FilterDesc::Bilinear),
+                    scale: t.scale.unwrap_or(RgbDesc([1.0; 3])),
+                })
+            }
+        })
+    }
+}
+
+/// An image table's mapping: `"uv"` refuses the planar keys; planar needs `size`.
+fn image_mapping(
+    t: &FieldTable,
+    projection: ProjectionDesc,
+) -> Result<ImageMappingDesc, DescError> {
+    match t.mapping.unwrap_or(MappingDesc::Planar) {
+        MappingDesc::Uv => {
+            for (k, given) in [
+                ("axis", t.axis.is_some()),
+                ("origin", t.origin.is_some()),
+                ("size", t.size.is_some()),
+            ] {
+                if given {
+                    return Err(DescError::at(
+                        k,
+                        format!("`{k}` does not apply to `mapping = \"uv\"`"),
+                    ));
+                }
+            }
+            Ok(ImageMappingDesc::Uv)
+        }
+        MappingDesc::Planar => {
+            let size = t.size.ok_or_else(|| {
+                DescError::here("a planar image field needs `size = [W, H]` (scene units)")
+            })?;
+            Ok(ImageMappingDesc::Planar { projection, size })
+        }
+    }
+}
+
+impl From<AxisDesc> for Axis {
+    fn from(a: AxisDesc) -> Axis {
+        match a {
+            AxisDesc::X => Axis::X,
+            AxisDesc::Y => Axis::Y,
+            AxisDesc::Z => Axis::Z,
+        }
+    }
+}
+
+impl From<WrapDesc> for Wrap {
+    fn from(w: WrapDesc) -> Wrap {
+        match w {
+            WrapDesc::Repeat => Wrap::Repeat,
+            WrapDesc::Clamp => Wrap::Clamp,
+        }
+    }
+}
+
+impl From<FilterDesc> for Filter {
+    fn from(f: FilterDesc) -> Filter {
+        match f {
+            FilterDesc::Bilinear => Filter::Bilinear,
+            FilterDesc::Nearest => Filter::Nearest,
+        }
+    }
+}
+
+impl From<ProjectionDesc> for PlanarProjection {
+    fn from(p: ProjectionDesc) -> PlanarProjection {
+        PlanarProjection::new(p.axis.into(), p.origin.into())
+    }
+}
+
 /// `[render]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -264,6 +598,16 @@ pub struct OrthographicDesc {
     /// View height (scene units).
     pub height: f64,
 }
+
+tagged!(
+    /// `[camera]`: its kind's description.
+    pub enum CameraDesc for "camera" {
+        /// `type = "perspective"`.
+        "perspective" => Perspective(PerspectiveDesc),
+        /// `type = "orthographic"`.
+        "orthographic" => Orthographic(OrthographicDesc),
+    }
+);
 
 /// `[[texture]]`.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -354,86 +698,25 @@ pub struct DiffuseDesc {
     pub roughness: Option<FieldDesc>,
 }
 
-/// `[[light]]` with `type = "directional"`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DirectionalDesc {
-    #[serde(rename = "type")]
-    _type: String,
-    /// Direction the light TRAVELS.
-    #[serde(deserialize_with = "exact")]
-    pub direction: [f64; 3],
-    /// Irradiance on a surface perpendicular to the light.
-    pub irradiance: RgbDesc,
-}
+tagged!(
+    /// `[[material]]`: its kind's description.
+    #[allow(clippy::large_enum_variant)] // a few per scene, read once
+    pub enum MaterialDesc for "material" {
+        /// `type = "translucent"`.
+        "translucent" => Translucent(TranslucentDesc),
+        /// `type = "diffuse"`.
+        "diffuse" => Diffuse(DiffuseDesc),
+    }
+);
 
-/// `[[light]]` with `type = "point"`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PointDesc {
-    #[serde(rename = "type")]
-    _type: String,
-    /// Position.
-    #[serde(deserialize_with = "exact")]
-    pub position: [f64; 3],
-    /// Intensity (W/sr).
-    pub intensity: RgbDesc,
-}
-
-/// `[[light]]` with `type = "quad"`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct QuadDesc {
-    #[serde(rename = "type")]
-    _type: String,
-    /// A corner.
-    #[serde(deserialize_with = "exact")]
-    pub corner: [f64; 3],
-    /// First edge.
-    #[serde(deserialize_with = "exact")]
-    pub edge_u: [f64; 3],
-    /// Second edge; light leaves on the side of edge_u × edge_v.
-    #[serde(deserialize_with = "exact")]
-    pub edge_v: [f64; 3],
-    /// Radiance.
-    pub radiance: RgbDesc,
-}
-
-/// `[[light]]` with `type = "environment"`: a constant `radiance`, or an image `filename`
-/// with its `scale`, `rotation` and `up` ([`crate::light::EnvironmentMap`]).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EnvironmentDesc {
-    #[serde(rename = "type")]
-    _type: String,
-    /// Constant radiance (W/(sr·m²)), without `filename`.
-    pub radiance: Option<RgbDesc>,
-    /// An equirectangular image of the radiance (`.exr` or Radiance `.hdr`; linear), relative
-    /// to the scene file.
-    pub filename: Option<String>,
-    /// With `filename`: per-channel multiplier of the texels (default 1).
-    pub scale: Option<RgbDesc>,
-    /// With `filename`: turn of the map about its up axis in DEGREES, counter-clockwise seen
-    /// from above (default 0).
-    pub rotation: Option<f64>,
-    /// With `filename`: the map's up axis, `"x" | "y" | "z"` (default z).
-    pub up: Option<AxisDesc>,
-}
-
-/// `[[light]]` with `type = "beam"`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BeamDesc {
-    #[serde(rename = "type")]
-    _type: String,
-    /// Start point.
-    #[serde(deserialize_with = "exact")]
-    pub origin: [f64; 3],
-    /// Direction of travel.
-    #[serde(deserialize_with = "exact")]
-    pub direction: [f64; 3],
-    /// Power.
-    pub power: RgbDesc,
+impl MaterialDesc {
+    /// The material's name.
+    pub fn name(&self) -> &str {
+        match self {
+            MaterialDesc::Translucent(d) => &d.name,
+            MaterialDesc::Diffuse(d) => &d.name,
+        }
+    }
 }
 
 /// A shape's optional transform: `p' = translate + R(rotate) · (scale ⊙ p)`.
@@ -559,5 +842,23 @@ shape_desc!(
         /// glTF only: let the file's buffer and image URIs name files outside its own folder
         /// (default false; see [`crate::geometry::gltf_assets`]).
         allow_outside_assets: Option<bool>,
+    }
+);
+
+tagged!(
+    /// `[[shape]]`: its kind's description.
+    pub enum ShapeDesc for "shape" {
+        /// `type = "box"`.
+        "box" => Box(BoxDesc),
+        /// `type = "sphere"`.
+        "sphere" => Sphere(SphereDesc),
+        /// `type = "half_space"`.
+        "half_space" => HalfSpace(HalfSpaceDesc),
+        /// `type = "obj"`.
+        "obj" => Obj(MeshFileDesc),
+        /// `type = "gltf"`.
+        "gltf" => Gltf(MeshFileDesc),
+        /// `type = "ply"`.
+        "ply" => Ply(MeshFileDesc),
     }
 );

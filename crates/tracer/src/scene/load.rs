@@ -12,20 +12,17 @@ use toml::Spanned;
 use toml::de::{DeTable, DeValue, ValueDeserializer};
 
 use super::builder::{
-    AssemblyInfo, PendingObject, assemble, validate_material, validate_medium, validate_settings,
-    validate_translucent_scalars,
+    AssemblyInfo, PendingObject, assemble, validate_albedo, validate_material, validate_medium,
+    validate_roughness, validate_settings, validate_translucent_scalars,
 };
 use super::desc::*;
 use super::locate::Locator;
 use super::{Diffuse, Material, RenderSettings, Scene, Translucent};
 use crate::camera::{Camera, CameraError};
 use crate::error::{FieldError, SceneError};
-use crate::field::{
-    ArtistMap, Axis, Field, Filter, ImageMapping, InvertAt, MediumField, PlanarProjection, Texture,
-    Wrap,
-};
-use crate::geometry::{Transform, TriangleMesh, primitives};
-use crate::light::{EnvironmentError, EnvironmentMap, Light, LightError};
+use crate::field::{ArtistMap, Field, Filter, ImageMapping, InvertAt, MediumField, Texture, Wrap};
+use crate::geometry::{Transform, TriangleMesh};
+use crate::light::{Light, LightDesc};
 
 const SECTIONS: &[&str] = &["render", "camera", "texture", "material", "light", "shape"];
 
@@ -263,6 +260,46 @@ impl Cx {
         }
     }
 
+    /// The description of kind `type` at `key` ([`Tagged`]): an unknown kind is an error
+    /// listing the kinds.
+    fn tagged<T: Tagged>(&self, v: &Val<'_>, key: &str) -> Result<T, SceneError> {
+        let expected = T::KINDS
+            .iter()
+            .map(|k| format!("\"{k}\""))
+            .collect::<Vec<_>>()
+            .join(" | ");
+        let kind = self.type_of(v, key, &expected)?;
+        T::from_kind(kind, ValueDeserializer::from(v.clone()))
+            .ok_or_else(|| {
+                self.parse_msg(
+                    &format!("{key}.type"),
+                    format!("unknown {} type `{kind}`, expected {expected}", T::WHAT),
+                )
+            })?
+            .map_err(|e| self.parse_err(e, key))
+    }
+
+    /// A description's error at `key`: its own key below `key`, or `key` itself.
+    fn desc_error(&self, key: &str, e: DescError) -> SceneError {
+        match e.key {
+            Some(sub) => self.invalid(&format!("{key}.{sub}"), e.message),
+            None => self.invalid(key, e.message),
+        }
+    }
+
+    /// The image at `rel` (relative to the scene file), named by `key`: checked readable,
+    /// recorded as an input, decoded.
+    fn read_texture(&self, key: &str, rel: &str, linear: bool) -> Result<Texture, SceneError> {
+        let path = self.resolve(rel);
+        self.check_readable(key, &path)?;
+        Texture::load(&path, linear).map_err(|source| SceneError::Texture {
+            file: self.file.clone(),
+            line: self.loc.line_of_key(key),
+            key: key.to_string(),
+            source: Box::new(source),
+        })
+    }
+
     fn load(&self, root: &Spanned<DeTable<'_>>, display_name: &str) -> Result<Scene, SceneError> {
         let t = root.get_ref();
         for (k, _) in t.iter() {
@@ -285,8 +322,31 @@ impl Cx {
         let materials = self.materials(t, &textures)?;
         let lights = self.lights(t)?;
         let shapes = self.shapes(t, &materials)?;
+        let pending = self.objects(shapes, &materials, &textures)?;
+        assemble(
+            AssemblyInfo {
+                file: self.file.clone(),
+                display_name: display_name.to_string(),
+                source_path: None,
+                locator: &self.loc,
+                inputs: self.inputs.take(),
+                notes: self.notes.take(),
+            },
+            settings,
+            camera,
+            lights,
+            pending,
+        )
+    }
 
-        // Build the materials used by some shape (decoding only their textures).
+    /// The shapes with their materials, building the materials some shape uses (decoding only
+    /// their textures, each once).
+    fn objects(
+        &self,
+        shapes: Vec<ShapePlan>,
+        materials: &HashMap<String, MaterialPlan>,
+        textures: &Textures,
+    ) -> Result<Vec<PendingObject>, SceneError> {
         let mut decoded: HashMap<String, Arc<Texture>> = HashMap::new();
         let mut built: HashMap<String, Material> = HashMap::new();
         let mut pending = Vec::with_capacity(shapes.len());
@@ -296,8 +356,7 @@ impl Cx {
                 ShapeMaterial::Named(name) => match built.get(name) {
                     Some(m) => m.clone(),
                     None => {
-                        let plan = &materials[name];
-                        let m = self.realize(plan, &textures, &mut decoded)?;
+                        let m = self.realize(&materials[name], textures, &mut decoded)?;
                         built.insert(name.clone(), m.clone());
                         m
                     }
@@ -321,20 +380,7 @@ impl Cx {
                 material,
             });
         }
-        assemble(
-            AssemblyInfo {
-                file: self.file.clone(),
-                display_name: display_name.to_string(),
-                source_path: None,
-                locator: &self.loc,
-                inputs: self.inputs.take(),
-                notes: self.notes.take(),
-            },
-            settings,
-            camera,
-            lights,
-            pending,
-        )
+        Ok(pending)
     }
 
     fn settings(&self, t: &DeTable<'_>) -> Result<RenderSettings, SceneError> {
@@ -383,43 +429,30 @@ impl Cx {
         let v = t
             .get("camera")
             .ok_or_else(|| self.parse_msg("", "missing section [camera]"))?;
-        const KINDS: &str = "\"perspective\" | \"orthographic\"";
-        let (cam, fov_key) = match self.type_of(v, "camera", KINDS)? {
-            "perspective" => {
-                let d: PerspectiveDesc = self.de(v, "camera")?;
-                (
-                    Camera::perspective(
-                        d.eye.into(),
-                        d.target.into(),
-                        d.up.into(),
-                        d.fov_y,
-                        s.width,
-                        s.height,
-                    ),
-                    "camera.fov_y",
-                )
-            }
-            "orthographic" => {
-                let d: OrthographicDesc = self.de(v, "camera")?;
-                (
-                    Camera::orthographic(
-                        d.centre.into(),
-                        d.direction.into(),
-                        d.up.into(),
-                        d.width,
-                        d.height,
-                        s.width,
-                        s.height,
-                    ),
-                    "camera.width",
-                )
-            }
-            other => {
-                return Err(self.parse_msg(
-                    "camera.type",
-                    format!("unknown camera type `{other}`, expected {KINDS}"),
-                ));
-            }
+        let (cam, fov_key) = match self.tagged(v, "camera")? {
+            CameraDesc::Perspective(d) => (
+                Camera::perspective(
+                    d.eye.into(),
+                    d.target.into(),
+                    d.up.into(),
+                    d.fov_y,
+                    s.width,
+                    s.height,
+                ),
+                "camera.fov_y",
+            ),
+            CameraDesc::Orthographic(d) => (
+                Camera::orthographic(
+                    d.centre.into(),
+                    d.direction.into(),
+                    d.up.into(),
+                    d.width,
+                    d.height,
+                    s.width,
+                    s.height,
+                ),
+                "camera.width",
+            ),
         };
         cam.map_err(|e| {
             let key = match e {
@@ -432,10 +465,7 @@ impl Cx {
         })
     }
 
-    fn textures(
-        &self,
-        t: &DeTable<'_>,
-    ) -> Result<HashMap<String, (String, TextureDesc)>, SceneError> {
+    fn textures(&self, t: &DeTable<'_>) -> Result<Textures, SceneError> {
         let mut out = HashMap::new();
         for (key, v) in self.elements(t, "texture")? {
             let d: TextureDesc = self.de(v, &key)?;
@@ -453,61 +483,54 @@ impl Cx {
     fn materials(
         &self,
         t: &DeTable<'_>,
-        textures: &HashMap<String, (String, TextureDesc)>,
+        textures: &Textures,
     ) -> Result<HashMap<String, MaterialPlan>, SceneError> {
-        const KINDS: &str = "\"translucent\" | \"diffuse\"";
         let mut out = HashMap::new();
         for (key, v) in self.elements(t, "material")? {
-            let plan = match self.type_of(v, &key, KINDS)? {
-                "translucent" => {
-                    let d: TranslucentDesc = self.de(v, &key)?;
-                    self.translucent_plan(&d, &key, textures)?
-                }
-                "diffuse" => {
-                    let d: DiffuseDesc = self.de(v, &key)?;
-                    let albedo = self.field_spec(&d.albedo, &format!("{key}.albedo"), textures)?;
-                    let roughness = d
-                        .roughness
-                        .as_ref()
-                        .map(|r| self.field_spec(r, &format!("{key}.roughness"), textures))
-                        .transpose()?;
-                    // Constant values are checked now (unused materials too); images when
-                    // they are decoded.
-                    let ready = |f: &FieldSpec| match f {
-                        FieldSpec::Ready(f) => f.clone(),
-                        FieldSpec::Image { .. } => Field::Constant(Rgb::ZERO),
-                    };
-                    let probe = Material::Diffuse(Diffuse {
-                        albedo: ready(&albedo),
-                        roughness: roughness.as_ref().map(ready),
-                    });
-                    validate_material(&probe)
-                        .map_err(|(k, msg)| self.invalid(&format!("{key}.{k}"), msg))?;
-                    (
-                        d.name.clone(),
-                        MaterialPlan::Diffuse {
-                            albedo,
-                            roughness,
-                            key: key.clone(),
-                        },
-                    )
-                }
-                other => {
-                    return Err(self.parse_msg(
-                        &format!("{key}.type"),
-                        format!("unknown material type `{other}`, expected {KINDS}"),
-                    ));
-                }
+            let d: MaterialDesc = self.tagged(v, &key)?;
+            let plan = match &d {
+                MaterialDesc::Translucent(d) => self.translucent_plan(d, &key, textures)?,
+                MaterialDesc::Diffuse(d) => self.diffuse_plan(d, &key, textures)?,
             };
-            if out.contains_key(&plan.0) {
+            if out.contains_key(d.name()) {
                 return Err(self.invalid(
                     &format!("{key}.name"),
-                    format!("duplicate material name `{}`", plan.0),
+                    format!("duplicate material name `{}`", d.name()),
                 ));
             }
-            out.insert(plan.0, plan.1);
+            out.insert(d.name().to_string(), plan);
         }
         Ok(out)
+    }
+
+    /// A diffuse material's plan; its constant fields are checked now (unused materials too),
+    /// its images when they are decoded.
+    fn diffuse_plan(
+        &self,
+        d: &DiffuseDesc,
+        key: &str,
+        textures: &Textures,
+    ) -> Result<MaterialPlan, SceneError> {
+        let albedo = self.field_spec(&d.albedo, &format!("{key}.albedo"), textures)?;
+        let roughness = d
+            .roughness
+            .as_ref()
+            .map(|r| self.field_spec(r, &format!("{key}.roughness"), textures))
+            .transpose()?;
+        let checked = |r: Result<(), (String, String)>| {
+            r.map_err(|(k, msg)| self.invalid(&format!("{key}.{k}"), msg))
+        };
+        if let FieldSpec::Ready(f) = &albedo {
+            checked(validate_albedo(f))?;
+        }
+        if let Some(FieldSpec::Ready(r)) = &roughness {
+            checked(validate_roughness(r))?;
+        }
+        Ok(MaterialPlan::Diffuse {
+            albedo,
+            roughness,
+            key: key.to_string(),
+        })
     }
 
     /// Validates a field description without decoding images.
@@ -515,163 +538,87 @@ impl Cx {
         &self,
         d: &FieldDesc,
         key: &str,
-        textures: &HashMap<String, (String, TextureDesc)>,
+        textures: &Textures,
     ) -> Result<FieldSpec, SceneError> {
-        let ferr = |e: FieldError| self.invalid(key, e.to_string());
-        let tbl = match d {
-            FieldDesc::Constant(v) => {
-                return Field::constant(Rgb(v.0))
-                    .map(FieldSpec::Ready)
-                    .map_err(ferr);
+        let typed = match d {
+            FieldDesc::Constant(v) => TypedField::Constant(*v),
+            FieldDesc::Table(t) => {
+                TypedField::try_from((**t).clone()).map_err(|e| self.desc_error(key, e))?
             }
-            FieldDesc::Table(t) => t,
         };
-        // Which keys each kind accepts.
-        let present: Vec<(&str, bool)> = vec![
-            ("value", tbl.value.is_some()),
-            ("width", tbl.width.is_some()),
-            ("angle", tbl.angle.is_some()),
-            ("values", tbl.values.is_some()),
-            ("axis", tbl.axis.is_some()),
-            ("origin", tbl.origin.is_some()),
-            ("texture", tbl.texture.is_some()),
-            ("mapping", tbl.mapping.is_some()),
-            ("size", tbl.size.is_some()),
-            ("wrap", tbl.wrap.is_some()),
-            ("filter", tbl.filter.is_some()),
-            ("scale", tbl.scale.is_some()),
-        ];
-        let (kind, allowed, required): (&str, &[&str], &[&str]) = match tbl.kind {
-            FieldKind::Constant => ("constant", &["value"], &["value"]),
-            FieldKind::Stripe => (
-                "stripe",
-                &["width", "angle", "values", "axis", "origin"],
-                &["width", "values"],
+        let rgb2 = |v: [RgbDesc; 2]| [Rgb(v[0].0), Rgb(v[1].0)];
+        let field = match typed {
+            TypedField::Constant(v) => Field::constant(Rgb(v.0)),
+            TypedField::Stripe(s) => Field::stripe(
+                s.width,
+                s.angle.to_radians(),
+                rgb2(s.values),
+                s.projection.into(),
             ),
-            FieldKind::Check => (
-                "check",
-                &["width", "values", "axis", "origin"],
-                &["width", "values"],
-            ),
-            FieldKind::Image => (
-                "image",
-                &[
-                    "texture", "mapping", "axis", "origin", "size", "wrap", "filter", "scale",
-                ],
-                &["texture"],
-            ),
+            TypedField::Check(c) => Field::check(c.width, rgb2(c.values), c.projection.into()),
+            TypedField::Image(i) => return self.image_spec(i, key, textures),
         };
-        for (k, is) in &present {
-            if *is && !allowed.contains(k) {
-                return Err(self.invalid(
-                    &format!("{key}.{k}"),
-                    format!(
-                        "`{k}` does not apply to a `{kind}` field (its keys: {})",
-                        allowed.join(", ")
-                    ),
-                ));
-            }
-        }
-        for r in required {
-            if !present.iter().any(|(k, is)| k == r && *is) {
-                return Err(self.invalid(key, format!("a `{kind}` field needs `{r}`")));
-            }
-        }
-        let axis = match tbl.axis.unwrap_or(AxisDesc::Z) {
-            AxisDesc::X => Axis::X,
-            AxisDesc::Y => Axis::Y,
-            AxisDesc::Z => Axis::Z,
-        };
-        let projection = PlanarProjection::new(axis, DVec3::from(tbl.origin.unwrap_or([0.0; 3])));
-        let values = tbl.values.map(|v| [Rgb(v[0].0), Rgb(v[1].0)]);
-        match tbl.kind {
-            FieldKind::Constant => Field::constant(Rgb(tbl.value.unwrap().0))
-                .map(FieldSpec::Ready)
-                .map_err(ferr),
-            FieldKind::Stripe => Field::stripe(
-                tbl.width.unwrap(),
-                tbl.angle.unwrap_or(0.0).to_radians(),
-                values.unwrap(),
-                projection,
-            )
+        field
             .map(FieldSpec::Ready)
-            .map_err(ferr),
-            FieldKind::Check => Field::check(tbl.width.unwrap(), values.unwrap(), projection)
-                .map(FieldSpec::Ready)
-                .map_err(ferr),
-            FieldKind::Image => {
-                let name = tbl.texture.clone().unwrap();
-                if !textures.contains_key(&name) {
-                    let mut known: Vec<&String> = textures.keys().collect();
-                    known.sort();
-                    return Err(self.invalid(
-                        &format!("{key}.texture"),
-                        format!("unknown texture `{name}` (defined: {known:?})"),
-                    ));
-                }
-                let mapping = match tbl.mapping.unwrap_or(MappingDesc::Planar) {
-                    MappingDesc::Uv => {
-                        for k in ["axis", "origin", "size"] {
-                            if present.iter().any(|(p, is)| *p == k && *is) {
-                                return Err(self.invalid(
-                                    &format!("{key}.{k}"),
-                                    format!("`{k}` does not apply to `mapping = \"uv\"`"),
-                                ));
-                            }
-                        }
-                        ImageMapping::Uv
-                    }
-                    MappingDesc::Planar => {
-                        let size = tbl.size.ok_or_else(|| {
-                            self.invalid(
-                                key,
-                                "a planar image field needs `size = [W, H]` (scene units)",
-                            )
-                        })?;
-                        for (i, s) in size.iter().enumerate() {
-                            if !(s.is_finite() && *s > 0.0) {
-                                return Err(self.invalid(
-                                    &format!("{key}.size"),
-                                    format!("size[{i}] must be finite and positive, got {s}"),
-                                ));
-                            }
-                        }
-                        ImageMapping::Planar { projection, size }
-                    }
-                };
-                let scale = Rgb(tbl.scale.map_or([1.0; 3], |s| s.0));
-                if !(scale.is_finite() && scale.min_component() >= 0.0) {
-                    return Err(self.invalid(
-                        &format!("{key}.scale"),
-                        format!("scale must be finite and non-negative, got {:?}", scale.0),
-                    ));
-                }
-                Ok(FieldSpec::Image {
-                    texture: name,
-                    mapping,
-                    wrap: match tbl.wrap.unwrap_or(WrapDesc::Repeat) {
-                        WrapDesc::Repeat => Wrap::Repeat,
-                        WrapDesc::Clamp => Wrap::Clamp,
-                    },
-                    filter: match tbl.filter.unwrap_or(FilterDesc::Bilinear) {
-                        FilterDesc::Bilinear => Filter::Bilinear,
-                        FilterDesc::Nearest => Filter::Nearest,
-                    },
-                    scale,
-                    key: key.to_string(),
-                })
-            }
-        }
+            .map_err(|e: FieldError| self.invalid(key, e.to_string()))
     }
 
-    /// A translucent material's plan: σa and σs, or the artist parameters (a constant zero
-    /// radius with a constant colour becomes a diffuse surface of that colour).
-    fn translucent_plan(
+    /// An image field, checked: its texture is defined, its size and scale are valid.
+    fn image_spec(
+        &self,
+        d: ImageDesc,
+        key: &str,
+        textures: &Textures,
+    ) -> Result<FieldSpec, SceneError> {
+        if !textures.contains_key(&d.texture) {
+            let mut known: Vec<&String> = textures.keys().collect();
+            known.sort();
+            return Err(self.invalid(
+                &format!("{key}.texture"),
+                format!("unknown texture `{}` (defined: {known:?})", d.texture),
+            ));
+        }
+        let mapping = match d.mapping {
+            ImageMappingDesc::Uv => ImageMapping::Uv,
+            ImageMappingDesc::Planar { projection, size } => {
+                for (i, s) in size.iter().enumerate() {
+                    if !(s.is_finite() && *s > 0.0) {
+                        return Err(self.invalid(
+                            &format!("{key}.size"),
+                            format!("size[{i}] must be finite and positive, got {s}"),
+                        ));
+                    }
+                }
+                ImageMapping::Planar {
+                    projection: projection.into(),
+                    size,
+                }
+            }
+        };
+        let scale = Rgb(d.scale.0);
+        if !(scale.is_finite() && scale.min_component() >= 0.0) {
+            return Err(self.invalid(
+                &format!("{key}.scale"),
+                format!("scale must be finite and non-negative, got {:?}", scale.0),
+            ));
+        }
+        Ok(FieldSpec::Image {
+            texture: d.texture,
+            mapping,
+            wrap: d.wrap.into(),
+            filter: d.filter.into(),
+            scale,
+            key: key.to_string(),
+        })
+    }
+
+    /// A translucent material's scalar keys, checked with the bounds every profile and
+    /// estimator accepts (so that unused materials are checked too).
+    fn translucent_scalars(
         &self,
         d: &TranslucentDesc,
         key: &str,
-        textures: &HashMap<String, (String, TextureDesc)>,
-    ) -> Result<(String, MaterialPlan), SceneError> {
+    ) -> Result<TranslucentScalars, SceneError> {
         let profile = match &d.profile {
             None => None,
             Some(p) => Some(
@@ -695,11 +642,10 @@ impl Cx {
                  remove one of the two",
             ));
         }
-        // Validate the scalar values now with placeholder constant fields (so that unused
-        // materials are checked too).
-        let probe = Translucent {
+        validate_translucent_scalars(g, d.eta, d.unit_scale)
+            .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+        Ok(TranslucentScalars {
             name: d.name.clone(),
-            medium: MediumField::new(Field::Constant(Rgb::ZERO), Field::Constant(Rgb::ZERO)),
             g,
             eta: d.eta,
             profile,
@@ -711,12 +657,20 @@ impl Cx {
             angular_coupling: d.angular_coupling.unwrap_or(true),
             oblique_shape: d.oblique_shape.unwrap_or(false),
             unit_scale: d.unit_scale,
-            roughness: None,
             key: key.to_string(),
             line: self.loc.line_of_key(key),
-        };
-        validate_translucent_scalars(&probe)
-            .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+        })
+    }
+
+    /// A translucent material's plan: σa and σs, or the artist parameters (a constant zero
+    /// radius with a constant colour becomes a diffuse surface of that colour).
+    fn translucent_plan(
+        &self,
+        d: &TranslucentDesc,
+        key: &str,
+        textures: &Textures,
+    ) -> Result<MaterialPlan, SceneError> {
+        let scalars = self.translucent_scalars(d, key)?;
         let field =
             |f: &FieldDesc, name: &str| self.field_spec(f, &format!("{key}.{name}"), textures);
         let roughness = d
@@ -725,80 +679,26 @@ impl Cx {
             .map(|r| field(r, "roughness"))
             .transpose()?;
         if let Some(FieldSpec::Ready(r)) = &roughness {
-            crate::scene::builder::validate_roughness(r)
-                .map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
+            validate_roughness(r).map_err(|(k, m)| self.invalid(&format!("{key}.{k}"), m))?;
         }
         let artist_keys = d.subsurface_color.is_some()
             || d.subsurface_radius.is_some()
             || d.radius_scale.is_some()
             || d.invert.is_some();
-        let plan = match (
+        let medium = match (
             &d.sigma_a,
             &d.sigma_s,
             &d.subsurface_color,
             &d.subsurface_radius,
         ) {
-            (Some(a), Some(s), None, None) if !artist_keys => MaterialPlan::Translucent {
-                base: probe,
+            (Some(a), Some(s), None, None) if !artist_keys => MediumPlan::Coefficients {
                 sigma_a: field(a, "sigma_a")?,
                 sigma_s: field(s, "sigma_s")?,
-                artist: None,
-                roughness,
             },
             (None, None, Some(c), Some(r)) => {
-                let scale = Rgb(d.radius_scale.map_or([1.0; 3], |s| s.0));
-                if !(scale.is_finite() && scale.min_component() >= 0.0) {
-                    return Err(self.invalid(
-                        &format!("{key}.radius_scale"),
-                        format!(
-                            "radius_scale must be finite and non-negative, got {:?}",
-                            scale.0
-                        ),
-                    ));
-                }
-                let invert = match &d.invert {
-                    None => InvertAt::DEFAULT,
-                    Some(s) => s.parse().map_err(|e: bssrdf_core::UnknownName| {
-                        self.invalid(&format!("{key}.invert"), e.to_string())
-                    })?,
-                };
-                let colour = field(c, "subsurface_color")?;
-                let radius = field(r, "subsurface_radius")?;
-                if let FieldSpec::Ready(Field::Constant(cv)) = &colour
-                    && cv.max_component() > 1.0
-                {
-                    return Err(self.invalid(
-                        &format!("{key}.subsurface_color"),
-                        format!("subsurface_color must lie in [0, 1], got {:?}", cv.0),
-                    ));
-                }
-                if let FieldSpec::Ready(Field::Constant(rv)) = &radius
-                    && (*rv * scale).is_zero()
-                {
-                    // No distance to travel: a diffuse surface of the colour.
-                    let FieldSpec::Ready(Field::Constant(cv)) = colour else {
-                        return Err(self.invalid(
-                            &format!("{key}.subsurface_radius"),
-                            "a zero subsurface_radius makes a diffuse surface, which needs a constant subsurface_color",
-                        ));
-                    };
-                    if roughness.is_some() {
-                        return Err(self.invalid(
-                            &format!("{key}.roughness"),
-                            "a zero subsurface_radius makes a diffuse surface, which has no \
-                             dielectric boundary to be rough: use a `diffuse` material and its \
-                             `roughness`",
-                        ));
-                    }
-                    MaterialPlan::Ready(Material::diffuse(cv))
-                } else {
-                    MaterialPlan::Translucent {
-                        base: probe,
-                        sigma_a: colour,
-                        sigma_s: radius,
-                        artist: Some((scale, invert)),
-                        roughness,
-                    }
+                match self.artist_plan(d, key, [c, r], textures, roughness.is_some())? {
+                    Ok(m) => m,
+                    Err(diffuse) => return Ok(MaterialPlan::Ready(diffuse)),
                 }
             }
             _ => {
@@ -811,14 +711,89 @@ impl Cx {
                 ));
             }
         };
-        Ok((d.name.clone(), plan))
+        Ok(MaterialPlan::Translucent {
+            scalars,
+            medium,
+            roughness,
+        })
+    }
+
+    /// The artist parameters' medium (`[colour, radius]`: their fields), checked; or `Err`
+    /// the diffuse material that a constant zero radius makes of a constant colour (which
+    /// takes no `roughness`: `rough`).
+    fn artist_plan(
+        &self,
+        d: &TranslucentDesc,
+        key: &str,
+        [colour, radius]: [&FieldDesc; 2],
+        textures: &Textures,
+        rough: bool,
+    ) -> Result<Result<MediumPlan, Material>, SceneError> {
+        let scale = Rgb(d.radius_scale.map_or([1.0; 3], |s| s.0));
+        if !(scale.is_finite() && scale.min_component() >= 0.0) {
+            return Err(self.invalid(
+                &format!("{key}.radius_scale"),
+                format!(
+                    "radius_scale must be finite and non-negative, got {:?}",
+                    scale.0
+                ),
+            ));
+        }
+        let invert = match &d.invert {
+            None => InvertAt::DEFAULT,
+            Some(s) => s.parse().map_err(|e: bssrdf_core::UnknownName| {
+                self.invalid(&format!("{key}.invert"), e.to_string())
+            })?,
+        };
+        let colour = self.field_spec(colour, &format!("{key}.subsurface_color"), textures)?;
+        let radius = self.field_spec(radius, &format!("{key}.subsurface_radius"), textures)?;
+        if let FieldSpec::Ready(Field::Constant(cv)) = &colour
+            && cv.max_component() > 1.0
+        {
+            return Err(self.invalid(
+                &format!("{key}.subsurface_color"),
+                format!("subsurface_color must lie in [0, 1], got {:?}", cv.0),
+            ));
+        }
+        let FieldSpec::Ready(Field::Constant(rv)) = &radius else {
+            return Ok(Ok(MediumPlan::Artist {
+                colour,
+                radius,
+                scale,
+                invert,
+            }));
+        };
+        if !(*rv * scale).is_zero() {
+            return Ok(Ok(MediumPlan::Artist {
+                colour,
+                radius,
+                scale,
+                invert,
+            }));
+        }
+        // No distance to travel: a diffuse surface of the colour.
+        let FieldSpec::Ready(Field::Constant(cv)) = colour else {
+            return Err(self.invalid(
+                &format!("{key}.subsurface_radius"),
+                "a zero subsurface_radius makes a diffuse surface, which needs a constant subsurface_color",
+            ));
+        };
+        if rough {
+            return Err(self.invalid(
+                &format!("{key}.roughness"),
+                "a zero subsurface_radius makes a diffuse surface, which has no \
+                 dielectric boundary to be rough: use a `diffuse` material and its \
+                 `roughness`",
+            ));
+        }
+        Ok(Err(Material::diffuse(cv)))
     }
 
     /// Builds a material, decoding the textures it uses (once per texture).
     fn realize(
         &self,
         plan: &MaterialPlan,
-        textures: &HashMap<String, (String, TextureDesc)>,
+        textures: &Textures,
         decoded: &mut HashMap<String, Arc<Texture>>,
     ) -> Result<Material, SceneError> {
         match plan {
@@ -840,53 +815,66 @@ impl Cx {
                 Ok(m)
             }
             MaterialPlan::Translucent {
-                base,
-                sigma_a,
-                sigma_s,
-                artist,
+                scalars,
+                medium,
                 roughness,
-            } => {
-                let a = self.realize_field(sigma_a, textures, decoded)?;
-                let s = self.realize_field(sigma_s, textures, decoded)?;
-                let mut t = base.clone();
-                if let Some(r) = roughness {
-                    let r = self.realize_field(r, textures, decoded)?;
-                    crate::scene::builder::validate_roughness(&r)
-                        .map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
-                    t.roughness = Some(r);
-                }
-                t.medium = match artist {
-                    None => MediumField::new(a, s).scaled(base.unit_scale),
-                    Some((scale, invert)) => {
-                        let model = t.profile.unwrap_or(ProfileModel::default_for(t.eta));
-                        let inversion =
-                            AlbedoInversion::shared(model, t.g, t.eta).map_err(|e| {
-                                self.invalid(&format!("{}.profile", t.key), e.to_string())
-                            })?;
-                        MediumField::artist(
-                            a,
-                            s.scaled_rgb(*scale * (1.0 / base.unit_scale)),
-                            ArtistMap::new(inversion, *invert),
-                        )
-                        .map_err(|e| {
-                            self.invalid(&format!("{}.subsurface_color", t.key), e.to_string())
-                        })?
-                    }
-                };
-                validate_medium(&t).map_err(|(k, m)| self.invalid(&format!("{}.{k}", t.key), m))?;
-                Ok(Material::Translucent(t))
-            }
+            } => self.realize_translucent(scalars, medium, roughness.as_ref(), textures, decoded),
         }
+    }
+
+    /// Builds a translucent material: its roughness and medium, decoding their textures.
+    fn realize_translucent(
+        &self,
+        s: &TranslucentScalars,
+        medium: &MediumPlan,
+        roughness: Option<&FieldSpec>,
+        textures: &Textures,
+        decoded: &mut HashMap<String, Arc<Texture>>,
+    ) -> Result<Material, SceneError> {
+        let key = |sub: &str| format!("{}.{sub}", s.key);
+        // σa and σs (or the colour and radius) first: their textures are decoded, and listed
+        // among the scene's inputs, before the roughness's.
+        let (a, b) = match medium {
+            MediumPlan::Coefficients { sigma_a, sigma_s } => (sigma_a, sigma_s),
+            MediumPlan::Artist { colour, radius, .. } => (colour, radius),
+        };
+        let a = self.realize_field(a, textures, decoded)?;
+        let b = self.realize_field(b, textures, decoded)?;
+        let roughness = match roughness {
+            None => None,
+            Some(r) => {
+                let r = self.realize_field(r, textures, decoded)?;
+                validate_roughness(&r).map_err(|(k, m)| self.invalid(&key(&k), m))?;
+                Some(r)
+            }
+        };
+        let medium = match medium {
+            MediumPlan::Coefficients { .. } => MediumField::new(a, b).scaled(s.unit_scale),
+            MediumPlan::Artist { scale, invert, .. } => {
+                let model = s.profile.unwrap_or(ProfileModel::default_for(s.eta));
+                let inversion = AlbedoInversion::shared(model, s.g, s.eta)
+                    .map_err(|e| self.invalid(&key("profile"), e.to_string()))?;
+                MediumField::artist(
+                    a,
+                    b.scaled_rgb(*scale * (1.0 / s.unit_scale)),
+                    ArtistMap::new(inversion, *invert),
+                )
+                .map_err(|e| self.invalid(&key("subsurface_color"), e.to_string()))?
+            }
+        };
+        let t = s.clone().into_translucent(medium, roughness);
+        validate_medium(&t).map_err(|(k, m)| self.invalid(&key(&k), m))?;
+        Ok(Material::Translucent(t))
     }
 
     fn realize_field(
         &self,
         spec: &FieldSpec,
-        textures: &HashMap<String, (String, TextureDesc)>,
+        textures: &Textures,
         decoded: &mut HashMap<String, Arc<Texture>>,
     ) -> Result<Field, SceneError> {
-        match spec {
-            FieldSpec::Ready(f) => Ok(f.clone()),
+        let (texture, mapping, wrap, filter, scale, key) = match spec {
+            FieldSpec::Ready(f) => return Ok(f.clone()),
             FieldSpec::Image {
                 texture,
                 mapping,
@@ -894,157 +882,32 @@ impl Cx {
                 filter,
                 scale,
                 key,
-            } => {
-                let tex = match decoded.get(texture) {
-                    Some(t) => t.clone(),
-                    None => {
-                        let (tkey, desc) = &textures[texture];
-                        let path = self.resolve(&desc.path);
-                        let path_key = format!("{tkey}.path");
-                        self.check_readable(&path_key, &path)?;
-                        let t = Texture::load(&path, desc.linear).map_err(|source| {
-                            SceneError::Texture {
-                                file: self.file.clone(),
-                                line: self.loc.line_of_key(&path_key),
-                                key: path_key.clone(),
-                                source: Box::new(source),
-                            }
-                        })?;
-                        let t = Arc::new(t);
-                        decoded.insert(texture.clone(), t.clone());
-                        t
-                    }
-                };
-                Field::image(tex, *mapping, *wrap, *filter, *scale)
-                    .map_err(|e| self.invalid(key, e.to_string()))
+            } => (texture, mapping, wrap, filter, scale, key),
+        };
+        let tex = match decoded.get(texture) {
+            Some(t) => t.clone(),
+            None => {
+                let (tkey, desc) = &textures[texture];
+                let t = self.read_texture(&format!("{tkey}.path"), &desc.path, desc.linear)?;
+                let t = Arc::new(t);
+                decoded.insert(texture.clone(), t.clone());
+                t
             }
-        }
+        };
+        Field::image(tex, *mapping, *wrap, *filter, *scale)
+            .map_err(|e| self.invalid(key, e.to_string()))
     }
 
     fn lights(&self, t: &DeTable<'_>) -> Result<Vec<Light>, SceneError> {
-        const KINDS: &str = "\"directional\" | \"point\" | \"quad\" | \"environment\" | \"beam\"";
         let mut out = Vec::new();
         for (key, v) in self.elements(t, "light")? {
-            let light = match self.type_of(v, &key, KINDS)? {
-                "directional" => {
-                    let d: DirectionalDesc = self.de(v, &key)?;
-                    Light::directional(d.direction.into(), Rgb(d.irradiance.0))
-                }
-                "point" => {
-                    let d: PointDesc = self.de(v, &key)?;
-                    Light::point(d.position.into(), Rgb(d.intensity.0))
-                }
-                "quad" => {
-                    let d: QuadDesc = self.de(v, &key)?;
-                    Light::quad(
-                        d.corner.into(),
-                        d.edge_u.into(),
-                        d.edge_v.into(),
-                        Rgb(d.radiance.0),
-                    )
-                }
-                "environment" => {
-                    let d: EnvironmentDesc = self.de(v, &key)?;
-                    match self.environment(&d, &key)? {
-                        Some(map) => Ok(map),
-                        None => Light::environment(Rgb(d.radiance.map_or([0.0; 3], |r| r.0))),
-                    }
-                }
-                "beam" => {
-                    let d: BeamDesc = self.de(v, &key)?;
-                    Light::beam(d.origin.into(), d.direction.into(), Rgb(d.power.0))
-                }
-                other => {
-                    return Err(self.parse_msg(
-                        &format!("{key}.type"),
-                        format!("unknown light type `{other}`, expected {KINDS}"),
-                    ));
-                }
-            };
-            out.push(light.map_err(|e| {
-                let sub = match &e {
-                    LightError::BadDirection(w) | LightError::NonFinite(w) => *w,
-                    LightError::BadValue { what, .. } => what,
-                    LightError::DegenerateQuad => "edge_v",
-                };
-                self.invalid(&format!("{key}.{sub}"), e.to_string())
+            let d: LightDesc = self.tagged(v, &key)?;
+            out.push(d.build(&At {
+                cx: self,
+                key: &key,
             })?);
         }
         Ok(out)
-    }
-
-    /// An environment light read from an image (`filename`), or `None` for a constant one
-    /// (`radiance`; `scale`, `rotation` and `up` then refused).
-    fn environment(&self, d: &EnvironmentDesc, key: &str) -> Result<Option<Light>, SceneError> {
-        let k = |sub: &str| format!("{key}.{sub}");
-        let Some(rel) = &d.filename else {
-            if d.radiance.is_none() {
-                return Err(self.invalid(
-                    key,
-                    "an environment light needs `radiance` (constant) or `filename` (an image)",
-                ));
-            }
-            for (name, given) in [
-                ("scale", d.scale.is_some()),
-                ("rotation", d.rotation.is_some()),
-                ("up", d.up.is_some()),
-            ] {
-                if given {
-                    return Err(self.invalid(
-                        &k(name),
-                        format!("`{name}` applies to an environment map (`filename`)"),
-                    ));
-                }
-            }
-            return Ok(None);
-        };
-        if d.radiance.is_some() {
-            return Err(self.invalid(
-                &k("radiance"),
-                "give `radiance` (constant) or `filename` (an image), not both; `scale` \
-                 multiplies the image",
-            ));
-        }
-        let path = self.resolve(rel);
-        let path_key = k("filename");
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase());
-        if !matches!(ext.as_deref(), Some("exr" | "hdr")) {
-            return Err(self.invalid(
-                &path_key,
-                format!(
-                    "`{rel}`: an environment map is an `.exr` or Radiance `.hdr` image \
-                     (linear radiance)"
-                ),
-            ));
-        }
-        self.check_readable(&path_key, &path)?;
-        let texture = Texture::load(&path, true).map_err(|source| SceneError::Texture {
-            file: self.file.clone(),
-            line: self.loc.line_of_key(&path_key),
-            key: path_key.clone(),
-            source: Box::new(source),
-        })?;
-        let up = match d.up.unwrap_or(AxisDesc::Z) {
-            AxisDesc::X => Axis::X,
-            AxisDesc::Y => Axis::Y,
-            AxisDesc::Z => Axis::Z,
-        };
-        let map = EnvironmentMap::new(
-            Arc::new(texture),
-            Rgb(d.scale.map_or([1.0; 3], |s| s.0)),
-            up,
-            d.rotation.unwrap_or(0.0),
-        )
-        .map_err(|e| {
-            let sub = match e {
-                EnvironmentError::BadRotation(_) => "rotation",
-                _ => "scale",
-            };
-            self.invalid(&k(sub), e.to_string())
-        })?;
-        Ok(Some(Light::environment_map(map)))
     }
 
     fn shapes(
@@ -1052,231 +915,44 @@ impl Cx {
         t: &DeTable<'_>,
         materials: &HashMap<String, MaterialPlan>,
     ) -> Result<Vec<ShapePlan>, SceneError> {
-        const KINDS: &str = "\"box\" | \"sphere\" | \"half_space\" | \"obj\" | \"gltf\" | \"ply\"";
-        let mut out: Vec<ShapePlan> = Vec::new();
-        let mut names = HashSet::new();
-        let shapes = self.elements(t, "shape")?;
+        let mut descs = Vec::new();
         // The primitives' triangles, counted before any is generated; the limits are read
         // once (a check per shape read them 100,000 times for as many boxes).
         let room = crate::memory::headroom();
         let mut tessellated = 0.0;
-        for (key, v) in &shapes {
-            let added = match self.type_of(v, key, KINDS)? {
-                "sphere" => {
-                    let d: SphereDesc = self.de(v, key)?;
-                    20.0 * 4f64.powi(d.subdivisions.unwrap_or(5).min(9) as i32)
-                }
-                "half_space" => {
-                    let d: HalfSpaceDesc = self.de(v, key)?;
-                    2.0 * f64::from(d.subdivisions.unwrap_or(32).min(1024)).powi(2) + 10.0
-                }
-                _ => continue,
-            };
-            tessellated += added;
-            self.check_tessellation(room, tessellated, &format!("{key}.subdivisions"))?;
-        }
-        for (i, (key, v)) in shapes.into_iter().enumerate() {
-            let k = |sub: &str| format!("{key}.{sub}");
-            let (common, mesh, source) = match self.type_of(v, &key, KINDS)? {
-                "box" => {
-                    let d: BoxDesc = self.de(v, &key)?;
-                    let (lo, hi) = (DVec3::from(d.min), DVec3::from(d.max));
-                    if !(lo.is_finite() && hi.is_finite() && lo.cmplt(hi).all()) {
-                        return Err(self.invalid(
-                            &k("max"),
-                            format!(
-                                "need min < max in every axis, got min {:?}, max {:?}",
-                                d.min, d.max
-                            ),
-                        ));
-                    }
-                    (d.common(), primitives::cuboid(lo, hi), "<box>".to_string())
-                }
-                "sphere" => {
-                    let d: SphereDesc = self.de(v, &key)?;
-                    let c = DVec3::from(d.centre);
-                    if !(d.radius.is_finite() && d.radius > 0.0) {
-                        return Err(self.invalid(
-                            &k("radius"),
-                            format!("radius must be finite and positive, got {}", d.radius),
-                        ));
-                    }
-                    if !c.is_finite() {
-                        return Err(self.invalid(&k("centre"), "centre must be finite"));
-                    }
-                    let s = d.subdivisions.unwrap_or(5);
-                    if s > 9 {
-                        return Err(self.invalid(
-                            &k("subdivisions"),
-                            format!("at most 9 (5,242,880 triangles), got {s}"),
-                        ));
-                    }
-                    (
-                        d.common(),
-                        primitives::icosphere(c, d.radius, s),
-                        "<sphere>".to_string(),
-                    )
-                }
-                "half_space" => {
-                    let d: HalfSpaceDesc = self.de(v, &key)?;
-                    let size = d.size.unwrap_or(1000.0);
-                    let depth = d.depth.unwrap_or(0.5 * size);
-                    let top = d.top.unwrap_or(0.0);
-                    let centre = d.centre.unwrap_or([0.0, 0.0]);
-                    let sub = d.subdivisions.unwrap_or(32);
-                    for (name, val) in [("size", size), ("depth", depth)] {
-                        if !(val.is_finite() && val > 0.0) {
-                            return Err(self.invalid(
-                                &k(name),
-                                format!("{name} must be finite and positive, got {val}"),
-                            ));
-                        }
-                    }
-                    if !(top.is_finite() && centre.iter().all(|c| c.is_finite())) {
-                        return Err(self.invalid(&k("top"), "top and centre must be finite"));
-                    }
-                    if sub == 0 || sub > 1024 {
-                        return Err(self.invalid(
-                            &k("subdivisions"),
-                            format!("must be in 1..=1024, got {sub}"),
-                        ));
-                    }
-                    (
-                        d.common(),
-                        primitives::half_space(top, centre, size, depth, sub),
-                        "<half_space>".to_string(),
-                    )
-                }
-                kind @ ("obj" | "gltf" | "ply") => {
-                    let d: MeshFileDesc = self.de(v, &key)?;
-                    let correction = (d.shape_correction, d.shape_correction_seed);
-                    if (correction.0.is_some() || correction.1.is_some())
-                        && (kind != "gltf" || d.material.is_some())
-                    {
-                        let which = if correction.0.is_some() {
-                            "shape_correction"
-                        } else {
-                            "shape_correction_seed"
-                        };
-                        return Err(self.invalid(
-                            &k(which),
-                            "applies to a glTF shape that uses the file's materials (no \
-                             `material`); set it on the material instead",
-                        ));
-                    }
-                    if correction.0 == Some(false) && correction.1.is_some() {
-                        return Err(self.invalid(
-                            &k("shape_correction_seed"),
-                            "a seed for the shape correction, which `shape_correction = false` \
-                             turns off: remove one of the two",
-                        ));
-                    }
-                    if d.allow_outside_assets.is_some() && kind != "gltf" {
-                        return Err(self.invalid(
-                            &k("allow_outside_assets"),
-                            "only a glTF shape reads external files by URI",
-                        ));
-                    }
-                    #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
-                    let scope = if d.allow_outside_assets.unwrap_or(false)
-                        || self.options.allow_outside_assets
-                    {
-                        crate::geometry::gltf_assets::AssetScope::Anywhere
-                    } else {
-                        crate::geometry::gltf_assets::AssetScope::ModelFolder
-                    };
-                    let (common, rel) = (d.common(), d.path);
-                    let path = self.resolve(&rel);
-                    if let Some(hint) = &d.if_missing
-                        && !path.exists()
-                    {
-                        return Err(self.invalid(
-                            &k("path"),
-                            format!("the mesh `{}` does not exist: {hint}", path.display()),
-                        ));
-                    }
-                    self.check_readable(&k("path"), &path)?;
-                    let mesh_error = |source| SceneError::Mesh {
-                        file: self.file.clone(),
-                        key: k("path"),
-                        line: self.loc.line_of_key(&k("path")),
-                        source: Box::new(source),
-                    };
-                    #[cfg(feature = "gltf")]
-                    if kind == "gltf" && common.material.is_none() {
-                        let mut model = crate::geometry::gltf::load_gltf_parts_with(&path, scope)
-                            .map_err(mesh_error)?;
-                        self.inputs
-                            .borrow_mut()
-                            .extend_from_slice(model.files_read());
-                        let shape = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
-                        let xf = self.shape_transform(&common, &key)?;
-                        let scale = xf.map_or(DVec3::ONE, |t| t.scale);
-                        // Materials that share an image decode it once.
-                        let mut images = HashMap::new();
-                        for part in std::mem::take(&mut model.parts) {
-                            let name = format!("{shape}/{}", part.material.name);
-                            let mut material = self.gltf_material(
-                                &model,
-                                &part.material,
-                                &mut images,
-                                &name,
-                                &key,
-                                scale,
-                            )?;
-                            if let Material::Translucent(t) = &mut material {
-                                if let Some(on) = correction.0 {
-                                    t.shape_correction = Some(on);
-                                }
-                                if let Some(seed) = correction.1 {
-                                    t.correction_seed = seed;
-                                }
-                            }
-                            self.add_shape(
-                                &mut out,
-                                &mut names,
-                                ShapePlan {
-                                    name,
-                                    key: key.clone(),
-                                    material: ShapeMaterial::Built(Box::new(material)),
-                                    mesh: part.mesh,
-                                    source: path.display().to_string(),
-                                },
-                                xf.as_ref(),
-                            )?;
-                        }
-                        continue;
-                    }
-                    let mesh = self.load_mesh(kind, &path, scope).map_err(mesh_error)?;
-                    (common, mesh, path.display().to_string())
-                }
-                other => {
-                    return Err(self.parse_msg(
-                        &k("type"),
-                        format!("unknown shape type `{other}`, expected {KINDS}"),
-                    ));
-                }
-            };
-            let Some(material) = common.material.clone() else {
-                return Err(self.invalid(
-                    &k("material"),
-                    "missing `material` (only a glTF shape may leave it out, to use the \
-                     file's materials)",
-                ));
-            };
-            if !materials.contains_key(&material) {
-                let mut known: Vec<&String> = materials.keys().collect();
-                known.sort();
-                return Err(self.invalid(
-                    &k("material"),
-                    format!("unknown material `{material}` (defined: {known:?})"),
-                ));
+        for (key, v) in self.elements(t, "shape")? {
+            let d: ShapeDesc = self.tagged(v, &key)?;
+            if let Some(added) = d.tessellated_triangles() {
+                tessellated += added;
+                self.check_tessellation(room, tessellated, &format!("{key}.subdivisions"))?;
             }
+            descs.push((key, d));
+        }
+        let mut out = ShapeList::default();
+        for (i, (key, d)) in descs.into_iter().enumerate() {
+            let common = d.common();
+            let primitive = |m: Result<TriangleMesh, DescError>, source: &str| {
+                m.map(|m| (m, source.to_string()))
+                    .map_err(|e| self.desc_error(&key, e))
+            };
+            let (mesh, source) = match &d {
+                ShapeDesc::Box(b) => primitive(TriangleMesh::try_from(b), "<box>")?,
+                ShapeDesc::Sphere(s) => primitive(TriangleMesh::try_from(s), "<sphere>")?,
+                ShapeDesc::HalfSpace(h) => primitive(TriangleMesh::try_from(h), "<half_space>")?,
+                ShapeDesc::Obj(m) => self.mesh_file(MeshKind::Obj, m, &key)?,
+                ShapeDesc::Ply(m) => self.mesh_file(MeshKind::Ply, m, &key)?,
+                #[cfg(feature = "gltf")]
+                ShapeDesc::Gltf(m) if m.material.is_none() => {
+                    self.gltf_parts(m, i, &key, &mut out)?;
+                    continue;
+                }
+                ShapeDesc::Gltf(m) => self.mesh_file(MeshKind::Gltf, m, &key)?,
+            };
+            let material = self.shape_material(&common, &key, materials)?;
             let name = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
             let xf = self.shape_transform(&common, &key)?;
-            self.add_shape(
-                &mut out,
-                &mut names,
+            out.add(
+                self,
                 ShapePlan {
                     name,
                     key,
@@ -1287,7 +963,162 @@ impl Cx {
                 xf.as_ref(),
             )?;
         }
-        Ok(out)
+        Ok(out.plans)
+    }
+
+    /// The material a shape names: given, and defined.
+    fn shape_material(
+        &self,
+        common: &ShapeCommon,
+        key: &str,
+        materials: &HashMap<String, MaterialPlan>,
+    ) -> Result<String, SceneError> {
+        let Some(material) = common.material.clone() else {
+            return Err(self.invalid(
+                &format!("{key}.material"),
+                "missing `material` (only a glTF shape may leave it out, to use the \
+                 file's materials)",
+            ));
+        };
+        if !materials.contains_key(&material) {
+            let mut known: Vec<&String> = materials.keys().collect();
+            known.sort();
+            return Err(self.invalid(
+                &format!("{key}.material"),
+                format!("unknown material `{material}` (defined: {known:?})"),
+            ));
+        }
+        Ok(material)
+    }
+
+    /// A mesh file shape's keys checked, and its file: where glTF reads its assets from, and
+    /// the path (existing and readable; `if_missing` tells how to get it).
+    fn mesh_path(
+        &self,
+        kind: MeshKind,
+        d: &MeshFileDesc,
+        key: &str,
+    ) -> Result<(PathBuf, crate::geometry::gltf_assets::AssetScope), SceneError> {
+        let k = |sub: &str| format!("{key}.{sub}");
+        let correction = (d.shape_correction, d.shape_correction_seed);
+        if (correction.0.is_some() || correction.1.is_some())
+            && (kind != MeshKind::Gltf || d.material.is_some())
+        {
+            let which = if correction.0.is_some() {
+                "shape_correction"
+            } else {
+                "shape_correction_seed"
+            };
+            return Err(self.invalid(
+                &k(which),
+                "applies to a glTF shape that uses the file's materials (no \
+                 `material`); set it on the material instead",
+            ));
+        }
+        if correction.0 == Some(false) && correction.1.is_some() {
+            return Err(self.invalid(
+                &k("shape_correction_seed"),
+                "a seed for the shape correction, which `shape_correction = false` \
+                 turns off: remove one of the two",
+            ));
+        }
+        if d.allow_outside_assets.is_some() && kind != MeshKind::Gltf {
+            return Err(self.invalid(
+                &k("allow_outside_assets"),
+                "only a glTF shape reads external files by URI",
+            ));
+        }
+        let scope = if d.allow_outside_assets.unwrap_or(false) || self.options.allow_outside_assets
+        {
+            crate::geometry::gltf_assets::AssetScope::Anywhere
+        } else {
+            crate::geometry::gltf_assets::AssetScope::ModelFolder
+        };
+        let path = self.resolve(&d.path);
+        if let Some(hint) = &d.if_missing
+            && !path.exists()
+        {
+            return Err(self.invalid(
+                &k("path"),
+                format!("the mesh `{}` does not exist: {hint}", path.display()),
+            ));
+        }
+        self.check_readable(&k("path"), &path)?;
+        Ok((path, scope))
+    }
+
+    /// A mesh file's error, at the shape's `path`.
+    fn mesh_error(&self, key: &str, source: crate::error::MeshError) -> SceneError {
+        let key = format!("{key}.path");
+        SceneError::Mesh {
+            file: self.file.clone(),
+            line: self.loc.line_of_key(&key),
+            key,
+            source: Box::new(source),
+        }
+    }
+
+    /// The mesh of an `obj`, `ply` or `gltf` shape (with a `material`), and its source.
+    fn mesh_file(
+        &self,
+        kind: MeshKind,
+        d: &MeshFileDesc,
+        key: &str,
+    ) -> Result<(TriangleMesh, String), SceneError> {
+        let (path, scope) = self.mesh_path(kind, d, key)?;
+        let mesh = self
+            .load_mesh(kind, &path, scope)
+            .map_err(|e| self.mesh_error(key, e))?;
+        Ok((mesh, path.display().to_string()))
+    }
+
+    /// A glTF shape without `material`: one object per material of the file, each with the
+    /// file's material.
+    #[cfg(feature = "gltf")]
+    fn gltf_parts(
+        &self,
+        d: &MeshFileDesc,
+        i: usize,
+        key: &str,
+        out: &mut ShapeList,
+    ) -> Result<(), SceneError> {
+        let (path, scope) = self.mesh_path(MeshKind::Gltf, d, key)?;
+        let mut model = crate::geometry::gltf::load_gltf_parts_with(&path, scope)
+            .map_err(|e| self.mesh_error(key, e))?;
+        self.inputs
+            .borrow_mut()
+            .extend_from_slice(model.files_read());
+        let common = d.common();
+        let shape = common.name.clone().unwrap_or_else(|| format!("shape[{i}]"));
+        let xf = self.shape_transform(&common, key)?;
+        let scale = xf.map_or(DVec3::ONE, |t| t.scale);
+        // Materials that share an image decode it once.
+        let mut images = HashMap::new();
+        for part in std::mem::take(&mut model.parts) {
+            let name = format!("{shape}/{}", part.material.name);
+            let mut material =
+                self.gltf_material(&model, &part.material, &mut images, &name, key, scale)?;
+            if let Material::Translucent(t) = &mut material {
+                if let Some(on) = d.shape_correction {
+                    t.shape_correction = Some(on);
+                }
+                if let Some(seed) = d.shape_correction_seed {
+                    t.correction_seed = seed;
+                }
+            }
+            out.add(
+                self,
+                ShapePlan {
+                    name,
+                    key: key.to_string(),
+                    material: ShapeMaterial::Built(Box::new(material)),
+                    mesh: part.mesh,
+                    source: path.display().to_string(),
+                },
+                xf.as_ref(),
+            )?;
+        }
+        Ok(())
     }
 
     /// The material of one glTF material's part (`docs/gltf.md`): the file's values read by
@@ -1336,39 +1167,9 @@ impl Cx {
                 anisotropy,
                 eta,
             } => {
-                use crate::geometry::gltf_material::GltfColour;
-                let colour = match colour {
-                    GltfColour::Constant(c) => Field::constant(Rgb(c)),
-                    GltfColour::Texture { factor, texture } => {
-                        let tex = match images.get(&texture.image) {
-                            Some(t) => t.clone(),
-                            None => {
-                                if let Some(file) = model.image_file(texture.image) {
-                                    self.inputs.borrow_mut().push(file.to_path_buf());
-                                }
-                                let t = model.decode_image(texture.image).map_err(|source| {
-                                    SceneError::Texture {
-                                        file: self.file.clone(),
-                                        line: self.loc.line_of_key(&field_key),
-                                        key: field_key.clone(),
-                                        source: Box::new(source),
-                                    }
-                                })?;
-                                let t = Arc::new(t);
-                                images.insert(texture.image, t.clone());
-                                t
-                            }
-                        };
-                        Field::image(
-                            tex,
-                            ImageMapping::Uv,
-                            texture.wrap,
-                            Filter::Bilinear,
-                            Rgb(factor),
-                        )
-                    }
-                }
-                .map_err(|e| invalid(e.to_string()))?;
+                let colour = self
+                    .gltf_colour(model, colour, images, &field_key)?
+                    .map_err(|e| invalid(e.to_string()))?;
                 let mfp =
                     Field::constant(Rgb(mean_free_path) * s).map_err(|e| invalid(e.to_string()))?;
                 // The material's profile, as for a scene material without a `profile` key: it
@@ -1388,6 +1189,50 @@ impl Cx {
         Ok(material)
     }
 
+    /// A glTF material's subsurface colour: constant, or its image (decoded once per image,
+    /// named in errors by `field_key`).
+    #[cfg(feature = "gltf")]
+    fn gltf_colour(
+        &self,
+        model: &crate::geometry::gltf::GltfModel,
+        colour: crate::geometry::gltf_material::GltfColour,
+        images: &mut HashMap<usize, Arc<Texture>>,
+        field_key: &str,
+    ) -> Result<Result<Field, FieldError>, SceneError> {
+        use crate::geometry::gltf_material::GltfColour;
+        let (factor, texture) = match colour {
+            GltfColour::Constant(c) => return Ok(Field::constant(Rgb(c))),
+            GltfColour::Texture { factor, texture } => (factor, texture),
+        };
+        let tex = match images.get(&texture.image) {
+            Some(t) => t.clone(),
+            None => {
+                if let Some(file) = model.image_file(texture.image) {
+                    self.inputs.borrow_mut().push(file.to_path_buf());
+                }
+                let t =
+                    model
+                        .decode_image(texture.image)
+                        .map_err(|source| SceneError::Texture {
+                            file: self.file.clone(),
+                            line: self.loc.line_of_key(field_key),
+                            key: field_key.to_string(),
+                            source: Box::new(source),
+                        })?;
+                let t = Arc::new(t);
+                images.insert(texture.image, t.clone());
+                t
+            }
+        };
+        Ok(Field::image(
+            tex,
+            ImageMapping::Uv,
+            texture.wrap,
+            Filter::Bilinear,
+            Rgb(factor),
+        ))
+    }
+
     /// The shape's `transform`, checked (once per shape, however many objects it makes).
     fn shape_transform(
         &self,
@@ -1401,59 +1246,39 @@ impl Cx {
             .transpose()
     }
 
-    /// Checks the shape's name is new, applies its transform and adds it to `out`.
-    fn add_shape(
-        &self,
-        out: &mut Vec<ShapePlan>,
-        names: &mut HashSet<String>,
-        mut plan: ShapePlan,
-        transform: Option<&Transform>,
-    ) -> Result<(), SceneError> {
-        if !names.insert(plan.name.clone()) {
-            return Err(self.invalid(
-                &format!("{}.name", plan.key),
-                format!("duplicate shape name `{}`", plan.name),
-            ));
-        }
-        if let Some(xf) = transform {
-            plan.mesh.transform(xf);
-        }
-        out.push(plan);
-        Ok(())
-    }
-
     /// Loads a mesh file; a glTF file's external files (read within `scope`) are added to
     /// the scene's inputs.
     #[cfg_attr(not(feature = "gltf"), allow(unused_variables))]
     fn load_mesh(
         &self,
-        kind: &str,
+        kind: MeshKind,
         path: &Path,
         scope: crate::geometry::gltf_assets::AssetScope,
     ) -> Result<TriangleMesh, crate::error::MeshError> {
         let file = path.display().to_string();
         match kind {
             #[cfg(feature = "obj")]
-            "obj" => crate::geometry::obj::load_obj(path),
+            MeshKind::Obj => crate::geometry::obj::load_obj(path),
             #[cfg(feature = "gltf")]
-            "gltf" => {
+            MeshKind::Gltf => {
                 let (mesh, files) = crate::geometry::gltf::load_gltf_with(path, scope)?;
                 self.inputs.borrow_mut().extend(files);
                 Ok(mesh)
             }
             #[cfg(feature = "ply")]
-            "ply" => crate::geometry::ply::load_ply(path),
+            MeshKind::Ply => crate::geometry::ply::load_ply(path),
+            #[allow(unreachable_patterns)] // with every mesh feature on
             _ => Err(crate::error::MeshError::Unsupported {
                 file,
                 format: match kind {
-                    "obj" => "OBJ",
-                    "gltf" => "glTF",
-                    _ => "PLY",
+                    MeshKind::Obj => "OBJ",
+                    MeshKind::Gltf => "glTF",
+                    MeshKind::Ply => "PLY",
                 },
                 feature: match kind {
-                    "obj" => "obj",
-                    "gltf" => "gltf",
-                    _ => "ply",
+                    MeshKind::Obj => "obj",
+                    MeshKind::Gltf => "gltf",
+                    MeshKind::Ply => "ply",
                 },
             }),
         }
@@ -1492,8 +1317,46 @@ impl Cx {
     }
 }
 
+/// The textures by name, with their keys (`texture[0]`).
+type Textures = HashMap<String, (String, TextureDesc)>;
+
+/// A description's place in the file, for the conversions that read files and name keys
+/// ([`DescContext`]).
+struct At<'a> {
+    cx: &'a Cx,
+    /// The description's key (`light[2]`).
+    key: &'a str,
+}
+
+impl At<'_> {
+    fn key(&self, sub: &str) -> String {
+        if sub.is_empty() {
+            self.key.to_string()
+        } else {
+            format!("{}.{sub}", self.key)
+        }
+    }
+}
+
+impl DescContext for At<'_> {
+    fn invalid(&self, sub: &str, message: String) -> SceneError {
+        self.cx.invalid(&self.key(sub), message)
+    }
+
+    fn texture(&self, sub: &str, rel: &str, linear: bool) -> Result<Texture, SceneError> {
+        self.cx.read_texture(&self.key(sub), rel, linear)
+    }
+}
+
+/// The kinds of mesh files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum MeshKind {
+    Obj,
+    Gltf,
+    Ply,
+}
+
 /// A material after validation, before its textures are decoded.
-#[allow(clippy::large_enum_variant)] // a few per scene, built once
 enum MaterialPlan {
     Ready(Material),
     Diffuse {
@@ -1503,16 +1366,71 @@ enum MaterialPlan {
         key: String,
     },
     Translucent {
-        base: Translucent,
-        /// σa, or the artist colour.
-        sigma_a: FieldSpec,
-        /// σs, or the artist radius.
-        sigma_s: FieldSpec,
-        /// For artist parameters: the radius scale and where estimators invert.
-        artist: Option<(Rgb, InvertAt)>,
+        scalars: TranslucentScalars,
+        medium: MediumPlan,
         /// The boundary's roughness.
         roughness: Option<FieldSpec>,
     },
+}
+
+/// A translucent material's medium before its textures are decoded.
+enum MediumPlan {
+    /// σa and σs (per file unit).
+    Coefficients {
+        sigma_a: FieldSpec,
+        sigma_s: FieldSpec,
+    },
+    /// The artist parameters.
+    Artist {
+        /// The subsurface colour, in [0, 1].
+        colour: FieldSpec,
+        /// The mean free path per channel (file units).
+        radius: FieldSpec,
+        /// `radius_scale`.
+        scale: Rgb,
+        /// Where the estimators invert the colour.
+        invert: InvertAt,
+    },
+}
+
+/// A translucent material's values besides its medium and roughness, checked: the
+/// [`Translucent`] they make once the medium is built.
+#[derive(Debug, Clone)]
+struct TranslucentScalars {
+    name: String,
+    g: f64,
+    eta: f64,
+    profile: Option<ProfileModel>,
+    thickness_aware: bool,
+    shape_correction: Option<bool>,
+    correction_seed: u64,
+    angular_coupling: bool,
+    oblique_shape: bool,
+    unit_scale: f64,
+    key: String,
+    line: Option<usize>,
+}
+
+impl TranslucentScalars {
+    /// The material with `medium` (per scene unit) and `roughness`.
+    fn into_translucent(self, medium: MediumField, roughness: Option<Field>) -> Translucent {
+        Translucent {
+            name: self.name,
+            medium,
+            g: self.g,
+            eta: self.eta,
+            profile: self.profile,
+            thickness_aware: self.thickness_aware,
+            shape_correction: self.shape_correction,
+            correction_seed: self.correction_seed,
+            angular_coupling: self.angular_coupling,
+            oblique_shape: self.oblique_shape,
+            unit_scale: self.unit_scale,
+            roughness,
+            key: self.key,
+            line: self.line,
+        }
+    }
 }
 
 /// A validated field; images are decoded later, only if used.
@@ -1552,4 +1470,33 @@ struct ShapePlan {
     material: ShapeMaterial,
     mesh: TriangleMesh,
     source: String,
+}
+
+/// The shapes' objects so far, and their names.
+#[derive(Default)]
+struct ShapeList {
+    plans: Vec<ShapePlan>,
+    names: HashSet<String>,
+}
+
+impl ShapeList {
+    /// Checks the object's name is new, applies its shape's transform and adds it.
+    fn add(
+        &mut self,
+        cx: &Cx,
+        mut plan: ShapePlan,
+        transform: Option<&Transform>,
+    ) -> Result<(), SceneError> {
+        if !self.names.insert(plan.name.clone()) {
+            return Err(cx.invalid(
+                &format!("{}.name", plan.key),
+                format!("duplicate shape name `{}`", plan.name),
+            ));
+        }
+        if let Some(xf) = transform {
+            plan.mesh.transform(xf);
+        }
+        self.plans.push(plan);
+        Ok(())
+    }
 }

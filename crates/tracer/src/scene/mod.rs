@@ -56,6 +56,7 @@ mod builder;
 mod load;
 mod locate;
 mod overlap;
+mod shape;
 
 pub mod desc;
 
