@@ -637,13 +637,13 @@ mod tests {
                         + thickness(&surface, &x_o, f64::INFINITY));
                 let unbounded = match slab_pair(&x_i, &x_o, d) {
                     Some((face, dist)) => (
-                        counters.eval_slab_profile(&object.family, coeffs, d, face, dist),
+                        eval_slab_profile(&object.family, coeffs, d, face, dist, &mut counters),
                         face == SlabFace::Reflection,
                     ),
-                    None => (
-                        counters.eval_profile(&object.family, coeffs, (x_i.p - x_o.p).length()),
-                        true,
-                    ),
+                    None => {
+                        let r = (x_i.p - x_o.p).length();
+                        (eval_profile(&object.family, coeffs, r, &mut counters), true)
+                    }
                 };
                 // Where the unbounded weight is a transmission (0 beyond the half-space
                 // thickness), the bounded one is the half-space profile at the chord, which
