@@ -10,6 +10,7 @@
 pub use rayon;
 pub mod bsdf;
 pub mod camera;
+mod correction;
 pub mod distribution;
 pub mod error;
 pub mod field;

@@ -89,9 +89,9 @@ pub(crate) struct BssrdfObject {
     /// (the field's smallest, [`bssrdf_core::ProfileFamily::half_space_thickness`]); +∞
     /// where no such thickness exists.
     far_side_reach: f64,
-    /// The shape correction c (module docs of [`super::shape_correction`]), when the material
+    /// The shape correction c (module docs of [`crate::correction`]), when the material
     /// asks for it: the profile is scaled by √(c(x_i) c(x_o)).
-    pub correction: Option<super::correction_factors::ShapeCorrection>,
+    pub correction: Option<crate::correction::factors::ShapeCorrection>,
     /// The rough boundary, when the material has one (module docs).
     rough: Option<RoughBoundary>,
 }
@@ -319,7 +319,7 @@ impl BssrdfObject {
     }
 
     /// The shape correction's factor f(hit, ω) for the unit direction `w` outside the medium
-    /// about the normal `n` (`super::shape_correction`; S is scaled by f(x_i, ω_i)·f(x_o, ω_o)),
+    /// about the normal `n` (`crate::correction`; S is scaled by f(x_i, ω_i)·f(x_o, ω_o)),
     /// or `None` when the material has no correction.
     #[inline]
     pub fn correction_along(&self, hit: &Hit, w: DVec3, n: DVec3) -> Option<Rgb> {

@@ -3,8 +3,7 @@
 //! medium ([`walk`]) also serves the light tracer of the beam experiment. [`light_trace`] is
 //! the BSSRDF renderer's adjoint (light paths splatted to the camera), for reciprocity checks.
 
-mod bssrdf;
-mod correction_factors;
+pub(crate) mod bssrdf;
 pub mod counters;
 pub mod light_trace;
 pub mod lighting;
@@ -14,7 +13,6 @@ pub mod plan;
 pub mod preparation;
 pub mod probe_gathering;
 pub mod profile_eval;
-mod shape_correction;
 pub mod walk;
 pub mod warnings;
 

@@ -40,10 +40,10 @@ use glam::DVec3;
 use het_estimate::{CoefficientField, Estimator};
 
 use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
+use crate::correction::factors::ShapeCorrection;
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
 use crate::integrator::bssrdf::{BssrdfObject, PairEnd, PairWeight, facing_normal};
-use crate::integrator::correction_factors::ShapeCorrection;
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;

@@ -134,7 +134,7 @@ pub struct Translucent {
     /// scene key `thickness_aware = false` turns it off (the half-space profile everywhere).
     pub thickness_aware: bool,
     /// Whether a BSSRDF render scales the profile by the shape correction measured by random
-    /// walks in the object when the render is prepared (`integrator/shape_correction.rs`,
+    /// walks in the object when the render is prepared (`correction/mod.rs`,
     /// docs/shapes.md): small and curved bodies answer uniform light as the volume does. Its
     /// preparation costs seconds (more with higher albedo and larger objects). Scene key
     /// `shape_correction`; `None` (no key) leaves the choice to the render

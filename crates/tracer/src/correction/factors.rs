@@ -1,8 +1,8 @@
 //! The shape correction's factors as the render reads them: f(x, ω) per channel at direction
 //! nodes ([`Directional`]) on sample points of an object's surface, and their lookup at a hit
 //! (barycentric over the mesh's vertices, or a Gaussian-weighted neighbourhood of samples).
-//! What f is and how it is measured: [`super::shape_correction`] (docs/shapes.md, "The shape
-//! correction"). A module of its own so that the BSSRDF ([`super::bssrdf`]), which reads the
+//! What f is and how it is measured: the parent module, [`super`] (docs/shapes.md, "The shape
+//! correction"). A module of its own so that the BSSRDF (`integrator::bssrdf`), which reads the
 //! factors, and the measurement, which evaluates the BSSRDF, do not import each other.
 
 use std::f64::consts::TAU;
@@ -32,7 +32,7 @@ impl Directional {
     /// No correction.
     pub const ONE: Directional = Directional([Rgb::ONE; DIRECTIONS]);
 
-    /// ⟨f⟩ over uniform incident light, per channel ([`incident_weights`]).
+    /// ⟨f⟩ over uniform incident light, per channel ([`super::incident_weights`]).
     #[inline]
     pub fn incident_mean(&self, weights: &[f64; DIRECTIONS]) -> Rgb {
         let mut m = Rgb::ZERO;
