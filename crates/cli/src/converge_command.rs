@@ -11,8 +11,8 @@ use bssrdf_core::ProfileModel;
 use experiments::beam::{PhotonBudget, write_beam_map};
 use experiments::converge::{MethodSummary, check_dir, summarize_with_reference, write_outputs};
 use experiments::study::{
-    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
-    reference_key, scene_reference, scene_study,
+    BeamBudgets, BeamReference, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir,
+    reference_file, reference_key, scene_reference, scene_study,
 };
 use pipeline::files::write_render;
 use pipeline::job::RenderJob;
@@ -424,8 +424,10 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         profile,
         &budgets,
         args.seed,
-        &reference,
-        args.min_radius,
+        BeamReference {
+            values: &reference,
+            min_radius: args.min_radius,
+        },
         |run, map| {
             bar.inc(1);
             bar.suspend(|| log.record(run));

@@ -19,7 +19,9 @@ use crate::error::WriteError;
 use crate::ledger::{Ledger, LedgerError};
 use crate::metrics::{ErrorRow, compare, compare_films};
 use crate::scenes::CHECKER_SLAB;
-use crate::study::{BeamBudgets, REFERENCE_SEED_OFFSET, StudyError, beam_study, scene_study};
+use crate::study::{
+    BeamBudgets, BeamReference, REFERENCE_SEED_OFFSET, StudyError, beam_study, scene_study,
+};
 use pipeline::files::write_render;
 use pipeline::job::{RenderJob, render_scene};
 use tracer::integrator::Method;
@@ -552,8 +554,10 @@ impl Reproduction<'_> {
                     ProfileModel::Dipole,
                     &budgets,
                     seed,
-                    &pt_values,
-                    1.0,
+                    BeamReference {
+                        values: &pt_values,
+                        min_radius: 1.0,
+                    },
                     |_, _| {},
                 )?;
                 let beam_summary = summarize(&beam_runs);
