@@ -11,8 +11,8 @@ use bssrdf_core::ProfileModel;
 use experiments::beam::{PhotonBudget, write_beam_map};
 use experiments::converge::{MethodSummary, check_dir, summarize_with_reference, write_outputs};
 use experiments::study::{
-    BeamBudgets, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir, reference_file,
-    reference_key, scene_reference, scene_study,
+    BeamBudgets, BeamReference, REFERENCE_SEED_OFFSET, beam_study, default_cache_dir,
+    reference_file, reference_key, scene_reference, scene_study,
 };
 use pipeline::files::write_render;
 use pipeline::job::RenderJob;
@@ -236,23 +236,7 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
     prepare_out(out)?;
     let reference = match given {
         Some(film) => film,
-        None => {
-            let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
-            let key = reference_key(&scene, &base, spp)
-                .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
-            let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
-            if !cache.is_file() {
-                say!(
-                    "rendering the path-traced reference at {spp} spp into {}",
-                    cache.display()
-                );
-            }
-            let mut job = base.clone();
-            job.progress = true;
-            let (film, _) = scene_reference(&scene, &job, spp, &cache)
-                .with_context(|| format!("cannot make the reference `{}`", cache.display()))?;
-            film
-        }
+        None => cached_scene_reference(args, &scene, &base, out)?,
     };
     let spp: Vec<u32> = doubling(1, args.max_spp)
         .into_iter()
@@ -302,20 +286,76 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
                 .collect::<serde_json::Map<_, _>>(),
         }),
     )?;
-    for (name, outcome) in &finals {
+    let job = RenderJob {
+        seed: args.seed,
+        ..base
+    };
+    write_final_renders(&finals, &methods, &scene, &job, out)?;
+    print_summary(&summary);
+    note_prepare_times(&finals);
+    say!(
+        "wrote {}/convergence.csv, convergence.png, summary.json",
+        out.display()
+    );
+    Ok(())
+}
+
+/// The path-traced reference of `scene` at `--reference-spp`: read from the reference cache,
+/// else rendered into it (with a progress bar).
+fn cached_scene_reference(
+    args: &Args,
+    scene: &Scene,
+    base: &RenderJob,
+    out: &Path,
+) -> anyhow::Result<tracer::film::Film> {
+    let file = args
+        .scene
+        .as_ref()
+        .expect("clap requires a scene without --beam");
+    let spp = u32::try_from(args.reference_spp).context("--reference-spp is too large")?;
+    let key = reference_key(scene, base, spp)
+        .with_context(|| format!("cannot read the inputs of `{}`", file.display()))?;
+    let cache = reference_file(&cache_dir(args.cache_dir.as_deref(), out), key);
+    if !cache.is_file() {
+        say!(
+            "rendering the path-traced reference at {spp} spp into {}",
+            cache.display()
+        );
+    }
+    let mut job = base.clone();
+    job.progress = true;
+    let (film, _) = scene_reference(scene, &job, spp, &cache)
+        .with_context(|| format!("cannot make the reference `{}`", cache.display()))?;
+    Ok(film)
+}
+
+/// Writes the largest run of every method as `<out>/<method>.exr` (with its PNG and sidecar),
+/// rendered with `job`'s settings and that method.
+fn write_final_renders(
+    finals: &[(String, pipeline::job::RenderOutcome)],
+    methods: &[Method],
+    scene: &Scene,
+    job: &RenderJob,
+    out: &Path,
+) -> anyhow::Result<()> {
+    for (name, outcome) in finals {
         let method = *methods
             .iter()
             .find(|m| m.name() == name)
             .expect("every run comes from one of the methods");
         let job = RenderJob {
             method,
-            seed: args.seed,
-            ..base.clone()
+            ..job.clone()
         };
-        write_render(outcome, &scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
+        write_render(outcome, scene, &job, &out.join(format!("{name}.exr")), 0.0)?;
     }
-    print_summary(&summary);
-    for (name, outcome) in &finals {
+    Ok(())
+}
+
+/// A note for each method whose preparation took long enough to matter (it is not in its
+/// runs' times).
+fn note_prepare_times(finals: &[(String, pipeline::job::RenderOutcome)]) {
+    for (name, outcome) in finals {
         if outcome.prepare_seconds >= 0.5 {
             say!(
                 "note: preparing `{name}` took {:.1} s, once, not counted in its times above",
@@ -323,11 +363,6 @@ fn run_scene(args: &Args, given: &Given, out: &Path) -> anyhow::Result<()> {
             );
         }
     }
-    say!(
-        "wrote {}/convergence.csv, convergence.png, summary.json",
-        out.display()
-    );
-    Ok(())
 }
 
 /// `convergence.csv` rewritten (atomically) after every finished run, so that a study stopped
@@ -365,32 +400,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
     prepare_out(out)?;
     let reference: Vec<f64> = match given {
         Some(film) => film.pixels.iter().map(|p| p[0]).collect(),
-        None => {
-            let path = out.join(format!(
-                "reference-pt-{}photons.exr",
-                args.reference_photons
-            ));
-            if path.is_file() {
-                read_exr(&path)?.pixels.iter().map(|p| p[0]).collect()
-            } else {
-                let map = run_method(
-                    &setup,
-                    Method::PathTraced,
-                    profile,
-                    PhotonBudget::Count(args.reference_photons),
-                    1,
-                    args.seed.wrapping_add(REFERENCE_SEED_OFFSET),
-                    true,
-                )?;
-                write_beam_map(
-                    &map,
-                    &setup,
-                    &path,
-                    serde_json::json!({"seed": args.seed.wrapping_add(REFERENCE_SEED_OFFSET)}),
-                )?;
-                map.values
-            }
-        }
+        None => beam_reference(args, &setup, profile, out)?,
     };
     let budgets = BeamBudgets {
         photons: doubling(1 << 16, args.max_photons.max(1 << 16)),
@@ -399,17 +409,7 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
             .map(|k| k as u32)
             .collect(),
     };
-    let runs_total: usize = args
-        .methods
-        .iter()
-        .map(|m| {
-            if *m == Method::PathTraced {
-                budgets.photons.len()
-            } else {
-                budgets.subsamples.len()
-            }
-        })
-        .sum();
+    let runs_total = beam_runs_total(&args.methods, &budgets);
     let bar = pipeline::progress::bar(runs_total as u64, "converge", "runs");
     let mut finals = Vec::new();
     let mut log = RunLog::new(out);
@@ -424,8 +424,10 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         profile,
         &budgets,
         args.seed,
-        &reference,
-        args.min_radius,
+        BeamReference {
+            values: &reference,
+            min_radius: args.min_radius,
+        },
         |run, map| {
             bar.inc(1);
             bar.suspend(|| log.record(run));
@@ -458,4 +460,52 @@ fn run_beam(args: &Args, out: &Path) -> anyhow::Result<()> {
         out.display()
     );
     Ok(())
+}
+
+/// The beam's path-traced reference (red channel) with `--reference-photons`: read from
+/// `<out>/reference-pt-<N>photons.exr`, else traced and written there.
+fn beam_reference(
+    args: &Args,
+    setup: &experiments::beam::BeamSetup,
+    profile: ProfileModel,
+    out: &Path,
+) -> anyhow::Result<Vec<f64>> {
+    let path = out.join(format!(
+        "reference-pt-{}photons.exr",
+        args.reference_photons
+    ));
+    if path.is_file() {
+        return Ok(read_exr(&path)?.pixels.iter().map(|p| p[0]).collect());
+    }
+    let map = run_method(
+        setup,
+        Method::PathTraced,
+        profile,
+        PhotonBudget::Count(args.reference_photons),
+        1,
+        args.seed.wrapping_add(REFERENCE_SEED_OFFSET),
+        true,
+    )?;
+    write_beam_map(
+        &map,
+        setup,
+        &path,
+        serde_json::json!({"seed": args.seed.wrapping_add(REFERENCE_SEED_OFFSET)}),
+    )?;
+    Ok(map.values)
+}
+
+/// How many runs the beam study makes: one per photon budget for the path tracer, one per
+/// subsample count for each BSSRDF method.
+fn beam_runs_total(methods: &[Method], budgets: &BeamBudgets) -> usize {
+    methods
+        .iter()
+        .map(|m| {
+            if *m == Method::PathTraced {
+                budgets.photons.len()
+            } else {
+                budgets.subsamples.len()
+            }
+        })
+        .sum()
 }

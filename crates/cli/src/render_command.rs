@@ -112,88 +112,14 @@ pub struct Args {
 
 /// Runs the subcommand.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = Scene::load_with(
-        &args.scene,
-        tracer::scene::LoadOptions::default().with_allow_outside_assets(args.allow_outside_assets),
-    )?;
-    let scene = match args.invert {
-        Some(at) => scene.with_invert(at),
-        None => scene,
-    };
-    let method = match args.method {
-        Some(m) => m,
-        None => Method::auto(
-            scene
-                .settings()
-                .estimator
-                .unwrap_or(Estimator::Sone(SoneParams::new())),
-        ),
-    };
-    if args.shape_correction.is_some() && method == Method::PathTraced {
-        bail!("--shape-correction does not apply to `pt`: it corrects BSSRDF objects");
-    }
-    let method = match args.shape_correction {
-        Some(c) => method.with_correction(c),
-        None => method,
-    };
-    args.estimator.check(&[method])?;
-    let method = args.estimator.apply(method, scene.settings().averaging);
-    let mut job = RenderJob::from_scene(&scene, method);
-    if let Some(spp) = args.spp {
-        job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);
-    }
-    if let Some(t) = args.time {
-        job.budget = Budget::Time(t);
-    }
-    if let Some(seed) = args.seed {
-        job.seed = seed;
-    }
-    if let Some(s) = args.scattering {
-        job.scattering = s;
-    }
-    if let Some(d) = args.max_depth {
-        job.max_depth = u32::try_from(d).context("--max-depth is too large")?;
-    }
-    job.progress = true;
-    if let Some(shard) = args.tile {
-        job.shard = Some(
-            pipeline::sharding::ShardJob::new(shard, &scene)
-                .with_context(|| format!("cannot hash the scene `{}`", args.scene.display()))?,
-        );
-    }
-    let stem = args
-        .scene
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tile = args
-        .tile
-        .map(|t| format!("-tile-{}-of-{}", t.index(), t.count()))
-        .unwrap_or_default();
-    let out = args
-        .out
-        .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}{tile}.exr", method.name())));
+    let scene = load_scene(&args)?;
+    let method = choose_method(&args, &scene)?;
+    let job = build_job(&args, &scene, method)?;
+    let out = output_path(&args, method);
     let mut inputs: Vec<&std::path::Path> = vec![args.scene.as_path()];
     inputs.extend(scene.input_files().iter().map(PathBuf::as_path));
     let _lock = claim_outputs(&out, &inputs)?;
-    // A finished render already at `out` is replaced only by another finished one: the images
-    // of this run's passes so far (checkpoints, an interrupted render) go beside it.
-    let partial_out = holds_finished_render(&out).then(|| partial_path(&out));
-    if let Some(p) = &partial_out {
-        check_writable(p)?;
-        let (png, json) = sidecar_paths(p);
-        for path in [p.as_path(), &png, &json] {
-            tracer::output::remove_stale_temporaries(path);
-        }
-        if args.checkpoint.is_some() {
-            say!(
-                "note: `{}` holds a finished render, kept until this one finishes; checkpoints go \
-                 to `{}`",
-                out.display(),
-                p.display()
-            );
-        }
-    }
+    let partial_out = prepare_partial_out(&out, args.checkpoint.is_some())?;
     let partial_to = partial_out.as_deref().unwrap_or(&out);
     let wrote_partial = std::sync::atomic::AtomicBool::new(false);
     let (width, height) = scene.camera().resolution();
@@ -237,25 +163,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     observer.finish();
     let outcome = outcome.with_context(|| format!("cannot render `{}`", args.scene.display()))?;
     if outcome.interrupted {
-        let signal = signals::received().map_or("interrupt", signals::name);
-        if outcome.spp == 0 {
-            bail!("{signal} before the first pass completed; nothing written");
-        }
-        write_render(&outcome, &scene, &job, partial_to, args.exposure)?;
-        let (png, json) = sidecar_paths(partial_to);
-        let kept = match &partial_out {
-            Some(_) => format!(
-                "; the finished render at `{}` was kept, not replaced",
-                out.display()
-            ),
-            None => String::new(),
-        };
-        bail!(
-            "{signal}: wrote the {} spp completed ({}, {}, {}; the sidecar says \"interrupted\": true){kept}",
-            outcome.spp,
-            partial_to.display(),
-            png.display(),
-            json.display()
+        return write_interrupted(
+            &outcome,
+            &scene,
+            &job,
+            &out,
+            partial_out.as_deref(),
+            args.exposure,
         );
     }
     write_render(&outcome, &scene, &job, &out, args.exposure)?;
@@ -268,7 +182,155 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let _ = std::fs::remove_file(path);
         }
     }
-    let (png, json) = sidecar_paths(&out);
+    report_finished(&outcome, &job, &out, args.verbose);
+    Ok(())
+}
+
+/// The scene of `args`, loaded (with glTF assets outside their folder if allowed) and with
+/// `--invert` applied.
+fn load_scene(args: &Args) -> anyhow::Result<Scene> {
+    let scene = Scene::load_with(
+        &args.scene,
+        tracer::scene::LoadOptions::default().with_allow_outside_assets(args.allow_outside_assets),
+    )?;
+    Ok(match args.invert {
+        Some(at) => scene.with_invert(at),
+        None => scene,
+    })
+}
+
+/// The method to render with: `--method` (else `auto` with the scene's estimator, else
+/// `sone`), with `--shape-correction` and the estimator flags applied.
+fn choose_method(args: &Args, scene: &Scene) -> anyhow::Result<Method> {
+    let method = match args.method {
+        Some(m) => m,
+        None => Method::auto(
+            scene
+                .settings()
+                .estimator
+                .unwrap_or(Estimator::Sone(SoneParams::new())),
+        ),
+    };
+    if args.shape_correction.is_some() && method == Method::PathTraced {
+        bail!("--shape-correction does not apply to `pt`: it corrects BSSRDF objects");
+    }
+    let method = match args.shape_correction {
+        Some(c) => method.with_correction(c),
+        None => method,
+    };
+    args.estimator.check(&[method])?;
+    Ok(args.estimator.apply(method, scene.settings().averaging))
+}
+
+/// The scene's render job with `method`, overridden by the command line's budget, seed,
+/// scattering, depth and shard.
+fn build_job(args: &Args, scene: &Scene, method: Method) -> anyhow::Result<RenderJob> {
+    let mut job = RenderJob::from_scene(scene, method);
+    if let Some(spp) = args.spp {
+        job.budget = Budget::Samples(u32::try_from(spp).context("--spp is too large")?);
+    }
+    if let Some(t) = args.time {
+        job.budget = Budget::Time(t);
+    }
+    if let Some(seed) = args.seed {
+        job.seed = seed;
+    }
+    if let Some(s) = args.scattering {
+        job.scattering = s;
+    }
+    if let Some(d) = args.max_depth {
+        job.max_depth = u32::try_from(d).context("--max-depth is too large")?;
+    }
+    job.progress = true;
+    if let Some(shard) = args.tile {
+        job.shard = Some(
+            pipeline::sharding::ShardJob::new(shard, scene)
+                .with_context(|| format!("cannot hash the scene `{}`", args.scene.display()))?,
+        );
+    }
+    Ok(job)
+}
+
+/// The output EXR: `--out`, else `<scene>-<method>[-tile-I-of-N].exr` in the current
+/// directory.
+fn output_path(args: &Args, method: Method) -> PathBuf {
+    let stem = args
+        .scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tile = args
+        .tile
+        .map(|t| format!("-tile-{}-of-{}", t.index(), t.count()))
+        .unwrap_or_default();
+    args.out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}-{}{tile}.exr", method.name())))
+}
+
+/// Where this run's partial images (checkpoints, an interrupted render) go when `out` already
+/// holds a finished render, which is replaced only by another finished one: that path, checked
+/// writable and cleared of stale temporaries; `None` when they go to `out` itself.
+fn prepare_partial_out(
+    out: &std::path::Path,
+    checkpoints: bool,
+) -> anyhow::Result<Option<PathBuf>> {
+    let partial_out = holds_finished_render(out).then(|| partial_path(out));
+    if let Some(p) = &partial_out {
+        check_writable(p)?;
+        let (png, json) = sidecar_paths(p);
+        for path in [p.as_path(), &png, &json] {
+            tracer::output::remove_stale_temporaries(path);
+        }
+        if checkpoints {
+            say!(
+                "note: `{}` holds a finished render, kept until this one finishes; checkpoints go \
+                 to `{}`",
+                out.display(),
+                p.display()
+            );
+        }
+    }
+    Ok(partial_out)
+}
+
+/// Writes an interrupted render's completed passes (to `partial_out` if set, else `out`), then
+/// fails with the error that says what was written, or that nothing was.
+fn write_interrupted(
+    outcome: &RenderOutcome,
+    scene: &Scene,
+    job: &RenderJob,
+    out: &std::path::Path,
+    partial_out: Option<&std::path::Path>,
+    exposure: f64,
+) -> anyhow::Result<()> {
+    let signal = signals::received().map_or("interrupt", signals::name);
+    if outcome.spp == 0 {
+        bail!("{signal} before the first pass completed; nothing written");
+    }
+    let partial_to = partial_out.unwrap_or(out);
+    write_render(outcome, scene, job, partial_to, exposure)?;
+    let (png, json) = sidecar_paths(partial_to);
+    let kept = match partial_out {
+        Some(_) => format!(
+            "; the finished render at `{}` was kept, not replaced",
+            out.display()
+        ),
+        None => String::new(),
+    };
+    bail!(
+        "{signal}: wrote the {} spp completed ({}, {}, {}; the sidecar says \"interrupted\": true){kept}",
+        outcome.spp,
+        partial_to.display(),
+        png.display(),
+        json.display()
+    )
+}
+
+/// Prints a finished render's summary: time and speed, the files written, the mean pixel value
+/// (over a shard's rows only), its notes, warnings and path counters.
+fn report_finished(outcome: &RenderOutcome, job: &RenderJob, out: &std::path::Path, verbose: bool) {
+    let (png, json) = sidecar_paths(out);
     say!(
         "{}: {} spp in {:.2} s ({:.2} Mrays/s); wrote {}, {}, {}",
         outcome.method,
@@ -306,9 +368,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for n in &outcome.notes {
         say!("note: {n}");
     }
-    print_warnings(&outcome.warnings, &json, args.verbose);
-    warn_counters(&outcome.counters, args.verbose);
-    Ok(())
+    print_warnings(&outcome.warnings, &json, verbose);
+    warn_counters(&outcome.counters, verbose);
 }
 
 /// Each warning as one line, or (`verbose`) as its full text; without `verbose`, one line

@@ -325,9 +325,7 @@ pub fn trace_photons(
     let n = setup.resolution as usize;
     let (e, delta) = (setup.extent, setup.pixel_size());
     let start = Instant::now();
-    let mut counts = vec![0u64; n * n];
-    let mut exits = ExitCounts::default();
-    let mut counters = PathCounters::default();
+    let mut tally = PhotonTally::new(n);
     let mut batches_done = 0u64;
     let (total, limit) = match budget {
         PhotonBudget::Count(p) => (Some(p.div_ceil(BATCH).max(1)), None),
@@ -381,14 +379,7 @@ pub fn trace_photons(
             })
             .collect();
         for (local, ex, c) in &results {
-            for (a, b) in counts.iter_mut().zip(local) {
-                *a += *b as u64;
-            }
-            exits.photons += ex.photons;
-            exits.single += ex.single;
-            exits.multiple += ex.multiple;
-            exits.unscattered += ex.unscattered;
-            counters.merge(c);
+            tally.add(local, ex, c);
         }
         batches_done += next;
         if tracer::interrupt::requested() {
@@ -403,20 +394,63 @@ pub fn trace_photons(
             limit,
         );
     }
-    let photons = exits.photons as f64;
-    let norm = 1.0 / (photons * delta * delta);
-    Ok(BeamMap {
-        resolution: setup.resolution,
-        extent: setup.extent,
-        values: counts.iter().map(|&c| c as f64 * norm).collect(),
-        std_error: Some(counts.iter().map(|&c| (c as f64).sqrt() * norm).collect()),
-        method: "pt".into(),
-        profile: None,
-        seconds: start.elapsed().as_secs_f64(),
-        samples: exits.photons,
-        exits: Some(exits),
-        counters,
-    })
+    Ok(tally.into_map(setup, start.elapsed().as_secs_f64()))
+}
+
+/// The light tracer's results so far: photon exits counted per pixel (row by row) and by
+/// scattering order, and the path counters.
+struct PhotonTally {
+    counts: Vec<u64>,
+    exits: ExitCounts,
+    counters: PathCounters,
+}
+
+impl PhotonTally {
+    /// Nothing counted yet, for an `n` × `n` map.
+    fn new(n: usize) -> Self {
+        Self {
+            counts: vec![0u64; n * n],
+            exits: ExitCounts::default(),
+            counters: PathCounters::default(),
+        }
+    }
+
+    /// Adds one batch's counts: per pixel (`local`), by order (`ex`), and its counters.
+    fn add(&mut self, local: &[u32], ex: &ExitCounts, c: &PathCounters) {
+        for (a, b) in self.counts.iter_mut().zip(local) {
+            *a += *b as u64;
+        }
+        self.exits.photons += ex.photons;
+        self.exits.single += ex.single;
+        self.exits.multiple += ex.multiple;
+        self.exits.unscattered += ex.unscattered;
+        self.counters.merge(c);
+    }
+
+    /// The map of `setup`: the counts per unit area per photon, with their standard errors,
+    /// traced in `seconds`.
+    fn into_map(self, setup: &BeamSetup, seconds: f64) -> BeamMap {
+        let delta = setup.pixel_size();
+        let photons = self.exits.photons as f64;
+        let norm = 1.0 / (photons * delta * delta);
+        BeamMap {
+            resolution: setup.resolution,
+            extent: setup.extent,
+            values: self.counts.iter().map(|&c| c as f64 * norm).collect(),
+            std_error: Some(
+                self.counts
+                    .iter()
+                    .map(|&c| (c as f64).sqrt() * norm)
+                    .collect(),
+            ),
+            method: "pt".into(),
+            profile: None,
+            seconds,
+            samples: self.exits.photons,
+            exits: Some(self.exits),
+            counters: self.counters,
+        }
+    }
 }
 
 /// The map of a BSSRDF method: `sub × sub` stratified jittered points per pixel.

@@ -163,19 +163,30 @@ pub struct BeamBudgets {
     pub subsamples: Vec<u32>,
 }
 
+/// What a beam study compares its maps with.
+#[derive(Debug, Clone, Copy)]
+pub struct BeamReference<'a> {
+    /// The reference map's values, row by row.
+    pub values: &'a [f64],
+    /// Pixels whose centre is closer than this to the beam are ignored (the singular peak).
+    pub min_radius: f64,
+}
+
 /// Runs every method of a beam study and compares each map with `reference` (pixels whose
-/// centre is closer than `min_radius` to the beam are ignored).
-#[allow(clippy::too_many_arguments)]
+/// centre is closer than its `min_radius` to the beam are ignored).
 pub fn beam_study(
     setup: &BeamSetup,
     methods: &[Method],
     profile: ProfileModel,
     budgets: &BeamBudgets,
     seed: u64,
-    reference: &[f64],
-    min_radius: f64,
+    reference: BeamReference<'_>,
     mut on_run: impl FnMut(&Run, &BeamMap),
 ) -> Result<Vec<Run>, StudyError> {
+    let BeamReference {
+        values: reference,
+        min_radius,
+    } = reference;
     let n = setup.resolution as usize;
     if reference.len() != n * n {
         let side = (reference.len() as f64).sqrt() as u32;

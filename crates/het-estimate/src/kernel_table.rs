@@ -281,17 +281,27 @@ mod tests {
     /// W̃₂ by an independent rule: adaptive Simpson in ζ on [0, 1] and on [1, ∞) mapped by
     /// ζ = 1 + u/(1 − u), straight from the closed-form Green's function.
     fn direct(rho_i: f64, rho_o: f64, kappa: f64, zb: f64) -> f64 {
-        #[allow(clippy::too_many_arguments)] // one step of the textbook recursion
-        fn simpson(
-            f: &dyn Fn(f64) -> f64,
+        /// An interval of the recursion: [a, b], f at its ends and midpoint, and its Simpson
+        /// estimate.
+        struct Panel {
             a: f64,
             b: f64,
             fa: f64,
             fm: f64,
             fb: f64,
             whole: f64,
-            depth: u32,
-        ) -> f64 {
+        }
+        /// One step of the textbook recursion: both halves of `p`, refined further unless
+        /// they agree with `p`'s estimate (or `depth` is spent).
+        fn simpson(f: &dyn Fn(f64) -> f64, p: Panel, depth: u32) -> f64 {
+            let Panel {
+                a,
+                b,
+                fa,
+                fm,
+                fb,
+                whole,
+            } = p;
             let m = 0.5 * (a + b);
             let (lm, rm) = (0.5 * (a + m), 0.5 * (m + b));
             let (flm, frm) = (f(lm), f(rm));
@@ -300,20 +310,38 @@ mod tests {
             if depth == 0 || (left + right - whole).abs() <= 1e-10 * (left + right).abs() {
                 left + right + (left + right - whole) / 15.0
             } else {
-                simpson(f, a, m, fa, flm, fm, left, depth - 1)
-                    + simpson(f, m, b, fm, frm, fb, right, depth - 1)
+                let left_half = Panel {
+                    a,
+                    b: m,
+                    fa,
+                    fm: flm,
+                    fb: fm,
+                    whole: left,
+                };
+                let right_half = Panel {
+                    a: m,
+                    b,
+                    fa: fm,
+                    fm: frm,
+                    fb,
+                    whole: right,
+                };
+                simpson(f, left_half, depth - 1) + simpson(f, right_half, depth - 1)
             }
         }
         let integrate = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
             let (fa, fm, fb) = (f(a), f(0.5 * (a + b)), f(b));
+            let whole = (b - a) / 6.0 * (fa + 4.0 * fm + fb);
             simpson(
                 f,
-                a,
-                b,
-                fa,
-                fm,
-                fb,
-                (b - a) / 6.0 * (fa + 4.0 * fm + fb),
+                Panel {
+                    a,
+                    b,
+                    fa,
+                    fm,
+                    fb,
+                    whole,
+                },
                 40,
             )
         };

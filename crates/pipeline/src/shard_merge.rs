@@ -105,6 +105,26 @@ fn shard_err(path: &Path, message: impl Into<String>) -> MergeError {
 /// Reads one shard's EXR, its header and its sidecar, and checks that they agree; returns the
 /// image apart.
 fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
+    let (json_path, sidecar) = read_sidecar(path)?;
+    let shard = finished_shard(path, &json_path, &sidecar)?;
+    let header = read_exr_metadata(path)?;
+    check_header(path, &json_path, &header, &sidecar, shard)?;
+    let film = read_exr(path)?;
+    check_pixels(path, &json_path, &sidecar, &header, &film)?;
+    Ok((
+        Part {
+            path: path.to_path_buf(),
+            sidecar,
+            header,
+            shard,
+            size: (film.width, film.height),
+        },
+        film,
+    ))
+}
+
+/// The path and parsed JSON of the sidecar beside the shard `path`.
+fn read_sidecar(path: &Path) -> Result<(PathBuf, Value), MergeError> {
     let (_, json_path) = sidecar_paths(path);
     let text = std::fs::read_to_string(&json_path).map_err(|source| OutputError::Io {
         path: json_path.clone(),
@@ -120,6 +140,12 @@ fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
             ),
         )
     })?;
+    Ok((json_path, sidecar))
+}
+
+/// The shard that the sidecar `json_path` of `path` states, checked to be one of this
+/// partition and finished (neither interrupted nor a checkpoint).
+fn finished_shard(path: &Path, json_path: &Path, sidecar: &Value) -> Result<Shard, MergeError> {
     let s = &sidecar["shard"];
     let field = |key: &str| {
         s[key]
@@ -168,9 +194,17 @@ fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
             ));
         }
     }
-    let header = read_exr_metadata(path)?;
-    check_header(path, &json_path, &header, &sidecar, shard)?;
-    let film = read_exr(path)?;
+    Ok(shard)
+}
+
+/// Checks a shard's pixels against its sidecar's size and its header's checksum.
+fn check_pixels(
+    path: &Path,
+    json_path: &Path,
+    sidecar: &Value,
+    header: &[(String, String)],
+    film: &Film,
+) -> Result<(), MergeError> {
     let size = (sidecar["width"].as_u64(), sidecar["height"].as_u64());
     if size != (Some(film.width.into()), Some(film.height.into())) {
         return Err(shard_err(
@@ -185,8 +219,8 @@ fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
             ),
         ));
     }
-    let stated = header_value(&header, "pixelChecksum").unwrap_or("none");
-    let actual = pixel_checksum(&film);
+    let stated = header_value(header, "pixelChecksum").unwrap_or("none");
+    let actual = pixel_checksum(film);
     if stated != actual {
         return Err(shard_err(
             path,
@@ -196,16 +230,7 @@ fn read_part(path: &Path) -> Result<(Part, Film), MergeError> {
             ),
         ));
     }
-    Ok((
-        Part {
-            path: path.to_path_buf(),
-            sidecar,
-            header,
-            shard,
-            size: (film.width, film.height),
-        },
-        film,
-    ))
+    Ok(())
 }
 
 /// The value of `name` in an EXR header's metadata pairs.
@@ -447,18 +472,9 @@ fn summed_counters(parts: &[Part]) -> Result<Value, MergeError> {
     Ok(Value::Object(sum))
 }
 
-/// Merges the shards `inputs` (EXR paths, each with its sidecar beside it) into `out`, with its
-/// PNG preview (exposure `exposure` stops, default the shards' `preview_exposure`) and
-/// sidecar; see the module docs. Nothing is written unless every check passes.
-pub fn merge(
-    inputs: &[PathBuf],
-    out: &Path,
-    exposure: Option<f64>,
-) -> Result<MergeSummary, MergeError> {
-    if inputs.is_empty() {
-        return Err(MergeError::Inconsistent("no shards given".into()));
-    }
-    // Each shard's rows are copied as it is read, so that one shard's image is held at a time.
+/// Reads the shards `inputs` and copies each one's rows into one image as it is read (so that
+/// one shard's image is held at a time); checks that they all have the same size.
+fn assemble(inputs: &[PathBuf]) -> Result<(Vec<Part>, Film), MergeError> {
     let mut parts: Vec<Part> = Vec::with_capacity(inputs.len());
     let mut film: Option<Film> = None;
     for path in inputs {
@@ -493,34 +509,37 @@ pub fn merge(
         }
         parts.push(part);
     }
-    let film = film.expect("at least one shard was read");
-    check_consistent(&parts, exposure.is_some())?;
-    let first = &parts[0];
-    let count = first.shard.count();
-    let mut by_index: Vec<&Part> = parts.iter().collect();
-    by_index.sort_by_key(|p| p.shard.index());
-    let spp = |p: &Part| {
-        p.sidecar["spp"]
-            .as_u64()
-            .and_then(|v| u32::try_from(v).ok())
-            .ok_or_else(|| shard_err(&p.path, "its sidecar has no valid `spp`"))
-    };
-    let spps = by_index
+    Ok((parts, film.expect("at least one shard was read")))
+}
+
+/// The samples per pixel of each shard of `by_index`, from its sidecar.
+fn shard_spps(by_index: &[&Part]) -> Result<Vec<u32>, MergeError> {
+    by_index
         .iter()
-        .map(|p| spp(p))
-        .collect::<Result<Vec<_>, _>>()?;
-    let (lo, hi) = (
-        spps.iter().copied().min().unwrap_or(0),
-        spps.iter().copied().max().unwrap_or(0),
-    );
-    let time_budget = !first.sidecar["time_budget_seconds"].is_null();
+        .map(|p| {
+            p.sidecar["spp"]
+                .as_u64()
+                .and_then(|v| u32::try_from(v).ok())
+                .ok_or_else(|| shard_err(&p.path, "its sidecar has no valid `spp`"))
+        })
+        .collect()
+}
+
+/// The merged EXR's header attributes: those of a render with `spp` samples per pixel and the
+/// `first` shard's seed, method, profile and writer's version, and, for a time-budgeted render,
+/// each shard's sample count (`per_shard_spp`).
+fn merged_attributes(
+    first: &Part,
+    spp: u32,
+    per_shard_spp: Option<&[u32]>,
+) -> Result<Vec<(&'static str, ExrAttribute)>, MergeError> {
     let seed = first.sidecar["seed"]
         .as_u64()
         .ok_or_else(|| shard_err(&first.path, "its sidecar has no valid `seed`"))?;
     let method = first.sidecar["method"]
         .as_str()
         .ok_or_else(|| shard_err(&first.path, "its sidecar has no valid `method`"))?;
-    let mut attributes = render_attributes(lo, seed, method, first.sidecar["profile"].as_str());
+    let mut attributes = render_attributes(spp, seed, method, first.sidecar["profile"].as_str());
     // The shards' writer, not this one, generated the pixels (all shards share a version).
     if let (Some(version), Some(generator)) = (
         first.sidecar["tool"]["version"].as_str(),
@@ -528,7 +547,7 @@ pub fn merge(
     ) {
         generator.1 = ExrAttribute::Text(format!("het-bssrdf {version}"));
     }
-    if time_budget {
+    if let Some(spps) = per_shard_spp {
         attributes.push((
             "samplesPerPixelPerShard",
             ExrAttribute::Text(
@@ -539,6 +558,33 @@ pub fn merge(
             ),
         ));
     }
+    Ok(attributes)
+}
+
+/// Merges the shards `inputs` (EXR paths, each with its sidecar beside it) into `out`, with its
+/// PNG preview (exposure `exposure` stops, default the shards' `preview_exposure`) and
+/// sidecar; see the module docs. Nothing is written unless every check passes.
+pub fn merge(
+    inputs: &[PathBuf],
+    out: &Path,
+    exposure: Option<f64>,
+) -> Result<MergeSummary, MergeError> {
+    if inputs.is_empty() {
+        return Err(MergeError::Inconsistent("no shards given".into()));
+    }
+    let (parts, film) = assemble(inputs)?;
+    check_consistent(&parts, exposure.is_some())?;
+    let first = &parts[0];
+    let count = first.shard.count();
+    let mut by_index: Vec<&Part> = parts.iter().collect();
+    by_index.sort_by_key(|p| p.shard.index());
+    let spps = shard_spps(&by_index)?;
+    let (lo, hi) = (
+        spps.iter().copied().min().unwrap_or(0),
+        spps.iter().copied().max().unwrap_or(0),
+    );
+    let time_budget = !first.sidecar["time_budget_seconds"].is_null();
+    let attributes = merged_attributes(first, lo, time_budget.then_some(spps.as_slice()))?;
     let secs = |p: &Part| p.sidecar["wall_seconds"].as_f64().unwrap_or(0.0);
     let wall_sum: f64 = by_index.iter().map(|p| secs(p)).sum();
     let wall_max = by_index.iter().map(|p| secs(p)).fold(0.0, f64::max);

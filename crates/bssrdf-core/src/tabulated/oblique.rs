@@ -37,8 +37,8 @@ use super::angular_file::N_MU;
 use super::grid::{N_BINS, annulus_area, centre};
 use super::half_space::{TabulatedTerm, row_position};
 use super::oblique_file::{
-    ALPHA_MAX, N_HARMONICS, N_RADII, N_ROWS, OBLIQUE_ETAS, ObliqueData, PLANE_LEN, index,
-    radial_bin, radial_edge,
+    ALPHA_MAX, N_HARMONICS, N_RADII, N_ROWS, OBLIQUE_ETAS, ObliqueData, ObliquePlane, PLANE_LEN,
+    index, radial_bin, radial_edge,
 };
 use crate::model::Scattering;
 
@@ -154,14 +154,7 @@ impl ObliqueShape {
             .collect();
         for row in 0..N_ROWS {
             let alpha = super::grid::albedo_of_row_in(row, N_ROWS).min(ALPHA_MAX);
-            // The rows above ALPHA_MAX read the shape of the row at it (paths cut earlier).
-            let data_row = if super::grid::albedo_of_row_in(row, N_ROWS) > ALPHA_MAX {
-                (0..N_ROWS)
-                    .find(|&r| super::grid::albedo_of_row_in(r, N_ROWS) <= ALPHA_MAX)
-                    .unwrap_or(row)
-            } else {
-                row
-            };
+            let data_row = data_row_of(row);
             // The normal-incidence profile's mass per fine bin (σt = 1).
             let term = TabulatedTerm::new(1.0, alpha, data.eta, single, multiple);
             let fine: Vec<f64> = (0..N_BINS)
@@ -177,21 +170,7 @@ impl ObliqueShape {
             }
             for j in 0..N_MU {
                 for k in j..N_MU {
-                    let mass = |b: usize| -> (f64, f64) {
-                        let mut v = 0.0;
-                        let mut var = 0.0;
-                        for (kind, _) in kinds.iter().enumerate().filter(|(_, on)| **on) {
-                            for (a, c) in [(j, k), (k, j)] {
-                                let i = index(kind, data_row, a, c, b);
-                                v += 0.5 * f64::from(data.p[i]);
-                                var += 0.25 * f64::from(data.p_se[i]).powi(2);
-                            }
-                        }
-                        // For j = k both terms are the same entry: its variance counted
-                        // twice at a quarter is half of it, undercounted by 2.
-                        (v, if j == k { 2.0 * var } else { var })
-                    };
-                    let masses: Vec<(f64, f64)> = (0..N_RADII).map(mass).collect();
+                    let masses = pair_masses(data, kinds, (data_row, j, k));
                     let total: f64 = masses.iter().map(|m| m.0).sum();
                     if total.is_nan() || total <= 0.0 {
                         continue;
@@ -240,28 +219,10 @@ impl ObliqueShape {
                         for b in 0..N_RADII {
                             out[at + b] = node[b].max(0.0);
                         }
-                        // The forward shift from incidence bin a: C_n = 2⟨cos nφ⟩ / ⟨sinⁿ θ⟩_a
-                        // per radial bin, from the bins whose mass is known to 10 %; a
-                        // sparser bin keeps the values of the nearest one inward.
-                        let mut value = [0.0; N_HARMONICS];
+                        let value = forward_shift(data, kinds, (data_row, a, c), &sin_mean[a]);
                         for b in 0..N_RADII {
-                            let (mut v, mut cos, mut var) = (0.0, [0.0; N_HARMONICS], 0.0);
-                            for kind in (0..2).filter(|&kind| kinds[kind]) {
-                                let i = index(kind, data_row, a, c, b);
-                                v += f64::from(data.p[i]);
-                                for (h, cos) in cos.iter_mut().enumerate() {
-                                    *cos += f64::from(data.p_cos[h * PLANE_LEN + i]);
-                                }
-                                var += f64::from(data.p_se[i]).powi(2);
-                            }
-                            if v > 0.0 && var.sqrt() <= MAX_REL_SE_SHIFT * v {
-                                for h in 0..N_HARMONICS {
-                                    value[h] =
-                                        (2.0 * cos[h] / v / sin_mean[a][h]).clamp(-C_MAX, C_MAX);
-                                }
-                            }
                             for h in 0..N_HARMONICS {
-                                shift[(at + b) * N_HARMONICS + h] = value[h];
+                                shift[(at + b) * N_HARMONICS + h] = value[b][h];
                             }
                         }
                     }
@@ -384,6 +345,75 @@ impl ObliqueShape {
         }
         out
     }
+}
+
+/// The mass of the unordered incidence/exit pair {j, k} at `data_row` (`(data_row, j, k)`)
+/// per radial bin, with its variance: the mean of (j, k) and (k, j) over the scattering
+/// orders `kinds` selects.
+fn pair_masses(
+    data: &ObliquePlane,
+    kinds: [bool; 2],
+    (data_row, j, k): (usize, usize, usize),
+) -> Vec<(f64, f64)> {
+    let mass = |b: usize| -> (f64, f64) {
+        let mut v = 0.0;
+        let mut var = 0.0;
+        for (kind, _) in kinds.iter().enumerate().filter(|(_, on)| **on) {
+            for (a, c) in [(j, k), (k, j)] {
+                let i = index(kind, data_row, a, c, b);
+                v += 0.5 * f64::from(data.p[i]);
+                var += 0.25 * f64::from(data.p_se[i]).powi(2);
+            }
+        }
+        // For j = k both terms are the same entry: its variance counted
+        // twice at a quarter is half of it, undercounted by 2.
+        (v, if j == k { 2.0 * var } else { var })
+    };
+    (0..N_RADII).map(mass).collect()
+}
+
+/// The data row whose shape albedo row `row` takes: itself, or for the rows above ALPHA_MAX
+/// the row at it (their paths were cut earlier).
+fn data_row_of(row: usize) -> usize {
+    if super::grid::albedo_of_row_in(row, N_ROWS) > ALPHA_MAX {
+        (0..N_ROWS)
+            .find(|&r| super::grid::albedo_of_row_in(r, N_ROWS) <= ALPHA_MAX)
+            .unwrap_or(row)
+    } else {
+        row
+    }
+}
+
+/// The forward shift from incidence bin a to exit bin c at `data_row` (`(data_row, a, c)`),
+/// for the scattering orders `kinds` selects: C_n = 2⟨cos nφ⟩ / ⟨sinⁿ θ⟩_a per radial bin
+/// (`sin_mean` is ⟨sinⁿ θ⟩_a), from the bins whose mass is known to 10 %; a sparser bin keeps
+/// the values of the nearest one inward.
+fn forward_shift(
+    data: &ObliquePlane,
+    kinds: [bool; 2],
+    (data_row, a, c): (usize, usize, usize),
+    sin_mean: &[f64; N_HARMONICS],
+) -> [[f64; N_HARMONICS]; N_RADII] {
+    let mut out = [[0.0; N_HARMONICS]; N_RADII];
+    let mut value = [0.0; N_HARMONICS];
+    for (b, out) in out.iter_mut().enumerate() {
+        let (mut v, mut cos, mut var) = (0.0, [0.0; N_HARMONICS], 0.0);
+        for kind in (0..2).filter(|&kind| kinds[kind]) {
+            let i = index(kind, data_row, a, c, b);
+            v += f64::from(data.p[i]);
+            for (h, cos) in cos.iter_mut().enumerate() {
+                *cos += f64::from(data.p_cos[h * PLANE_LEN + i]);
+            }
+            var += f64::from(data.p_se[i]).powi(2);
+        }
+        if v > 0.0 && var.sqrt() <= MAX_REL_SE_SHIFT * v {
+            for h in 0..N_HARMONICS {
+                value[h] = (2.0 * cos[h] / v / sin_mean[h]).clamp(-C_MAX, C_MAX);
+            }
+        }
+        *out = value;
+    }
+    out
 }
 
 /// What [`ObliqueShape::pair`] reads for one channel.

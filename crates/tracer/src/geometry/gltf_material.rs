@@ -137,30 +137,6 @@ impl GltfMaterial {
         let base_color_texture = pbr
             .base_color_texture()
             .map(|info| texture_ref(&info.texture()));
-        let mut ignored = Vec::new();
-        if let Some(t) = pbr.base_color_texture()
-            && t.tex_coord() != 0
-        {
-            ignored.push(format!(
-                "baseColorTexture.texCoord {} (texture coordinate set 0 is used)",
-                t.tex_coord()
-            ));
-        }
-        if pbr.metallic_roughness_texture().is_some() {
-            ignored.push("metallicRoughnessTexture".to_string());
-        }
-        if pbr.metallic_factor() != 0.0 {
-            ignored.push(format!("metallicFactor {}", pbr.metallic_factor()));
-        }
-        if m.normal_texture().is_some() {
-            ignored.push("normalTexture".to_string());
-        }
-        if m.occlusion_texture().is_some() {
-            ignored.push("occlusionTexture".to_string());
-        }
-        if m.emissive_texture().is_some() || m.emissive_factor() != [0.0; 3] {
-            ignored.push("emissive".to_string());
-        }
         let mut out = GltfMaterial {
             index: m.index(),
             name: m
@@ -174,102 +150,152 @@ impl GltfMaterial {
             diffuse_transmission: None,
             volume_scatter: None,
             transmission: None,
-            ignored,
+            ignored: ignored_core_fields(m),
         };
         let Some(ext) = m.extensions() else {
             return Ok(out);
         };
         for (name, v) in ext {
-            let path = |k: &str| format!("extensions.{name}.{k}");
-            match name.as_str() {
-                "KHR_materials_volume" => {
-                    let thickness = number(v, "thicknessFactor", 0.0, &path)?;
-                    if thickness < 0.0 {
-                        return Err(bad(path("thicknessFactor"), "must be ≥ 0"));
-                    }
-                    let attenuation_distance =
-                        number(v, "attenuationDistance", f64::INFINITY, &path)?;
-                    if attenuation_distance <= 0.0 {
-                        return Err(bad(path("attenuationDistance"), "must be > 0"));
-                    }
-                    let attenuation_color = colour(v, "attenuationColor", &path)?;
-                    ignore_textures(v, &["thicknessTexture"], name, &mut out.ignored);
-                    out.volume = Some(VolumeExt {
-                        thickness,
-                        attenuation_distance,
-                        attenuation_color,
-                    });
-                }
-                "KHR_materials_diffuse_transmission" => {
-                    let factor = number(v, "diffuseTransmissionFactor", 0.0, &path)?;
-                    if !(0.0..=1.0).contains(&factor) {
-                        return Err(bad(path("diffuseTransmissionFactor"), "must be in [0, 1]"));
-                    }
-                    let color = colour(v, "diffuseTransmissionColorFactor", &path)?;
-                    ignore_textures(
-                        v,
-                        &[
-                            "diffuseTransmissionTexture",
-                            "diffuseTransmissionColorTexture",
-                        ],
-                        name,
-                        &mut out.ignored,
-                    );
-                    out.diffuse_transmission = Some(DiffuseTransmissionExt { factor, color });
-                }
-                "KHR_materials_transmission" => {
-                    let factor = number(v, "transmissionFactor", 0.0, &path)?;
-                    if !(0.0..=1.0).contains(&factor) {
-                        return Err(bad(path("transmissionFactor"), "must be in [0, 1]"));
-                    }
-                    ignore_textures(v, &["transmissionTexture"], name, &mut out.ignored);
-                    out.transmission = Some(factor);
-                }
-                "KHR_materials_ior" => {
-                    let ior = number(v, "ior", GLTF_DEFAULT_IOR, &path)?;
-                    // glTF allows ior = 0 (a special value for an infinite index); the
-                    // project accepts η in [1, 3] and the loader checks that range.
-                    if ior < 1.0 {
-                        return Err(bad(path("ior"), "must be ≥ 1 (η < 1 is not supported)"));
-                    }
-                    out.ior = ior;
-                }
-                "KHR_materials_volume_scatter" | "KHR_materials_scatter" => {
-                    let newer = name == "KHR_materials_scatter";
-                    let (key, default) = if newer {
-                        ("multiscatterColorFactor", [1.0; 3])
-                    } else {
-                        ("multiscatterColor", [0.0; 3])
-                    };
-                    let mut multiscatter_color = match v.get(key) {
-                        None => default,
-                        Some(_) => colour(v, key, &path)?,
-                    };
-                    let strength = number(v, "scatterStrengthFactor", 1.0, &path)?;
-                    if !(0.0..=1.0).contains(&strength) {
-                        return Err(bad(path("scatterStrengthFactor"), "must be in [0, 1]"));
-                    }
-                    multiscatter_color = multiscatter_color.map(|c| c * strength);
-                    let anisotropy = number(v, "scatterAnisotropy", 0.0, &path)?;
-                    if anisotropy.abs() >= 1.0 {
-                        return Err(bad(path("scatterAnisotropy"), "must be in (−1, 1)"));
-                    }
-                    ignore_textures(
-                        v,
-                        &["multiscatterColorTexture", "scatterStrengthTexture"],
-                        name,
-                        &mut out.ignored,
-                    );
-                    out.volume_scatter = Some(VolumeScatterExt {
-                        multiscatter_color,
-                        anisotropy,
-                    });
-                }
-                other => out.ignored.push(other.to_string()),
-            }
+            out.read_extension(name, v)?;
         }
         Ok(out)
     }
+
+    /// Reads the material extension `name` (its object `v`) into `self`; an unknown extension
+    /// is noted as ignored.
+    fn read_extension(&mut self, name: &str, v: &Value) -> Result<(), MaterialFieldError> {
+        let path = |k: &str| format!("extensions.{name}.{k}");
+        match name {
+            "KHR_materials_volume" => {
+                let thickness = number(v, "thicknessFactor", 0.0, &path)?;
+                if thickness < 0.0 {
+                    return Err(bad(path("thicknessFactor"), "must be ≥ 0"));
+                }
+                let attenuation_distance = number(v, "attenuationDistance", f64::INFINITY, &path)?;
+                if attenuation_distance <= 0.0 {
+                    return Err(bad(path("attenuationDistance"), "must be > 0"));
+                }
+                let attenuation_color = colour(v, "attenuationColor", &path)?;
+                ignore_textures(v, &["thicknessTexture"], name, &mut self.ignored);
+                self.volume = Some(VolumeExt {
+                    thickness,
+                    attenuation_distance,
+                    attenuation_color,
+                });
+            }
+            "KHR_materials_diffuse_transmission" => {
+                let factor = number(v, "diffuseTransmissionFactor", 0.0, &path)?;
+                if !(0.0..=1.0).contains(&factor) {
+                    return Err(bad(path("diffuseTransmissionFactor"), "must be in [0, 1]"));
+                }
+                let color = colour(v, "diffuseTransmissionColorFactor", &path)?;
+                ignore_textures(
+                    v,
+                    &[
+                        "diffuseTransmissionTexture",
+                        "diffuseTransmissionColorTexture",
+                    ],
+                    name,
+                    &mut self.ignored,
+                );
+                self.diffuse_transmission = Some(DiffuseTransmissionExt { factor, color });
+            }
+            "KHR_materials_transmission" => {
+                let factor = number(v, "transmissionFactor", 0.0, &path)?;
+                if !(0.0..=1.0).contains(&factor) {
+                    return Err(bad(path("transmissionFactor"), "must be in [0, 1]"));
+                }
+                ignore_textures(v, &["transmissionTexture"], name, &mut self.ignored);
+                self.transmission = Some(factor);
+            }
+            "KHR_materials_ior" => {
+                let ior = number(v, "ior", GLTF_DEFAULT_IOR, &path)?;
+                // glTF allows ior = 0 (a special value for an infinite index); the
+                // project accepts η in [1, 3] and the loader checks that range.
+                if ior < 1.0 {
+                    return Err(bad(path("ior"), "must be ≥ 1 (η < 1 is not supported)"));
+                }
+                self.ior = ior;
+            }
+            "KHR_materials_volume_scatter" | "KHR_materials_scatter" => {
+                self.volume_scatter = Some(read_volume_scatter(name, v, &mut self.ignored)?);
+            }
+            other => self.ignored.push(other.to_string()),
+        }
+        Ok(())
+    }
+}
+
+/// Reads the scattering draft `name` (`KHR_materials_volume_scatter`, or the newer
+/// `KHR_materials_scatter` with its other key and default for the multi-scatter colour):
+/// the colour scaled by the scatter strength, and the anisotropy.
+fn read_volume_scatter(
+    name: &str,
+    v: &Value,
+    ignored: &mut Vec<String>,
+) -> Result<VolumeScatterExt, MaterialFieldError> {
+    let path = |k: &str| format!("extensions.{name}.{k}");
+    let newer = name == "KHR_materials_scatter";
+    let (key, default) = if newer {
+        ("multiscatterColorFactor", [1.0; 3])
+    } else {
+        ("multiscatterColor", [0.0; 3])
+    };
+    let mut multiscatter_color = match v.get(key) {
+        None => default,
+        Some(_) => colour(v, key, &path)?,
+    };
+    let strength = number(v, "scatterStrengthFactor", 1.0, &path)?;
+    if !(0.0..=1.0).contains(&strength) {
+        return Err(bad(path("scatterStrengthFactor"), "must be in [0, 1]"));
+    }
+    multiscatter_color = multiscatter_color.map(|c| c * strength);
+    let anisotropy = number(v, "scatterAnisotropy", 0.0, &path)?;
+    if anisotropy.abs() >= 1.0 {
+        return Err(bad(path("scatterAnisotropy"), "must be in (−1, 1)"));
+    }
+    ignore_textures(
+        v,
+        &["multiscatterColorTexture", "scatterStrengthTexture"],
+        name,
+        ignored,
+    );
+    Ok(VolumeScatterExt {
+        multiscatter_color,
+        anisotropy,
+    })
+}
+
+/// What the core material of `m` sets that the project does not read: a base colour texture
+/// on another texture coordinate set, metallic-roughness, normal and occlusion textures,
+/// emission.
+fn ignored_core_fields(m: &gltf::Material<'_>) -> Vec<String> {
+    let pbr = m.pbr_metallic_roughness();
+    let mut ignored = Vec::new();
+    if let Some(t) = pbr.base_color_texture()
+        && t.tex_coord() != 0
+    {
+        ignored.push(format!(
+            "baseColorTexture.texCoord {} (texture coordinate set 0 is used)",
+            t.tex_coord()
+        ));
+    }
+    if pbr.metallic_roughness_texture().is_some() {
+        ignored.push("metallicRoughnessTexture".to_string());
+    }
+    if pbr.metallic_factor() != 0.0 {
+        ignored.push(format!("metallicFactor {}", pbr.metallic_factor()));
+    }
+    if m.normal_texture().is_some() {
+        ignored.push("normalTexture".to_string());
+    }
+    if m.occlusion_texture().is_some() {
+        ignored.push("occlusionTexture".to_string());
+    }
+    if m.emissive_texture().is_some() || m.emissive_factor() != [0.0; 3] {
+        ignored.push("emissive".to_string());
+    }
+    ignored
 }
 
 fn bad(field: String, message: &str) -> MaterialFieldError {
@@ -425,7 +451,6 @@ impl GltfMaterial {
             .iter()
             .map(|s| format!("`{s}` is not read"))
             .collect();
-        let eta = self.ior;
         let transmits = self.transmission.is_some_and(|t| t > 0.0);
         let scatters = self.volume_scatter.is_some()
             || self.diffuse_transmission.is_some_and(|t| t.factor > 0.0);
@@ -454,25 +479,6 @@ impl GltfMaterial {
         let volume = self
             .volume
             .filter(|v| v.thickness > 0.0 && v.attenuation_distance.is_finite());
-        let base_colour = || match &self.base_color_texture {
-            Some(t) => GltfColour::Texture {
-                factor: self.base_color,
-                texture: t.clone(),
-            },
-            None => GltfColour::Constant(self.base_color),
-        };
-        let diffuse = |notes: &mut Vec<String>| {
-            if self.base_color_texture.is_some() {
-                notes.push(
-                    "baseColorTexture is not read on an opaque surface (diffuse surfaces take \
-                     a constant albedo; the base colour factor is used)"
-                        .to_string(),
-                );
-            }
-            GltfInterpretation::Diffuse {
-                albedo: self.base_color,
-            }
-        };
         let Some(v) = volume else {
             if let Some(v) = self.volume {
                 notes.push(if v.thickness <= 0.0 {
@@ -492,8 +498,41 @@ impl GltfMaterial {
                         .to_string(),
                 );
             }
-            return (diffuse(&mut notes), notes);
+            return (self.diffuse(&mut notes), notes);
         };
+        let interpretation = self.volume_interpretation(v, &mut notes);
+        (interpretation, notes)
+    }
+
+    /// The base colour: its factor, times its texture if it has one.
+    fn base_colour(&self) -> GltfColour {
+        match &self.base_color_texture {
+            Some(t) => GltfColour::Texture {
+                factor: self.base_color,
+                texture: t.clone(),
+            },
+            None => GltfColour::Constant(self.base_color),
+        }
+    }
+
+    /// An opaque diffuse surface of the base colour factor (noting an unread texture).
+    fn diffuse(&self, notes: &mut Vec<String>) -> GltfInterpretation {
+        if self.base_color_texture.is_some() {
+            notes.push(
+                "baseColorTexture is not read on an opaque surface (diffuse surfaces take \
+                 a constant albedo; the base colour factor is used)"
+                    .to_string(),
+            );
+        }
+        GltfInterpretation::Diffuse {
+            albedo: self.base_color,
+        }
+    }
+
+    /// A volume `v` (thickness > 0, finite attenuation distance): translucent with a
+    /// scattering draft or diffuse transmission, else clear and absorbing.
+    fn volume_interpretation(&self, v: VolumeExt, notes: &mut Vec<String>) -> GltfInterpretation {
+        let eta = self.ior;
         let d = v.attenuation_distance;
         // −ln(c) per channel, with white channels capped (see MAX_MEAN_FREE_PATH_IN_DISTANCES)
         // and black ones floored at the smallest positive colour.
@@ -507,7 +546,7 @@ impl GltfMaterial {
             ));
         }
         let mean_free_path = optical.map(|o| d / o);
-        let interpretation = if let Some(s) = self.volume_scatter {
+        if let Some(s) = self.volume_scatter {
             if self.base_color_texture.is_some() {
                 notes.push(
                     "baseColorTexture is not read: with a scattering extension the volume's \
@@ -530,7 +569,7 @@ impl GltfMaterial {
                 ));
             }
             GltfInterpretation::Translucent {
-                colour: base_colour(),
+                colour: self.base_colour(),
                 mean_free_path,
                 anisotropy: 0.0,
                 eta,
@@ -542,7 +581,6 @@ impl GltfMaterial {
                     .map(|c| (-(c.max(f64::MIN_POSITIVE)).ln()).max(0.0) / d),
                 eta,
             }
-        };
-        (interpretation, notes)
+        }
     }
 }
