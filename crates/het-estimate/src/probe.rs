@@ -614,9 +614,6 @@ pub struct ProbeDensity<'s> {
     /// The projection heuristic applies: the object is at least as wide as every probe
     /// sphere (module docs); the balance heuristic otherwise.
     projection: bool,
-    /// Whether the tangent probes may be traced by roulette: the projection heuristic
-    /// applies.
-    tangent_roulette: bool,
     /// The probability that this set's tangent probes were traced: [`TANGENT_PROBE_RATE`]
     /// where they went by roulette, else 1 (set by [`ProbeDensity::trace`] once the normal
     /// probe is traced; module docs, "Tangent probes by roulette").
@@ -643,7 +640,6 @@ impl<'s> ProbeDensity<'s> {
             frame: Frame::new(x_o.normal()),
             channels,
             projection,
-            tangent_roulette: projection,
             tangent_rate: Cell::new(1.0),
         }
     }
@@ -763,7 +759,8 @@ impl<'s> ProbeDensity<'s> {
         let mut normal_found = false;
         for axis in [ProbeAxis::N, ProbeAxis::S, ProbeAxis::T] {
             if axis != ProbeAxis::N {
-                let rate = if self.tangent_roulette && normal_found {
+                // Roulette only where the projection heuristic makes tangent hits light.
+                let rate = if self.projection && normal_found {
                     TANGENT_PROBE_RATE
                 } else {
                     1.0

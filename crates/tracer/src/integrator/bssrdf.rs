@@ -607,17 +607,24 @@ mod tests {
             het_estimate::Coefficients::new(Rgb([0.042, 0.082, 0.142]), Rgb([2.19, 2.62, 3.0]));
         let medium = MediumField::homogeneous(coeffs).expect("a medium");
         let material = Translucent::new("marble", medium, 0.0, 1.3);
-        let object = BssrdfObject::new(
-            &material,
-            Some(ProfileModel::Tabulated),
-            Scattering::All,
-            Estimator::JensenOut,
-            80.0,
-        )
-        .expect("a BSSRDF");
+        let make = || {
+            BssrdfObject::new(
+                &material,
+                Some(ProfileModel::Tabulated),
+                Scattering::All,
+                Estimator::JensenOut,
+                80.0,
+            )
+            .expect("a BSSRDF")
+        };
+        let object = make();
         assert!(object.thickness_aware);
         let reach = object.far_side_reach;
         assert!(reach.is_finite() && reach > 10.0 && reach < 80.0, "{reach}");
+        // The same material weighing with rays that look all the way (the weights before the
+        // reach existed).
+        let mut unbounded_object = make();
+        unbounded_object.far_side_reach = f64::INFINITY;
         for radius in [40.0, 4.0] {
             let geometry = Geometry::build(vec![primitives::icosphere(DVec3::ZERO, radius, 5)]);
             let surface = ObjectSurface::new(&geometry, 0);
@@ -632,19 +639,7 @@ mod tests {
             for theta in [0.02, 0.1, 0.4, 1.0, 2.0, 3.0] {
                 let x_i = at(theta);
                 let bounded = object.weigh(&surface, coeffs, &x_i, &x_o, &mut counters);
-                let d = 0.5
-                    * (thickness(&surface, &x_i, f64::INFINITY)
-                        + thickness(&surface, &x_o, f64::INFINITY));
-                let unbounded = match slab_pair(&x_i, &x_o, d) {
-                    Some((face, dist)) => (
-                        eval_slab_profile(&object.family, coeffs, d, face, dist, &mut counters),
-                        face == SlabFace::Reflection,
-                    ),
-                    None => {
-                        let r = (x_i.p - x_o.p).length();
-                        (eval_profile(&object.family, coeffs, r, &mut counters), true)
-                    }
-                };
+                let unbounded = unbounded_object.weigh(&surface, coeffs, &x_i, &x_o, &mut counters);
                 // Where the unbounded weight is a transmission (0 beyond the half-space
                 // thickness), the bounded one is the half-space profile at the chord, which
                 // is at least as long: below a millionth of the profile near x_o.

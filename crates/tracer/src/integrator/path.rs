@@ -236,6 +236,15 @@ enum ObjectKind<'s> {
     },
 }
 
+impl ObjectKind<'_> {
+    /// Whether a shadow ray crosses this object's boundary and goes on through its medium
+    /// (ratio-tracked, [`PathIntegrator::shadow`]): a path-traced index-matched medium. Every
+    /// other object blocks shadow rays.
+    fn passes_shadow_rays(&self) -> bool {
+        matches!(self, ObjectKind::Translucent { material, bssrdf: None, .. } if material.eta == 1.0)
+    }
+}
+
 /// A translucent object's material: the scene's, or, for a path-traced object whose medium is
 /// UV-mapped, a copy whose medium holds the object's body
 /// ([`crate::field::MediumField::with_interior`]), boxed so that the objects stay small.
@@ -416,9 +425,8 @@ pub struct PathIntegrator<'s> {
     /// Trace smooth dielectrics' mirror directions to the emitters they see
     /// ([`PathIntegrator::mirror_emission`]): the scene has a quad light.
     mirror_nee: bool,
-    /// Some object lets shadow rays through (a path-traced index-matched medium,
-    /// [`PathIntegrator::shadow`]); without one, a shadow ray from outside every medium is an
-    /// any-hit query.
+    /// Some object lets shadow rays through ([`ObjectKind::passes_shadow_rays`]); without
+    /// one, a shadow ray from outside every medium is an any-hit query.
     shadows_cross_objects: bool,
 }
 
@@ -698,9 +706,7 @@ impl<'s> PathIntegrator<'s> {
             });
         }
         let warnings = crate::integrator::warnings::scene_warnings(scene, method);
-        let shadows_cross_objects = objects.iter().any(|o| {
-            matches!(o, ObjectKind::Translucent { material, bssrdf: None, .. } if material.eta == 1.0)
-        });
+        let shadows_cross_objects = objects.iter().any(ObjectKind::passes_shadow_rays);
         Ok(Self {
             scene,
             method,
@@ -1081,15 +1087,7 @@ impl<'s> PathIntegrator<'s> {
             if Some(h.object) == seg.light_object {
                 return Transmission { tr, through_medium };
             }
-            let ObjectKind::Translucent {
-                material,
-                bssrdf: None,
-                ..
-            } = &self.objects[h.object as usize]
-            else {
-                return Transmission::BLOCKED;
-            };
-            if material.eta != 1.0 {
+            if !self.objects[h.object as usize].passes_shadow_rays() {
                 return Transmission::BLOCKED;
             }
             inside = (dir.dot(h.ng) < 0.0).then_some(h.object);
