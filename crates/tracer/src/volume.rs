@@ -88,26 +88,79 @@ pub fn sample_interaction<M: ChannelMedium + ?Sized>(
     rng: &mut Rng,
     counters: &mut TrackingCounters,
 ) -> Interaction {
+    match next_collision(medium, origin, dir, t_max, u32::MAX, rng, counters) {
+        // Absorption and scattering split the real collision by the same number: xi < σa.
+        TrackedFlight::Collision(c) if c.xi < c.sigma_a => Interaction::Absorb { t: c.t },
+        TrackedFlight::Collision(c) => Interaction::Scatter { t: c.t },
+        TrackedFlight::Pass | TrackedFlight::Stopped => Interaction::Pass,
+    }
+}
+
+/// A real collision found by delta tracking ([`next_collision`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    /// Distance along the ray.
+    pub t: f64,
+    /// σa there (1/length).
+    pub sigma_a: f64,
+    /// σs there (1/length).
+    pub sigma_s: f64,
+    /// The uniform number that made the tentative collision real, scaled by σ̄:
+    /// `xi < σa + σs`. `xi < σa` chooses absorption in an analog walk
+    /// ([`sample_interaction`]); a walk that weights by the albedo instead ignores it.
+    pub xi: f64,
+}
+
+/// How a delta-tracked flight ends ([`next_collision`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TrackedFlight {
+    /// A real collision before `t_max`.
+    Collision(Collision),
+    /// No real collision before `t_max`.
+    Pass,
+    /// The guard on tentative collisions ran out first.
+    Stopped,
+}
+
+/// Delta (Woodcock) tracking: the first real collision along `origin + t·dir`,
+/// `t ∈ (0, t_max)`, drawing tentative collisions at the majorant's rate σ̄ and making each
+/// real with probability σt/σ̄ (Woodcock et al. 1965; pbrt-v4 §14.2.2). Each tentative
+/// collision draws two numbers, an exponential flight and the uniform `xi`, in that order.
+/// At most `max_steps` tentative collisions are drawn (`u32::MAX`: no guard in practice). A
+/// medium whose majorant is not positive is crossed without collision.
+#[inline]
+pub fn next_collision<M: ChannelMedium + ?Sized>(
+    medium: &M,
+    origin: DVec3,
+    dir: DVec3,
+    t_max: f64,
+    max_steps: u32,
+    rng: &mut Rng,
+    counters: &mut TrackingCounters,
+) -> TrackedFlight {
     let majorant = medium.majorant();
     if majorant.is_nan() || majorant <= 0.0 {
-        return Interaction::Pass;
+        return TrackedFlight::Pass;
     }
     let mut t = 0.0;
-    loop {
+    for _ in 0..max_steps {
         t += unit_exponential(rng) / majorant;
         counters.delta_steps += 1;
         if t >= t_max {
-            return Interaction::Pass;
+            return TrackedFlight::Pass;
         }
         let (sigma_a, sigma_s) = medium.coefficients(origin + t * dir);
         let xi = rng.uniform() * majorant;
-        if xi < sigma_a {
-            return Interaction::Absorb { t };
-        }
         if xi < sigma_a + sigma_s {
-            return Interaction::Scatter { t };
+            return TrackedFlight::Collision(Collision {
+                t,
+                sigma_a,
+                sigma_s,
+                xi,
+            });
         }
     }
+    TrackedFlight::Stopped
 }
 
 /// A free-flight sampler the random walk ([`crate::integrator::walk`]) can use: the next real
@@ -150,7 +203,9 @@ impl<M: ChannelMedium> FreeFlight for M {
 }
 
 /// Transmittance `exp(−∫₀^{t_max} σt)` along `origin + t·dir`: exact for constant media,
-/// otherwise the ratio-tracking estimate (unbiased; see the module docs).
+/// otherwise the residual ratio-tracking estimate against the medium's control extinction,
+/// with Russian roulette below [`RR_THRESHOLD`] ([`ratio_tracking`]; unbiased, see the
+/// module docs).
 pub fn transmittance<M: ChannelMedium + ?Sized>(
     medium: &M,
     origin: DVec3,
@@ -163,12 +218,60 @@ pub fn transmittance<M: ChannelMedium + ?Sized>(
         let tau = (sigma_a + sigma_s) * t_max;
         return if tau.is_finite() { (-tau).exp() } else { 0.0 };
     }
+    let tracking = RatioTracking {
+        control: medium.control(),
+        ending: LowTransmittance::Roulette(RR_THRESHOLD),
+    };
+    ratio_tracking(medium, origin, dir, t_max, tracking, rng, counters)
+}
+
+/// How [`ratio_tracking`] treats a running estimate that has become small.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LowTransmittance {
+    /// Russian roulette once the estimate is below the threshold: it survives with
+    /// probability estimate/threshold and goes on as the threshold. Unbiased, and O(1)
+    /// expected steps beyond that point; what [`transmittance`] does.
+    Roulette(f64),
+    /// The estimate counts as 0 once it is below `floor` at a tentative collision, or after
+    /// `max_steps` tentative collisions: a relative bias of at most `floor`, and no number
+    /// drawn but the flights' (for walks whose numbers must stay in step with a twin's: the
+    /// shape correction, `crate::correction`).
+    Floor {
+        /// The smallest estimate tracked further.
+        floor: f64,
+        /// The most tentative collisions drawn.
+        max_steps: u32,
+    },
+}
+
+/// The settings of one ratio-tracked transmittance ([`ratio_tracking`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RatioTracking {
+    /// The control extinction σc (1/length), clamped to [0, σ̄]: 0 is plain ratio tracking.
+    pub control: f64,
+    /// What happens to a small estimate.
+    pub ending: LowTransmittance,
+}
+
+/// Residual ratio tracking (Novák, Selle & Jarosz 2014, §5): the unbiased transmittance
+/// estimate `exp(−σc d) · Π (1 − (σt(x_k) − σc)/(σ̄ − σc))` over tentative collisions drawn at
+/// the residual rate σ̄ − σc along `origin + t·dir`, `t ∈ (0, t_max)`, one exponential number
+/// each (plus one per roulette). A medium whose majorant is not positive transmits 1.
+pub fn ratio_tracking<M: ChannelMedium + ?Sized>(
+    medium: &M,
+    origin: DVec3,
+    dir: DVec3,
+    t_max: f64,
+    tracking: RatioTracking,
+    rng: &mut Rng,
+    counters: &mut TrackingCounters,
+) -> f64 {
     let majorant = medium.majorant();
     if majorant.is_nan() || majorant <= 0.0 {
         return 1.0;
     }
     // σc in [0, σ̄]: the control part is integrated exactly, the residual is ratio-tracked.
-    let control = medium.control().clamp(0.0, majorant);
+    let control = tracking.control.clamp(0.0, majorant);
     let residual = majorant - control;
     let mut tr = if control > 0.0 {
         (-control * t_max).exp()
@@ -178,24 +281,32 @@ pub fn transmittance<M: ChannelMedium + ?Sized>(
     if residual <= 0.0 {
         return tr;
     }
+    let (roulette, floor, max_steps) = match tracking.ending {
+        LowTransmittance::Roulette(threshold) => (threshold, 0.0, u32::MAX),
+        LowTransmittance::Floor { floor, max_steps } => (0.0, floor, max_steps),
+    };
     let mut t = 0.0;
-    loop {
-        if tr < RR_THRESHOLD {
-            // Survive with probability tr / RR_THRESHOLD and continue with weight
-            // RR_THRESHOLD: the expectation is unchanged.
-            if rng.uniform() * RR_THRESHOLD >= tr {
+    for _ in 0..max_steps {
+        if tr < roulette {
+            // Survive with probability tr / threshold and continue with weight threshold:
+            // the expectation is unchanged.
+            if rng.uniform() * roulette >= tr {
                 return 0.0;
             }
-            tr = RR_THRESHOLD;
+            tr = roulette;
         }
         t += unit_exponential(rng) / residual;
         counters.ratio_steps += 1;
         if t >= t_max {
             return tr;
         }
+        if tr < floor {
+            return 0.0;
+        }
         let (sigma_a, sigma_s) = medium.coefficients(origin + t * dir);
         tr *= (1.0 - (sigma_a + sigma_s - control).max(0.0) / residual).max(0.0);
     }
+    0.0
 }
 
 pub use het_estimate::frame::orthonormal_basis;

@@ -41,9 +41,9 @@
 //!   plane they agree step for step. The reciprocity that turns exitance under a uniform sky
 //!   into an escape probability is that of Vea97 (adjoint transport). In a heterogeneous
 //!   medium the flights are delta-tracked (Woo65 in docs/references.md) and the chance of
-//!   reaching the boundary is ratio-tracked (NSJ14) against the medium's majorant, each step
-//!   from random numbers keyed by the step's index, so that the two walks stay in step
-//!   however many null collisions each takes.
+//!   reaching the boundary is ratio-tracked (NSJ14) against the medium's majorant, by
+//!   [`crate::volume`]'s trackers, each step from random numbers keyed by the step's index,
+//!   so that the two walks stay in step however many null collisions each takes.
 //! * B by probe sets on the body and on the tangent plane with the same random numbers.
 //! * Points drawn uniformly by area on the object's mesh (the material's fixed
 //!   `correction_seed`, keyed per object and point, so renders stay deterministic whatever

@@ -7,7 +7,10 @@ use crate::field::MediumField;
 use crate::geometry::{Hit, ObjectSurface, Ray};
 use crate::integrator::walk::{reflect, refract};
 use crate::rng::Rng;
-use crate::volume::direction_about;
+use crate::volume::{
+    self, ChannelView, LowTransmittance, RatioTracking, TrackedFlight, TrackingCounters,
+    direction_about,
+};
 use bssrdf_core::Scattering;
 use glam::{DVec2, DVec3};
 use het_estimate::probe::ProbeChords;
@@ -208,12 +211,8 @@ impl Walk<'_> {
                 self.escape_homogeneous(sigma_t, albedo, boundary, entry, rng)
             }
             EscapeMedium::Field { field, channel } => {
-                let majorant = field.majorant()[channel];
-                let sigma = |p: DVec3| {
-                    let c = field.at_point(p);
-                    (c.sigma_a[channel] + c.sigma_s[channel], c.sigma_s[channel])
-                };
-                self.escape_tracked(&sigma, majorant, boundary, entry, rng.next_u64())
+                let medium = ChannelView::new(field, channel);
+                self.escape_tracked(&medium, boundary, entry, rng.next_u64())
             }
         }
     }
@@ -280,29 +279,29 @@ impl Walk<'_> {
         tally
     }
 
-    /// [`Walk::escape`] in a field `sigma(p) = (σt, σs)` bounded by `majorant`, from `entry`.
-    /// At each vertex the chance of reaching the
-    /// boundary is estimated by ratio tracking (the product of 1 − σt/σ̄ over tentative
-    /// collisions, an unbiased estimate of the transmittance) and tallied; the walk then goes
-    /// on by delta tracking: a real collision (probability σt/σ̄ at each tentative one)
-    /// scatters with weight ×σs/σt, reaching the boundary reflects with probability F and
-    /// ends otherwise (that escape was tallied already, in expectation). Step k draws its
-    /// numbers from a generator keyed by (`key`, k), so that the walks in the body and under
-    /// the plane stay in step however many tentative collisions each takes.
+    /// [`Walk::escape`] in a field `medium` (one channel), from `entry`, with the tracking of
+    /// [`crate::volume`]. At each vertex the chance of reaching the boundary is estimated by
+    /// ratio tracking ([`volume::ratio_tracking`] without a control extinction, stopping below
+    /// [`MIN_TRANSMITTANCE`]: an unbiased estimate of the transmittance to within that) and
+    /// tallied; the walk then goes on by delta tracking ([`volume::next_collision`]): a real
+    /// collision scatters with weight ×σs/σt, reaching the boundary reflects with probability
+    /// F and ends otherwise (that escape was tallied already, in expectation). Step k draws its
+    /// numbers from generators keyed by (`key`, k), so that the walks in the body and under
+    /// the plane stay in step however many tentative collisions each takes: hence the floor
+    /// rather than the path tracer's roulette, which would draw numbers of its own.
     pub(super) fn escape_tracked(
         &self,
-        sigma: &impl Fn(DVec3) -> (f64, f64),
-        majorant: f64,
+        medium: &ChannelView<'_>,
         boundary: &Boundary<'_>,
         entry: Entry<'_>,
         key: u64,
     ) -> f64 {
         let Entry { x_o, mut d, mut w } = entry;
-        let flight = |rng: &mut Rng| -(1.0 - rng.uniform()).ln() / majorant;
         let mut pos = x_o.p;
         let mut on: Option<Hit> = Some(*x_o);
         let mut order = 0u32;
         let mut tally = 0.0;
+        let mut counters = TrackingCounters::default();
         // Steps over a face met from behind do not count, so that such a step in one walk
         // does not put it out of step with the other.
         let mut step = 0u64;
@@ -322,56 +321,51 @@ impl Walk<'_> {
                     let f = bssrdf_core::fresnel::dielectric(cos, 1.0 / self.eta);
                     if self.counts(order) {
                         let mut ratio = Rng::from_keys(key, &[step, 1]);
-                        let (mut t, mut transmittance) = (0.0, 1.0);
-                        for _ in 0..MAX_TRACKING {
-                            t += flight(&mut ratio);
-                            if t >= s || transmittance < MIN_TRANSMITTANCE {
-                                break;
-                            }
-                            transmittance *= 1.0 - sigma(pos + t * d).0 / majorant;
-                        }
-                        if t >= s {
-                            tally += w * transmittance * (1.0 - f);
-                        }
+                        let tracking = RatioTracking {
+                            control: 0.0,
+                            ending: LowTransmittance::Floor {
+                                floor: MIN_TRANSMITTANCE,
+                                max_steps: MAX_TRACKING,
+                            },
+                        };
+                        let transmittance = volume::ratio_tracking(
+                            medium,
+                            pos,
+                            d,
+                            s,
+                            tracking,
+                            &mut ratio,
+                            &mut counters,
+                        );
+                        tally += w * transmittance * (1.0 - f);
                     }
                     (s, Some((p, ng, f, hit)))
                 }
             };
             step += 1;
             // Delta tracking to the next real collision, or to the boundary.
-            let mut t = 0.0;
-            let mut collision = None;
-            for _ in 0..MAX_TRACKING {
-                t += flight(&mut rng);
-                if t >= s_max {
-                    break;
-                }
-                let (sigma_t, sigma_s) = sigma(pos + t * d);
-                if rng.uniform() * majorant < sigma_t {
-                    collision = Some(sigma_s / sigma_t);
-                    break;
-                }
-            }
-            match (collision, at) {
-                (Some(albedo), _) => {
-                    pos += t * d;
+            let flight =
+                volume::next_collision(medium, pos, d, s_max, MAX_TRACKING, &mut rng, &mut counters);
+            match (flight, at) {
+                (TrackedFlight::Collision(c), _) => {
+                    pos += c.t * d;
                     on = None;
                     order += 1;
-                    w *= albedo;
+                    w *= c.sigma_s / (c.sigma_a + c.sigma_s);
                     d = self.scatter(d, rng.uniform(), rng.uniform());
                     match roulette(w, rng.uniform()) {
                         Some(survivor) => w = survivor,
                         None => return tally,
                     }
                 }
-                (None, Some((p, ng, f, hit))) if t >= s_max && rng.uniform() < f => {
+                (TrackedFlight::Pass, Some((p, ng, f, hit))) if rng.uniform() < f => {
                     d = reflect(d, -ng);
                     pos = p;
                     on = hit;
                 }
                 // Left through the boundary (tallied above), or a flight that found neither a
                 // collision nor the boundary within the guard: absorbed.
-                (None, _) => return tally,
+                _ => return tally,
             }
         }
         tally
