@@ -1,10 +1,11 @@
 //! Python bindings of het-bssrdf (module `het_bssrdf`, built with maturin as an abi3 wheel):
 //!
 //! * [`Profile`]: a radial profile family R(r) (1/length²) evaluated on numpy arrays of radii;
-//! * [`Bssrdf`]: the full separable S (`bssrdf_core::SeparableBssrdf`) on arrays of point,
-//!   normal and direction triples;
-//! * [`Field`] and [`estimate`]: the estimators (`het_estimate::Estimator`) on arrays of point
-//!   pairs over the built-in analytic plane z = 0 and its fields (constant, stripes, checks);
+//! * [`Bssrdf`]: the full separable S (`bssrdf_core::SeparableBssrdf`) on pairs of
+//!   [`Crossings`] (arrays of point, normal and direction triples);
+//! * [`Field`] and `Estimator` ([`PyEstimator`]): the estimators (`het_estimate::Estimator`) on
+//!   arrays of point pairs over the built-in analytic plane z = 0 and its fields (constant,
+//!   stripes, checks);
 //! * [`render`]: a scene file rendered by the tracer to an (height, width, 3) numpy array.
 //!
 //! Errors are Python exceptions: `ValueError` for invalid parameters (the message names the
@@ -120,6 +121,53 @@ impl Profile {
     }
 }
 
+/// N places where light crosses the boundary: `Crossings(x, n, w)`, each an (N, 3) array of
+/// points `x`, their unit normals `n` out of the medium and unit directions `w` outside,
+/// pointing away from the surface (toward the light where light enters, toward the viewer
+/// where it leaves). One end of N pairs for [`Bssrdf::eval`] (in Rust, N
+/// `bssrdf_core::Crossing`s).
+#[pyclass(frozen, module = "het_bssrdf")]
+struct Crossings {
+    rows: Vec<Crossing>,
+}
+
+#[pymethods]
+impl Crossings {
+    #[new]
+    fn new(
+        x: PyReadonlyArray2<'_, f64>,
+        n: PyReadonlyArray2<'_, f64>,
+        w: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<Self> {
+        let (x, n, w) = (
+            rows3(&x.as_array(), "x")?,
+            rows3(&n.as_array(), "n")?,
+            rows3(&w.as_array(), "w")?,
+        );
+        if n.len() != x.len() || w.len() != x.len() {
+            return Err(PyValueError::new_err(format!(
+                "x, n and w must hold the same number of rows, got {}, {} and {}",
+                x.len(),
+                n.len(),
+                w.len()
+            )));
+        }
+        let v = DVec3::from_array;
+        let rows = (0..x.len())
+            .map(|i| Crossing::new(v(x[i]), v(n[i]), v(w[i])))
+            .collect();
+        Ok(Self { rows })
+    }
+
+    fn __len__(&self) -> usize {
+        self.rows.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Crossings(<{} rows>)", self.rows.len())
+    }
+}
+
 /// The separable BSSRDF S(x_i, ω_i; x_o, ω_o) the `het-bssrdf` renderer uses:
 /// `Bssrdf(model="tabulated", scattering="all", g=0.0, eta=1.3, angular_coupling=True)`.
 ///
@@ -153,46 +201,31 @@ impl Bssrdf {
         self.bssrdf.normalisation()
     }
 
-    /// S per channel (1/(length²·sr)), an (N, 3) array, for N pairs: `x_i`, `n_i`, `w_i`
-    /// (incident point, its unit normal out of the medium, the unit direction toward the
-    /// light) and `x_o`, `n_o`, `w_o` (exitant point, normal, direction toward the viewer),
-    /// each an (N, 3) array; `sigma_a`, `sigma_s` the coefficients, (N, 3) arrays (per pair)
-    /// or sequences of 1 or 3 values (every pair).
-    #[allow(clippy::too_many_arguments)]
+    /// S per channel (1/(length²·sr)), an (N, 3) array, for the N pairs of `incident[k]`
+    /// (where light enters: its direction points toward the light) and `exitant[k]` (where it
+    /// leaves: toward the viewer), two [`Crossings`] of N rows; `sigma_a`, `sigma_s` the
+    /// coefficients, (N, 3) arrays (per pair) or sequences of 1 or 3 values (every pair).
     fn eval<'py>(
         &self,
         py: Python<'py>,
         sigma_a: &Bound<'py, PyAny>,
         sigma_s: &Bound<'py, PyAny>,
-        x_i: PyReadonlyArray2<'py, f64>,
-        n_i: PyReadonlyArray2<'py, f64>,
-        w_i: PyReadonlyArray2<'py, f64>,
-        x_o: PyReadonlyArray2<'py, f64>,
-        n_o: PyReadonlyArray2<'py, f64>,
-        w_o: PyReadonlyArray2<'py, f64>,
+        incident: &Crossings,
+        exitant: &Crossings,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let parts = [
-            rows3(&x_i.as_array(), "x_i")?,
-            rows3(&n_i.as_array(), "n_i")?,
-            rows3(&w_i.as_array(), "w_i")?,
-            rows3(&x_o.as_array(), "x_o")?,
-            rows3(&n_o.as_array(), "n_o")?,
-            rows3(&w_o.as_array(), "w_o")?,
-        ];
-        let n = parts[0].len();
-        if parts.iter().any(|p| p.len() != n) {
-            return Err(PyValueError::new_err(
-                "x_i, n_i, w_i, x_o, n_o and w_o must hold the same number of rows",
-            ));
+        let n = incident.rows.len();
+        if exitant.rows.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "incident has {n} rows and exitant {}",
+                exitant.rows.len()
+            )));
         }
         let sa = per_pair(sigma_a, n, "sigma_a")?;
         let ss = per_pair(sigma_s, n, "sigma_s")?;
-        let v = |k: usize, i: usize| DVec3::from_array(parts[k][i]);
         let mut out = Array2::<f64>::zeros((n, 3));
         for i in 0..n {
             let c = Coefficients::new(sa[i], ss[i]);
-            let incident = Crossing::new(v(0, i), v(1, i), v(2, i));
-            let exitant = Crossing::new(v(3, i), v(4, i), v(5, i));
+            let (incident, exitant) = (incident.rows[i], exitant.rows[i]);
             let s = self
                 .bssrdf
                 .eval(&c, &incident, &exitant)
@@ -225,7 +258,7 @@ fn per_pair(v: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<Rgb>> {
     Ok(vec![channels(&values, what)?; n])
 }
 
-/// The built-in fields over the plane z = 0 (the medium below it), the surface [`estimate`]
+/// The built-in fields over the plane z = 0 (the medium below it), the surface `Estimator.estimate`
 /// works on. Made by `Field.constant`, `Field.stripes` or `Field.checks`; coefficients are
 /// sequences of 1 or 3 values (1/length).
 #[pyclass(frozen, module = "het_bssrdf")]
@@ -322,66 +355,91 @@ fn estimate_pairs<F: het_estimate::CoefficientField<PlanePoint>>(
         .collect()
 }
 
-/// The homogeneous coefficients an estimator chooses for N pairs of points on the plane z = 0
-/// over `field`: `x_i` and `x_o` are (N, 2) arrays of (x, y); returns `(sigma_a, sigma_s)`,
-/// two (N, 3) arrays. `estimator` is one of `jensen-in`, `jensen-out`, `endpoints`,
-/// `segment`, `sone`, `kernel` (default parameters), for a material with mean cosine `g` and
-/// relative index `eta`. Pair k draws its random numbers from `seed + k`, so results do not
-/// depend on how the pairs are batched.
-#[pyfunction]
-#[pyo3(signature = (estimator, field, x_i, x_o, g = 0.0, eta = 1.3, seed = 0))]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
-fn estimate<'py>(
-    py: Python<'py>,
-    estimator: &str,
-    field: &Field,
-    x_i: PyReadonlyArray2<'py, f64>,
-    x_o: PyReadonlyArray2<'py, f64>,
+/// An estimator prepared for a material: `Estimator(name, g=0.0, eta=1.3)`, `name` one of
+/// `ESTIMATORS` (`jensen-in`, `jensen-out`, `endpoints`, `segment`, `sone`, `kernel`, with
+/// default parameters), for a material with mean cosine `g` and relative index `eta` (in
+/// Rust, `het_estimate::Estimator::prepare`).
+#[pyclass(frozen, name = "Estimator", module = "het_bssrdf")]
+struct PyEstimator {
+    prepared: PreparedEstimator,
     g: f64,
     eta: f64,
-    seed: u64,
-) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    let prepared = parse::<Estimator>(estimator)?
-        .prepare(g, eta)
-        .map_err(value_error)?;
-    let points = |a: &ArrayView2<'_, f64>, what: &str| -> PyResult<Vec<PlanePoint>> {
-        if a.ncols() != 2 {
+}
+
+#[pymethods]
+impl PyEstimator {
+    #[new]
+    #[pyo3(signature = (name, g = 0.0, eta = 1.3))]
+    fn new(name: &str, g: f64, eta: f64) -> PyResult<Self> {
+        let prepared = parse::<Estimator>(name)?
+            .prepare(g, eta)
+            .map_err(value_error)?;
+        Ok(Self { prepared, g, eta })
+    }
+
+    /// The homogeneous coefficients this estimator chooses for N pairs of points on the plane
+    /// z = 0 over `field`: `x_i` and `x_o` are (N, 2) arrays of (x, y); returns
+    /// `(sigma_a, sigma_s)`, two (N, 3) arrays. Pair k draws its random numbers from
+    /// `seed + k`, so results do not depend on how the pairs are batched.
+    #[pyo3(signature = (field, x_i, x_o, seed = 0))]
+    #[allow(clippy::type_complexity)]
+    fn estimate<'py>(
+        &self,
+        py: Python<'py>,
+        field: &Field,
+        x_i: PyReadonlyArray2<'py, f64>,
+        x_o: PyReadonlyArray2<'py, f64>,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+        let prepared = &self.prepared;
+        let points = |a: &ArrayView2<'_, f64>, what: &str| -> PyResult<Vec<PlanePoint>> {
+            if a.ncols() != 2 {
+                return Err(PyValueError::new_err(format!(
+                    "`{what}` must have shape (N, 2), got {:?}",
+                    a.shape()
+                )));
+            }
+            Ok(a.axis_iter(Axis(0))
+                .map(|r| PlanePoint::new(r[0], r[1]))
+                .collect())
+        };
+        let (pi, po) = (
+            points(&x_i.as_array(), "x_i")?,
+            points(&x_o.as_array(), "x_o")?,
+        );
+        if pi.len() != po.len() {
             return Err(PyValueError::new_err(format!(
-                "`{what}` must have shape (N, 2), got {:?}",
-                a.shape()
+                "x_i has {} rows and x_o {}",
+                pi.len(),
+                po.len()
             )));
         }
-        Ok(a.axis_iter(Axis(0))
-            .map(|r| PlanePoint::new(r[0], r[1]))
-            .collect())
-    };
-    let (pi, po) = (
-        points(&x_i.as_array(), "x_i")?,
-        points(&x_o.as_array(), "x_o")?,
-    );
-    if pi.len() != po.len() {
-        return Err(PyValueError::new_err(format!(
-            "x_i has {} rows and x_o {}",
-            pi.len(),
-            po.len()
-        )));
-    }
-    let pairs: Vec<_> = pi.into_iter().zip(po).collect();
-    let kind = field.kind;
-    let result = py.detach(|| match &kind {
-        FieldKind::Constant(f) => estimate_pairs(&prepared, f, &pairs, seed),
-        FieldKind::Stripes(f) => estimate_pairs(&prepared, f, &pairs, seed),
-        FieldKind::Checks(f) => estimate_pairs(&prepared, f, &pairs, seed),
-    });
-    let mut sa = Array2::<f64>::zeros((result.len(), 3));
-    let mut ss = Array2::<f64>::zeros((result.len(), 3));
-    for (k, c) in result.iter().enumerate() {
-        for ch in 0..3 {
-            sa[[k, ch]] = c.sigma_a[ch];
-            ss[[k, ch]] = c.sigma_s[ch];
+        let pairs: Vec<_> = pi.into_iter().zip(po).collect();
+        let kind = field.kind;
+        let result = py.detach(|| match &kind {
+            FieldKind::Constant(f) => estimate_pairs(prepared, f, &pairs, seed),
+            FieldKind::Stripes(f) => estimate_pairs(prepared, f, &pairs, seed),
+            FieldKind::Checks(f) => estimate_pairs(prepared, f, &pairs, seed),
+        });
+        let mut sa = Array2::<f64>::zeros((result.len(), 3));
+        let mut ss = Array2::<f64>::zeros((result.len(), 3));
+        for (k, c) in result.iter().enumerate() {
+            for ch in 0..3 {
+                sa[[k, ch]] = c.sigma_a[ch];
+                ss[[k, ch]] = c.sigma_s[ch];
+            }
         }
+        Ok((sa.into_pyarray(py), ss.into_pyarray(py)))
     }
-    Ok((sa.into_pyarray(py), ss.into_pyarray(py)))
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Estimator('{}', g={}, eta={})",
+            self.prepared.estimator(),
+            self.g,
+            self.eta
+        )
+    }
 }
 
 /// Renders the scene file `scene_path` with `method` (`pt` for the path-traced reference,
@@ -461,8 +519,9 @@ fn het_bssrdf(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add_class::<Profile>()?;
     m.add_class::<Bssrdf>()?;
+    m.add_class::<Crossings>()?;
     m.add_class::<Field>()?;
-    m.add_function(wrap_pyfunction!(estimate, m)?)?;
+    m.add_class::<PyEstimator>()?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     Ok(())
 }

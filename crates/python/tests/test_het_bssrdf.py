@@ -78,7 +78,7 @@ def test_s_is_profile_times_normalised_fresnel():
     up = np.array([[0.0, 0.0, 1.0]])
     w_i = np.array([[0.6, 0.0, 0.8]])
     w_o = np.array([[0.0, 0.28, 0.96]])
-    got = s.eval([0.01, 0.1, 0.5], [1.0, 2.0, 0.7], x_i=x_i, n_i=up, w_i=w_i, x_o=x_o, n_o=up, w_o=w_o)
+    got = s.eval([0.01, 0.1, 0.5], [1.0, 2.0, 0.7], hb.Crossings(x_i, up, w_i), hb.Crossings(x_o, up, w_o))
     assert got.shape == (1, 3)
     profile = hb.Profile("dipole", "multiple", 0.0, eta)
     for ch, (sa, ss) in enumerate([(0.01, 1.0), (0.1, 2.0), (0.5, 0.7)]):
@@ -105,13 +105,14 @@ def test_s_is_reciprocal_and_zero_behind_the_surface():
     w_i, w_o = directions(), directions()
     sigma_a = rng.uniform(0.0, 1.0, (n, 3))
     sigma_s = rng.uniform(0.1, 3.0, (n, 3))
-    a = s.eval(sigma_a, sigma_s, x_i=x_i, n_i=up, w_i=w_i, x_o=x_o, n_o=up, w_o=w_o)
-    b = s.eval(sigma_a, sigma_s, x_i=x_o, n_i=up, w_i=w_o, x_o=x_i, n_o=up, w_o=w_i)
+    incident, exitant = hb.Crossings(x_i, up, w_i), hb.Crossings(x_o, up, w_o)
+    a = s.eval(sigma_a, sigma_s, incident, exitant)
+    b = s.eval(sigma_a, sigma_s, incident=exitant, exitant=incident)
     assert np.all(np.isfinite(a)) and np.all(a > 0.0)
     assert np.array_equal(a, b)
     below = w_i.copy()
     below[:, 2] *= -1.0
-    zero = s.eval(sigma_a, sigma_s, x_i=x_i, n_i=up, w_i=below, x_o=x_o, n_o=up, w_o=w_o)
+    zero = s.eval(sigma_a, sigma_s, hb.Crossings(x_i, up, below), exitant)
     assert np.all(zero == 0.0)
 
 
@@ -124,10 +125,11 @@ def test_estimators_on_constant_and_patterned_fields():
     a, b = ([0.005], [1.0]), ([0.1], [2.0])
     checks = hb.Field.checks(1.0, a, b)
     for name in hb.ESTIMATORS:
-        sa, ss = hb.estimate(name, constant, x_i, x_o, seed=1)
+        estimator = hb.Estimator(name)
+        sa, ss = estimator.estimate(constant, x_i, x_o, seed=1)
         assert sa.shape == (n, 3) and ss.shape == (n, 3)
         assert np.all(sa == np.array([0.02, 0.05, 0.1])) and np.all(ss == 1.0), name
-        sa, ss = hb.estimate(name, checks, x_i, x_o, seed=1)
+        sa, ss = estimator.estimate(checks, x_i, x_o, seed=1)
         # Averages of the two media lie between them.
         assert np.all((sa >= 0.005 - 1e-12) & (sa <= 0.1 + 1e-12)), name
         assert np.all((ss >= 1.0 - 1e-12) & (ss <= 2.0 + 1e-12)), name
@@ -138,11 +140,12 @@ def test_estimates_are_deterministic_per_pair():
     rng = np.random.default_rng(9)
     x_i = rng.uniform(-2, 2, (10, 2))
     x_o = x_i + rng.uniform(-1, 1, (10, 2))
-    whole, _ = hb.estimate("sone", field, x_i, x_o, seed=11)
-    again, _ = hb.estimate("sone", field, x_i, x_o, seed=11)
+    sone = hb.Estimator("sone", g=0.0, eta=1.3)
+    whole, _ = sone.estimate(field, x_i, x_o, seed=11)
+    again, _ = sone.estimate(field, x_i, x_o, seed=11)
     assert np.array_equal(whole, again)
     # Pair k draws from seed + k: alone, with that seed, it gives the same numbers.
-    alone, _ = hb.estimate("sone", field, x_i[4:5], x_o[4:5], seed=15)
+    alone, _ = sone.estimate(field, x_i[4:5], x_o[4:5], seed=15)
     assert np.array_equal(alone[0], whole[4])
     # The field varies between the pairs: the estimates are not all one value.
     assert np.ptp(whole[:, 0]) > 0.0
@@ -160,9 +163,15 @@ def test_invalid_input_raises_value_error_naming_it():
     with pytest.raises(ValueError, match="sigma_s"):
         hb.Field.constant([0.1], [1e13])
     with pytest.raises(ValueError, match="shape"):
-        hb.estimate("sone", hb.Field.constant([0.1], [1.0]), np.zeros((2, 3)), np.zeros((2, 3)))
+        hb.Estimator("sone").estimate(hb.Field.constant([0.1], [1.0]), np.zeros((2, 3)), np.zeros((2, 3)))
     with pytest.raises(ValueError):
-        hb.estimate("nonsense", hb.Field.constant([0.1], [1.0]), np.zeros((1, 2)), np.zeros((1, 2)))
+        hb.Estimator("nonsense")
+    with pytest.raises(ValueError, match="eta"):
+        hb.Estimator("sone", eta=0.5)
+    with pytest.raises(ValueError, match="rows"):
+        hb.Crossings(np.zeros((2, 3)), np.zeros((1, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="rows"):
+        hb.Bssrdf().eval([0.1], [1.0], hb.Crossings(*[np.zeros((2, 3))] * 3), hb.Crossings(*[np.zeros((1, 3))] * 3))
 
 
 def test_render_checker_slab():
