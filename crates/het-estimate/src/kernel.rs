@@ -50,6 +50,7 @@ use bssrdf_core::ParamError;
 use glam::{DVec2, DVec3};
 
 use crate::budget::{MissPolicy, SampleBudget};
+use crate::chord::Chord;
 use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::kernel_table::KernelTable;
@@ -321,119 +322,169 @@ where
         return probe.endpoints();
     };
     probe.diag.region = Region::Kernel;
-    // Means live in the field's averaging space; the kernel's weights need coefficients.
+    // Step 1: start from the endpoint mean. Means live in the field's averaging space; the
+    // kernel's weights need coefficients.
     let start = known.finish(probe.endpoints());
     let start_sigma = probe.to_coefficients(start);
-    let exponent = if !probe.field.capabilities().own_averaging_space {
-        params.exponent
-    } else {
-        1.0
+    let pair = KernelPair {
+        chord,
+        d: chord.length(),
+        g,
+        table,
+        exponent: if !probe.field.capabilities().own_averaging_space {
+            params.exponent
+        } else {
+            1.0
+        },
+        wanted: std::array::from_fn(|c| !known.channel_constant(c)),
     };
-    let d = chord.length();
-    let wanted: [bool; 3] = std::array::from_fn(|c| !known.channel_constant(c));
-    let reduced = |a: f64, s: f64| a + (1.0 - g) * s;
 
     // Step 2: the points, projected and looked up once.
-    let mut longest_mfp: f64 = 0.0;
-    for c in (0..3).filter(|&c| wanted[c]) {
-        let st = reduced(start_sigma.sigma_a[c], start_sigma.sigma_s[c]);
-        if st > 0.0 {
-            longest_mfp = longest_mfp.max(1.0 / st);
-        }
-    }
-    let proposal = Proposal {
-        half: chord.half_len,
-        scale: chord.half_len.max(longest_mfp.min(100.0 * d)),
-    };
-    let n = params.sample_count() as usize;
-    let miss_endpoints = params.misses == MissPolicy::Endpoints;
-    // Points near the chord are read on the pair's local quadric (in the plane, where the
-    // pair is flat) for a field defined in space, or read through texture coordinates that
-    // are one affine map over the region; the others are projected by rays.
-    let lift_radius = if params.averaging == Averaging::Prefiltered
-        && (probe.field.capabilities().point_lookup || probe.field.capabilities().reads_uv)
-    {
-        probe.prepare_prefilter(params.flatness, &chord);
-        let radius = probe.lifting_radius(&chord.ellipse(chord.half_len));
-        if radius > 0.0 {
-            probe.diag.field_averages += 1;
-            if radius < f64::INFINITY {
-                probe.diag.lifted = true;
-            }
-        } else {
-            probe.diag.prefilter_fallback = true;
-        }
-        radius
-    } else {
-        0.0
-    };
-    let set = DiskPoints::new(rng);
+    let proposal = pair.proposal(&start_sigma);
+    let lift_radius = lifting_radius(params, probe, &chord);
     // Uninitialised storage: zeroing 72 KiB per estimate would cost more than the estimate.
     let mut store = [const { MaybeUninit::<Sample>::uninit() }; KernelParams::MAX_SAMPLES as usize];
-    let mut len = 0usize;
-    // The points a chunk at a time: read together in the plane, or projected together. Each
-    // step is a pass with no dependency from one point to the next (the processor overlaps
-    // the points' square roots): the points and their densities, the values, σa^p, then the
-    // stored samples.
-    let mut origins = [DVec3::ZERO; CHUNK];
-    let mut found = [None; CHUNK];
-    let (mut rho, mut inv_q) = ([(0.0, 0.0); CHUNK], [0.0; CHUNK]);
-    for first in (0..n).step_by(CHUNK) {
-        let m = CHUNK.min(n - first);
-        for j in 0..m {
-            let p = proposal.sample(set.unit_square((first + j) as u32));
-            origins[j] = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
-            rho[j] = proposal.distances(p);
-            inv_q[j] = proposal.inv_pdf(rho[j]);
-        }
-        probe.lift_or_project(
-            &origins[..m],
-            chord.mid,
-            lift_radius,
-            chord.normal,
-            &mut found[..m],
-        );
-        if miss_endpoints {
-            for f in &mut found[..m] {
-                f.get_or_insert_with(|| probe.endpoints());
-            }
-        }
-        // σa^p in place of σa.
-        for c in found[..m].iter_mut().flatten() {
-            c.sigma_a.0 = power(c.sigma_a.0, exponent);
-        }
-        for j in 0..m {
-            if let Some(c) = found[j] {
-                store[len].write(Sample {
-                    rho: rho[j],
-                    inv_q: inv_q[j],
-                    a_p: c.sigma_a.0,
-                    s: c.sigma_s.0,
-                });
-                len += 1;
-            }
-        }
-    }
-    probe.diag.samples += n as u32;
-    // SAFETY: the first `len` elements were initialised by `write` above (and `Sample` is
-    // `Copy`, so nothing needs dropping).
-    let samples: &[Sample] =
-        unsafe { std::slice::from_raw_parts(store.as_ptr().cast::<Sample>(), len) };
+    let samples = pair.look_up(params, &proposal, lift_radius, probe, rng, &mut store);
 
     // Steps 3–4: reweight the same points with the kernel of the current estimate.
-    let mut est = start;
-    let mut fell_back = false;
-    for iteration in 0..params.iterations {
-        // Every iteration but the last only sets the next one's kernel: a pilot prefix of the
-        // points serves it (an R2 prefix, spread over the whole proposal).
-        let used = if iteration + 1 < params.iterations {
-            &samples[..samples.len().min(PILOT_POINTS.max(n / 4))]
-        } else {
-            samples
-        };
+    pair.reweight(params, samples, start, probe, known)
+}
+
+/// What the steps of one pair's estimate share: the chord, the material's kernel, and the
+/// channels averaged with their power-mean exponent.
+struct KernelPair<'t> {
+    chord: Chord,
+    /// The chord length d.
+    d: f64,
+    /// The material's HG mean cosine.
+    g: f64,
+    /// The material's kernel table (W₂ per κ, in transport units).
+    table: &'t KernelTable,
+    /// The power-mean exponent p ([`KernelParams::exponent`]; 1 for a field with its own
+    /// averaging space, whose means are arithmetic there).
+    exponent: f64,
+    /// The channels not known constant from the field's bounds.
+    wanted: [bool; 3],
+}
+
+impl KernelPair<'_> {
+    /// The proposal around the chord ([`Proposal`]): its scale c is the larger of d/2 and the
+    /// longest transport mean free path 1/σt' of the starting estimate `start` (capped at
+    /// 100 d).
+    #[inline]
+    fn proposal(&self, start: &Coefficients) -> Proposal {
+        let reduced = |a: f64, s: f64| a + (1.0 - self.g) * s;
+        let mut longest_mfp: f64 = 0.0;
+        for c in (0..3).filter(|&c| self.wanted[c]) {
+            let st = reduced(start.sigma_a[c], start.sigma_s[c]);
+            if st > 0.0 {
+                longest_mfp = longest_mfp.max(1.0 / st);
+            }
+        }
+        Proposal {
+            half: self.chord.half_len,
+            scale: self.chord.half_len.max(longest_mfp.min(100.0 * self.d)),
+        }
+    }
+
+    /// Step 2 (module docs): N points p_k drawn from `proposal` in the averaging plane,
+    /// projected onto the surface by the two rays ±normal (paper §3.2) or read on the local
+    /// quadric within `lift_radius` of the midpoint, and looked up once; the hits are stored
+    /// in `store` with their distances from the chord's ends, 1/q, σa^p and σs, and returned.
+    #[inline]
+    fn look_up<'s, S, F, U>(
+        &self,
+        params: &KernelParams,
+        proposal: &Proposal,
+        lift_radius: f64,
+        probe: &mut Probe<'_, S, F>,
+        rng: &mut U,
+        store: &'s mut [MaybeUninit<Sample>; KernelParams::MAX_SAMPLES as usize],
+    ) -> &'s [Sample]
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+        U: UniformSource + ?Sized,
+    {
+        let chord = &self.chord;
+        let n = params.sample_count() as usize;
+        let miss_endpoints = params.misses == MissPolicy::Endpoints;
+        let set = DiskPoints::new(rng);
+        let mut len = 0usize;
+        // The points a chunk at a time: read together in the plane, or projected together.
+        let mut chunk = Chunk::new();
+        for first in (0..n).step_by(CHUNK) {
+            let m = CHUNK.min(n - first);
+            chunk.draw(chord, proposal, &set, first, m);
+            probe.lift_or_project(
+                &chunk.origins[..m],
+                chord.mid,
+                lift_radius,
+                chord.normal,
+                &mut chunk.found[..m],
+            );
+            if miss_endpoints {
+                for f in &mut chunk.found[..m] {
+                    f.get_or_insert_with(|| probe.endpoints());
+                }
+            }
+            len = chunk.store(m, self.exponent, store, len);
+        }
+        probe.diag.samples += n as u32;
+        // SAFETY: the first `len` elements were initialised by `write` above (and `Sample` is
+        // `Copy`, so nothing needs dropping).
+        unsafe { std::slice::from_raw_parts(store.as_ptr().cast::<Sample>(), len) }
+    }
+
+    /// Steps 3–4 (module docs): [`KernelParams::iterations`] weighted averages of the same
+    /// `samples`, each with the kernel W₂ of the previous estimate (the first with that of
+    /// `start`, the endpoint mean). Sets [`crate::Diagnostics::fallback`] when the last left
+    /// a channel at its previous estimate.
+    #[inline]
+    fn reweight<S, F>(
+        &self,
+        params: &KernelParams,
+        samples: &[Sample],
+        start: Coefficients,
+        probe: &mut Probe<'_, S, F>,
+        known: &Known,
+    ) -> Coefficients
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+    {
+        let n = params.sample_count() as usize;
+        let mut est = start;
+        let mut fell_back = false;
+        for iteration in 0..params.iterations {
+            // Every iteration but the last only sets the next one's kernel: a pilot prefix of
+            // the points serves it (an R2 prefix, spread over the whole proposal).
+            let used = if iteration + 1 < params.iterations {
+                &samples[..samples.len().min(PILOT_POINTS.max(n / 4))]
+            } else {
+                samples
+            };
+            let (next, fell) = self.weighted_average(used, est, probe.to_coefficients(est));
+            fell_back = fell;
+            est = known.finish(next);
+        }
+        probe.diag.fallback |= fell_back;
+        est
+    }
+
+    /// Step 3 (module docs), one iteration: per channel, the W₂/q-weighted (power) means of
+    /// `used` with the kernel of the current estimate `est` (whose coefficients are `sigma`);
+    /// a channel without a weight keeps `est` (the flag returned).
+    #[inline]
+    fn weighted_average(
+        &self,
+        used: &[Sample],
+        est: Coefficients,
+        sigma: Coefficients,
+    ) -> (Coefficients, bool) {
+        let wanted = self.wanted;
         let mut next = est;
-        let sigma = probe.to_coefficients(est);
-        fell_back = false;
+        let mut fell_back = false;
         let mut done = [false; 3];
         for c in (0..3).filter(|&c| wanted[c]) {
             if done[c] {
@@ -448,8 +499,8 @@ where
                     && sigma.sigma_s[k] == sigma.sigma_s[c]
             });
             (0..3).for_each(|k| done[k] |= group[k]);
-            let medium = (sigma.sigma_a[c], sigma.sigma_s[c], g);
-            match weighted_means(used, group, medium, d, table, exponent) {
+            let medium = (sigma.sigma_a[c], sigma.sigma_s[c], self.g);
+            match weighted_means(used, group, medium, self.d, self.table, self.exponent) {
                 Some(means) => {
                     for k in (0..3).filter(|&k| group[k]) {
                         next.sigma_a[k] = means[k].0;
@@ -459,10 +510,109 @@ where
                 None => fell_back = true,
             }
         }
-        est = known.finish(next);
+        (next, fell_back)
     }
-    probe.diag.fallback |= fell_back;
-    est
+}
+
+/// One chunk of step 2's points (at most [`CHUNK`]), handled in passes with no dependency
+/// from one point to the next (the processor overlaps the points' square roots): the points
+/// and their densities ([`Chunk::draw`]), the values (`found`, by the caller), then σa^p and
+/// the stored samples ([`Chunk::store`]).
+struct Chunk {
+    /// The points in the averaging plane (scene space).
+    origins: [DVec3; CHUNK],
+    /// The coefficients read or projected at each point (`None`: a miss).
+    found: [Option<Coefficients>; CHUNK],
+    /// Distances from the chord's ends, and 1/q.
+    rho: [(f64, f64); CHUNK],
+    inv_q: [f64; CHUNK],
+}
+
+impl Chunk {
+    #[inline]
+    fn new() -> Self {
+        Chunk {
+            origins: [DVec3::ZERO; CHUNK],
+            found: [None; CHUNK],
+            rho: [(0.0, 0.0); CHUNK],
+            inv_q: [0.0; CHUNK],
+        }
+    }
+
+    /// Points `first..first + m` of `set`, drawn from `proposal` in chord coordinates and
+    /// placed in the averaging plane of `chord`, with their distances from its ends and 1/q.
+    #[inline]
+    fn draw(
+        &mut self,
+        chord: &Chord,
+        proposal: &Proposal,
+        set: &DiskPoints,
+        first: usize,
+        m: usize,
+    ) {
+        for j in 0..m {
+            let p = proposal.sample(set.unit_square((first + j) as u32));
+            self.origins[j] = chord.mid + p.x * chord.x_hat + p.y * chord.minor_dir;
+            self.rho[j] = proposal.distances(p);
+            self.inv_q[j] = proposal.inv_pdf(self.rho[j]);
+        }
+    }
+
+    /// σa^p in place of σa for the first `m` points found, then those points stored as
+    /// samples in `store` after its first `len`; the new length.
+    #[inline]
+    fn store(
+        &mut self,
+        m: usize,
+        exponent: f64,
+        store: &mut [MaybeUninit<Sample>; KernelParams::MAX_SAMPLES as usize],
+        mut len: usize,
+    ) -> usize {
+        for c in self.found[..m].iter_mut().flatten() {
+            c.sigma_a.0 = power(c.sigma_a.0, exponent);
+        }
+        for j in 0..m {
+            if let Some(c) = self.found[j] {
+                store[len].write(Sample {
+                    rho: self.rho[j],
+                    inv_q: self.inv_q[j],
+                    a_p: c.sigma_a.0,
+                    s: c.sigma_s.0,
+                });
+                len += 1;
+            }
+        }
+        len
+    }
+}
+
+/// The radius around the chord's midpoint within which step 2 reads its points on the pair's
+/// local quadric (in the plane, where the pair is flat) instead of projecting them by rays:
+/// with [`Averaging::Prefiltered`], for a field defined in space, or read through texture
+/// coordinates that are one affine map over the region; 0 (every point projected) otherwise.
+#[inline]
+fn lifting_radius<S, F>(params: &KernelParams, probe: &mut Probe<'_, S, F>, chord: &Chord) -> f64
+where
+    S: SurfaceQuery + ?Sized,
+    F: CoefficientField<S::Point> + ?Sized,
+{
+    if params.averaging == Averaging::Prefiltered
+        && (probe.field.capabilities().point_lookup || probe.field.capabilities().reads_uv)
+    {
+        probe.prepare_prefilter(params.flatness, chord);
+        let radius = probe.lifting_radius(&chord.ellipse(chord.half_len));
+        if radius > 0.0 {
+            probe.diag.field_averages += 1;
+            if radius < f64::INFINITY {
+                probe.diag.lifted = true;
+            }
+        } else {
+            probe.diag.prefilter_fallback = true;
+        }
+        radius
+    } else {
+        0.0
+    }
 }
 
 /// `a^p` per channel, computed once per distinct value (grey fields: once). The default

@@ -48,13 +48,14 @@ use std::num::NonZeroU32;
 use bssrdf_core::Rgb;
 
 use crate::budget::{MissPolicy, SampleBudget};
+use crate::chord::Chord;
 use crate::estimator_output::Region;
 use crate::field::{CoefficientField, Coefficients};
 use crate::known::{Known, sanitise};
 use crate::path_integral::{MeanSquareAngle, SemiMinorAxis, width_unchecked};
 use crate::prefilter::{Averaging, Flatness};
 use crate::random::UniformSource;
-use crate::region_average::{Accumulator, Channels, Probe, Reading, average_chunks};
+use crate::region_average::{Accumulator, Averaged, Channels, Probe, Reading, average_chunks};
 use crate::sampling::DiskPoints;
 use crate::surface::SurfaceQuery;
 
@@ -278,103 +279,234 @@ where
     let Some(chord) = probe.chord() else {
         return probe.endpoints();
     };
-    let miss_endpoints = params.misses == MissPolicy::Endpoints;
-    let wanted: [bool; 3] = std::array::from_fn(|c| !known.channel_constant(c));
-    let wanted_rgb = Rgb(wanted.map(|w| if w { 1.0 } else { 0.0 }));
-    let mut rel_se: Option<f64> = None;
-    let mut note_se = |e: Option<f64>| {
-        if let Some(e) = e {
-            rel_se = Some(rel_se.map_or(e, |r| r.max(e)));
-        }
-    };
-
-    // Prefiltered averaging: each region in closed form, on the local quadric, or by rays,
-    // by the criterion of `params.flatness`.
-    let closed_form = probe.field.capabilities().ellipse_average;
-    let prefiltered = params.averaging == Averaging::Prefiltered
-        && (closed_form
-            || probe.field.capabilities().point_lookup
-            || probe.field.capabilities().reads_uv);
-    if prefiltered {
-        probe.prepare_prefilter(params.flatness, &chord);
-    }
-    let reading = |probe: &mut Probe<'_, S, F>, e: &crate::PlanarEllipse| {
-        if prefiltered {
-            probe.reading(e, closed_form)
-        } else {
-            Reading::Rays
-        }
-    };
-
-    // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2.
-    let disk = chord.ellipse(chord.half_len);
-    let disk_reading = reading(probe, &disk);
-    let field_disk = match disk_reading {
-        Reading::ClosedForm => probe.field_ellipse_average(&disk),
-        _ => None,
-    };
-    let disk_mean = match field_disk {
-        Some(c) => {
-            probe.diag.field_averages += 1;
-            sanitise(c)
-        }
-        None => {
-            let lift = sampled_reading(disk_reading, probe);
-            let averaged =
-                average_chunks::<DiskPoints, _>(params.disk, known.varying(), rng, |us, acc| {
-                    probe.read_ellipse_points(&disk, us, Rgb::ONE, miss_endpoints, acc, lift)
-                });
-            probe.diag.samples += averaged.samples;
-            note_se(averaged.rel_se);
-            let (mean, fell_back) = averaged.acc.mean_or(wanted_rgb, || probe.endpoints());
-            probe.diag.fallback |= fell_back;
-            mean
-        }
-    };
-    let disk_mean = probe.to_coefficients(known.finish(disk_mean));
-
+    let mut pair = SonePair::new(params, chord, probe, known);
+    // Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2 (§3.1).
+    let disk_mean = pair.disk_mean(probe, known, rng);
     // Step 2: the width of Eq. (2) per channel, and the semi-minor axis.
-    let d = chord.length();
-    let w = Rgb(std::array::from_fn(|c| {
+    let w = path_widths(theta2, sigma_s_scale, &disk_mean, chord.length());
+    let b = w.map(|w| params.semi_minor.from_width(w));
+    // Step 3: Eq. (3) over each distinct ellipse.
+    let groups = Ellipses::group(b, pair.wanted);
+    let mean = pair.ellipse_mean(&groups, probe, known, rng);
+
+    let degenerate = (0..groups.len).all(|g| groups.semi_minor[g] <= 1e-12 * chord.half_len);
+    probe.diag.region = if degenerate {
+        Region::DegenerateEllipse
+    } else {
+        Region::Ellipse
+    };
+    probe.diag.disk_mean = Some(disk_mean);
+    probe.diag.width = Some(w);
+    probe.diag.rel_std_error = pair.rel_se;
+    mean
+}
+
+/// Step 2: the width w of Eq. (2) per channel, from the step-1 means `disk_mean` (σs scaled
+/// by `sigma_s_scale`, see [`WidthScattering`]) over a chord of length `d`.
+#[inline]
+fn path_widths(theta2: f64, sigma_s_scale: f64, disk_mean: &Coefficients, d: f64) -> Rgb {
+    Rgb(std::array::from_fn(|c| {
         width_unchecked(
             theta2,
             sigma_s_scale * disk_mean.sigma_s[c],
             disk_mean.sigma_a[c],
             d,
         )
-    }));
-    let b = w.map(|w| params.semi_minor.from_width(w));
+    }))
+}
 
-    // Step 3: Eq. (3) over each distinct ellipse; field averages first, then sampling.
-    let groups = Ellipses::group(b, wanted);
-    let mut acc = Accumulator::default();
-    let mut sampled: [Option<Reading>; 3] = [None; 3];
-    for (g, how) in sampled.iter_mut().enumerate().take(groups.len) {
-        let e = chord.ellipse(groups.semi_minor[g]);
-        let r = reading(probe, &e);
-        let field_avg = match r {
-            Reading::ClosedForm => probe.field_ellipse_average(&e),
-            _ => None,
-        };
-        match field_avg {
-            Some(c) => {
-                probe.diag.field_averages += 1;
-                acc.add(&sanitise(c), groups.channels[g]);
-            }
-            None => *how = Some(sampled_reading(r, probe)),
+/// What the steps of one pair's estimate share: the chord, how its regions are read, the
+/// channels averaged, and the largest relative standard error so far.
+struct SonePair<'p> {
+    params: &'p SoneParams,
+    chord: Chord,
+    /// [`MissPolicy::Endpoints`]: a missed projection counts as the endpoint mean.
+    miss_endpoints: bool,
+    /// The channels not known constant from the field's bounds (as flags and as weights).
+    wanted: [bool; 3],
+    wanted_rgb: Rgb,
+    /// Prefiltered averaging applies to this field ([`SoneParams::averaging`]).
+    prefiltered: bool,
+    /// The field has closed-form ellipse averages.
+    closed_form: bool,
+    /// With `SampleBudget::TargetRelError`: the largest estimated relative standard error of
+    /// the stages sampled so far.
+    rel_se: Option<f64>,
+}
+
+impl<'p> SonePair<'p> {
+    /// The pair's shared state; with prefiltered averaging, the flatness test of
+    /// `params.flatness` is prepared here, so that each region is then read in closed form,
+    /// on the local quadric, or by rays.
+    #[inline]
+    fn new<S, F>(
+        params: &'p SoneParams,
+        chord: Chord,
+        probe: &mut Probe<'_, S, F>,
+        known: &Known,
+    ) -> Self
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+    {
+        let wanted: [bool; 3] = std::array::from_fn(|c| !known.channel_constant(c));
+        let closed_form = probe.field.capabilities().ellipse_average;
+        let prefiltered = params.averaging == Averaging::Prefiltered
+            && (closed_form
+                || probe.field.capabilities().point_lookup
+                || probe.field.capabilities().reads_uv);
+        if prefiltered {
+            probe.prepare_prefilter(params.flatness, &chord);
+        }
+        SonePair {
+            params,
+            chord,
+            miss_endpoints: params.misses == MissPolicy::Endpoints,
+            wanted,
+            wanted_rgb: Rgb(wanted.map(|w| if w { 1.0 } else { 0.0 })),
+            prefiltered,
+            closed_form,
+            rel_se: None,
         }
     }
-    if sampled.iter().any(|s| s.is_some()) {
+
+    /// Keeps the larger relative standard error.
+    #[inline]
+    fn note_se(&mut self, e: Option<f64>) {
+        if let Some(e) = e {
+            self.rel_se = Some(self.rel_se.map_or(e, |r| r.max(e)));
+        }
+    }
+
+    /// How the region `e` is read: as the prefilter decides, or by rays.
+    #[inline]
+    fn reading<S, F>(&self, probe: &mut Probe<'_, S, F>, e: &crate::PlanarEllipse) -> Reading
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+    {
+        if self.prefiltered {
+            probe.reading(e, self.closed_form)
+        } else {
+            Reading::Rays
+        }
+    }
+
+    /// Step 1: ⟨σs⟩, ⟨σa⟩ over the disk of radius d/2 centred at the midpoint (paper §3.1),
+    /// in closed form where the field has it, else sampled with each point projected by the
+    /// two rays ±n_i* (§3.2); as coefficients.
+    #[inline]
+    fn disk_mean<S, F, U>(
+        &mut self,
+        probe: &mut Probe<'_, S, F>,
+        known: &Known,
+        rng: &mut U,
+    ) -> Coefficients
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+        U: UniformSource + ?Sized,
+    {
+        let disk = self.chord.ellipse(self.chord.half_len);
+        let disk_reading = self.reading(probe, &disk);
+        let field_disk = match disk_reading {
+            Reading::ClosedForm => probe.field_ellipse_average(&disk),
+            _ => None,
+        };
+        let disk_mean = match field_disk {
+            Some(c) => {
+                probe.diag.field_averages += 1;
+                sanitise(c)
+            }
+            None => {
+                let lift = sampled_reading(disk_reading, probe);
+                let miss_endpoints = self.miss_endpoints;
+                let budget = self.params.disk;
+                let averaged =
+                    average_chunks::<DiskPoints, _>(budget, known.varying(), rng, |us, acc| {
+                        probe.read_ellipse_points(&disk, us, Rgb::ONE, miss_endpoints, acc, lift)
+                    });
+                probe.diag.samples += averaged.samples;
+                self.note_se(averaged.rel_se);
+                let (mean, fell_back) = averaged.acc.mean_or(self.wanted_rgb, || probe.endpoints());
+                probe.diag.fallback |= fell_back;
+                mean
+            }
+        };
+        probe.to_coefficients(known.finish(disk_mean))
+    }
+
+    /// Step 3: σ̄s, σ̄a by Eq. (3), area means over each distinct ellipse of `groups` (semi-axes
+    /// d/2 along x̂ and b along n_i* × x̂): field averages first, then the remaining ellipses
+    /// sampled together.
+    #[inline]
+    fn ellipse_mean<S, F, U>(
+        &mut self,
+        groups: &Ellipses,
+        probe: &mut Probe<'_, S, F>,
+        known: &Known,
+        rng: &mut U,
+    ) -> Coefficients
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+        U: UniformSource + ?Sized,
+    {
+        let mut acc = Accumulator::default();
+        let mut sampled: [Option<Reading>; 3] = [None; 3];
+        for (g, how) in sampled.iter_mut().enumerate().take(groups.len) {
+            let e = self.chord.ellipse(groups.semi_minor[g]);
+            let r = self.reading(probe, &e);
+            let field_avg = match r {
+                Reading::ClosedForm => probe.field_ellipse_average(&e),
+                _ => None,
+            };
+            match field_avg {
+                Some(c) => {
+                    probe.diag.field_averages += 1;
+                    acc.add(&sanitise(c), groups.channels[g]);
+                }
+                None => *how = Some(sampled_reading(r, probe)),
+            }
+        }
+        if sampled.iter().any(|s| s.is_some()) {
+            let averaged = self.sample_ellipses(groups, &sampled, probe, known, rng);
+            acc.merge(&averaged.acc);
+        }
+        let (mean, fell_back) = acc.mean_or(self.wanted_rgb, || probe.endpoints());
+        probe.diag.fallback |= fell_back;
+        mean
+    }
+
+    /// Step 3, sampled: the ellipses of `groups` whose reading `sampled` gives, with one
+    /// unit-disk point mapped to every such ellipse (the channels share their random numbers,
+    /// module docs), each point projected by the two rays ±n_i* (§3.2) or read on the
+    /// quadric.
+    #[inline]
+    fn sample_ellipses<S, F, U>(
+        &mut self,
+        groups: &Ellipses,
+        sampled: &[Option<Reading>; 3],
+        probe: &mut Probe<'_, S, F>,
+        known: &Known,
+        rng: &mut U,
+    ) -> Averaged
+    where
+        S: SurfaceQuery + ?Sized,
+        F: CoefficientField<S::Point> + ?Sized,
+        U: UniformSource + ?Sized,
+    {
         let mut tracked_channels = Rgb::ZERO;
         for g in (0..groups.len).filter(|&g| sampled[g].is_some()) {
             tracked_channels += groups.channels[g];
         }
         let (va, vs) = known.varying();
-        let ellipses: [_; 3] = std::array::from_fn(|g| chord.ellipse(groups.semi_minor[g]));
+        let ellipses: [_; 3] = std::array::from_fn(|g| self.chord.ellipse(groups.semi_minor[g]));
+        let miss_endpoints = self.miss_endpoints;
         // Group by group over each chunk: every channel is in one group, so each channel
         // still sums its points in order.
         let averaged = average_chunks::<DiskPoints, _>(
-            params.ellipse,
+            self.params.ellipse,
             (va * tracked_channels, vs * tracked_channels),
             rng,
             |us, acc| {
@@ -388,22 +520,9 @@ where
             },
         );
         probe.diag.samples += averaged.samples;
-        note_se(averaged.rel_se);
-        acc.merge(&averaged.acc);
+        self.note_se(averaged.rel_se);
+        averaged
     }
-    let (mean, fell_back) = acc.mean_or(wanted_rgb, || probe.endpoints());
-    probe.diag.fallback |= fell_back;
-
-    let degenerate = (0..groups.len).all(|g| groups.semi_minor[g] <= 1e-12 * chord.half_len);
-    probe.diag.region = if degenerate {
-        Region::DegenerateEllipse
-    } else {
-        Region::Ellipse
-    };
-    probe.diag.disk_mean = Some(disk_mean);
-    probe.diag.width = Some(w);
-    probe.diag.rel_std_error = rel_se;
-    mean
 }
 
 /// How a region whose closed form was not used is sampled: on the local quadric where its
