@@ -539,6 +539,70 @@ mod tests {
         )
     }
 
+    /// The floor setting (the shape correction's): unbiased to within its floor, drawing
+    /// only the flights' numbers (one per tentative collision, no roulette draw), and 0 once
+    /// the guard on steps runs out.
+    #[test]
+    fn ratio_tracking_with_a_floor_is_unbiased_and_draws_one_number_per_step() {
+        let m = TwoLayer {
+            split: 1.0,
+            left: (0.1, 0.4),
+            right: (1.5, 0.5),
+        };
+        let exact = (-(0.5 * 1.0 + 2.0 * 1.5f64)).exp(); // t_max = 2.5
+        let floor = RatioTracking {
+            control: 0.0,
+            ending: LowTransmittance::Floor {
+                floor: 1e-9,
+                max_steps: 1_000_000,
+            },
+        };
+        let mut rng = Rng::from_keys(17, &[]);
+        let mut c = TrackingCounters::default();
+        let n = 400_000;
+        let (mut s, mut s2) = (0.0, 0.0);
+        for _ in 0..n {
+            let t = ratio_tracking(&m, DVec3::ZERO, DVec3::X, 2.5, floor, &mut rng, &mut c);
+            assert!((0.0..=1.0).contains(&t));
+            s += t;
+            s2 += t * t;
+        }
+        let mean = s / n as f64;
+        let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
+        assert!((mean - exact).abs() < 4.0 * se, "{mean} vs {exact} (se {se})");
+        // One number per tentative collision: a generator that tracked k steps is where a
+        // twin stands after k draws.
+        let (mut a, mut twin) = (Rng::from_keys(5, &[]), Rng::from_keys(5, &[]));
+        let mut c = TrackingCounters::default();
+        for _ in 0..1000 {
+            let before = c.ratio_steps;
+            ratio_tracking(&m, DVec3::ZERO, DVec3::X, 2.5, floor, &mut a, &mut c);
+            for _ in before..c.ratio_steps {
+                twin.uniform();
+            }
+            assert_eq!(a.uniform(), twin.uniform());
+        }
+        // The guard: a flight longer than max_steps tentative collisions counts as 0.
+        let short = RatioTracking {
+            ending: LowTransmittance::Floor {
+                floor: 1e-9,
+                max_steps: 2,
+            },
+            ..floor
+        };
+        // An empty layer 100 long under a majorant of 2: about 100 tentative collisions to
+        // cross 50 of it, each leaving the estimate at 1.
+        let empty = TwoLayer {
+            split: 100.0,
+            left: (0.0, 0.0),
+            right: (1.0, 1.0),
+        };
+        let t = ratio_tracking(&empty, DVec3::ZERO, DVec3::X, 50.0, floor, &mut a, &mut c);
+        assert_eq!(t, 1.0);
+        let t = ratio_tracking(&empty, DVec3::ZERO, DVec3::X, 50.0, short, &mut a, &mut c);
+        assert_eq!(t, 0.0);
+    }
+
     #[test]
     fn ratio_tracking_is_unbiased_and_exact_for_constant_media() {
         let layers = || TwoLayer {

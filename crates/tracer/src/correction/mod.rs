@@ -73,12 +73,12 @@ use het_estimate::Coefficients;
 use rayon::prelude::*;
 
 pub(crate) mod factors;
-mod walk;
+mod paired_walks;
 
 use self::factors::{
     DIRECTIONS, Directional, Grid, MU_NODES, PHI_NODES, Sample, ShapeCorrection, mu_weights,
 };
-use self::walk::{Boundary, EscapeMedium, MAX_TRACKING_CONTRAST, TangentPlane, Walk};
+use self::paired_walks::{Boundary, EscapeMedium, MAX_TRACKING_CONTRAST, TangentPlane, Walk};
 use crate::field::MediumField;
 use crate::geometry::{Geometry, Hit, ObjectSurface, Ray};
 use crate::integrator::bssrdf::BssrdfObject;
