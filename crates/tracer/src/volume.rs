@@ -569,7 +569,10 @@ mod tests {
         }
         let mean = s / n as f64;
         let se = ((s2 / n as f64 - mean * mean) / n as f64).sqrt();
-        assert!((mean - exact).abs() < 4.0 * se, "{mean} vs {exact} (se {se})");
+        assert!(
+            (mean - exact).abs() < 4.0 * se,
+            "{mean} vs {exact} (se {se})"
+        );
         // One number per tentative collision: a generator that tracked k steps is where a
         // twin stands after k draws.
         let (mut a, mut twin) = (Rng::from_keys(5, &[]), Rng::from_keys(5, &[]));

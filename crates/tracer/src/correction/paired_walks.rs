@@ -344,8 +344,15 @@ impl Walk<'_> {
             };
             step += 1;
             // Delta tracking to the next real collision, or to the boundary.
-            let flight =
-                volume::next_collision(medium, pos, d, s_max, MAX_TRACKING, &mut rng, &mut counters);
+            let flight = volume::next_collision(
+                medium,
+                pos,
+                d,
+                s_max,
+                MAX_TRACKING,
+                &mut rng,
+                &mut counters,
+            );
             match (flight, at) {
                 (TrackedFlight::Collision(c), _) => {
                     pos += c.t * d;
