@@ -345,6 +345,45 @@ impl SeparableBssrdf {
         }))
     }
 
+    /// One side's forward-shift amplitudes a_n = C_n(σt' r; α', μ_side → μ_other) · sinⁿθ_side
+    /// (n = 1, 2, 3; unitless) for channel `channel` of `c` at distance `r` (length; σt' and
+    /// α' the channel's reduced extinction and albedo): the coefficients of cos nφ in that
+    /// side's factor max(0, 1 + Σ_n a_n cos nφ) / N of [`Self::coupling_between`], φ measured
+    /// at the side's own end of the chord from its light's direction of travel along the
+    /// surface (docs/oblique-incidence.md; C_n from [`ObliqueShape::shift`]). The exit side of
+    /// a pair is `shift_amplitudes(c, ch, r, cos_o, cos_i)`, the incident side
+    /// `shift_amplitudes(c, ch, r, cos_i, cos_o)`. What a probe sampler that draws azimuths
+    /// from the shift needs (`het_estimate::azimuth`). 0 without the oblique shape, for a
+    /// channel that does not scatter or has invalid coefficients, and for non-finite input.
+    pub fn shift_amplitudes(
+        &self,
+        c: &Coefficients,
+        channel: usize,
+        r: f64,
+        side_cos: f64,
+        other_cos: f64,
+    ) -> [f64; 3] {
+        let Some(m) = self.oblique.as_ref() else {
+            return [0.0; 3];
+        };
+        let ch = channel.min(2);
+        let Ok(reduced) = self.family.reduced_of(c.sigma_a[ch], c.sigma_s[ch]) else {
+            return [0.0; 3];
+        };
+        let Some(alpha) = reduced.albedo else {
+            return [0.0; 3];
+        };
+        let q = (1.0 - side_cos * side_cos).max(0.0);
+        let s = q.sqrt();
+        let k = m.shift(alpha, reduced.sigma_tp * r, side_cos, other_cos);
+        let a = [k[0] * s, k[1] * q, k[2] * q * s];
+        if a.iter().all(|v| v.is_finite()) {
+            a
+        } else {
+            [0.0; 3]
+        }
+    }
+
     /// S from its parts: the profile value `rd` (1/length², per channel; R(r), or another
     /// profile a renderer weighs the pair by), the coupling `t` (per channel;
     /// [`SeparableBssrdf::coupling`], or 1) and the two cosines:
@@ -425,6 +464,47 @@ mod tests {
 
     fn crossing(x: f64, dir: DVec3) -> Crossing {
         Crossing::new(DVec3::new(x, 0.0, 0.0), DVec3::Z, dir.normalize())
+    }
+
+    /// The amplitudes the probe sampler reads are the exit side's factor of `coupling_between`:
+    /// with light entering along the normal (no incident shift), moving x_i from the exit
+    /// side's direction of travel (φ_o = 0) to the opposite side (φ_o = π) at the same
+    /// distance changes the coupling by (1 + a₁ + a₂ + a₃)/(1 − a₁ + a₂ − a₃) (T and M see
+    /// only the cosines and r; N cancels). Without the oblique shape they are 0.
+    #[test]
+    fn shift_amplitudes_are_the_exit_side_s_series() {
+        let b = SeparableBssrdf::new(ProfileModel::Tabulated, Scattering::All, 0.0, 1.3).unwrap();
+        let c = Coefficients::new(Rgb::new(0.01, 0.05, 0.3), Rgb::splat(2.0));
+        let (s60, c60) = (60f64.to_radians().sin(), 60f64.to_radians().cos());
+        // ω_o tilted toward +x: light arriving along −ω_o travels toward −x.
+        let exit = Crossing::new(DVec3::ZERO, DVec3::Z, DVec3::new(s60, 0.0, c60));
+        let mut tested = 0;
+        for r in [0.2, 0.7, 1.5, 4.0] {
+            let at = |x: f64| Crossing::new(DVec3::new(x, 0.0, 0.0), DVec3::Z, DVec3::Z);
+            let ahead = b.coupling_between(&c, &at(-r), &exit);
+            let behind = b.coupling_between(&c, &at(r), &exit);
+            for ch in 0..3 {
+                let a = b.shift_amplitudes(&c, ch, r, c60, 1.0);
+                assert!(
+                    a.iter().all(|v| v.is_finite()) && a[0] != 0.0,
+                    "{r} {ch}: {a:?}"
+                );
+                let (p, q) = (1.0 + a[0] + a[1] + a[2], 1.0 - a[0] + a[1] - a[2]);
+                if p > 0.0 && q > 0.0 {
+                    let want = p / q;
+                    let got = ahead[ch] / behind[ch];
+                    assert!(
+                        (got / want - 1.0).abs() < 1e-12,
+                        "{r} {ch}: {got} vs {want}"
+                    );
+                    tested += 1;
+                }
+            }
+        }
+        assert!(tested >= 6, "too few positive series: {tested}");
+        let plain = b.clone().with_oblique_shape(false);
+        assert_eq!(plain.shift_amplitudes(&c, 0, 1.0, c60, 1.0), [0.0; 3]);
+        assert_eq!(b.shift_amplitudes(&c, 0, f64::NAN, c60, 1.0), [0.0; 3]);
     }
 
     /// `from_family_with` builds what `from_family` and the `with_*` switches would keep,

@@ -46,6 +46,7 @@
 pub mod names;
 
 pub mod analytic;
+pub mod azimuth;
 pub mod budget;
 mod chord;
 pub mod ellipse;

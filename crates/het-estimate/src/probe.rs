@@ -82,6 +82,21 @@
 //! `w_a(x)` ([`ProbeDensity::weigh`]), not uniformly: the points' weights now differ by orders
 //! of magnitude, and the carried factor `Σ w / w_k` stays near the set's own estimate.
 //!
+//! # Guided azimuths
+//! [`probe_points_guided_into`] takes an optional [`AzimuthGuide`]: the preferred azimuthal
+//! shape of the integrand about x_o, per channel and radius (the oblique shape's forward
+//! shift, docs/oblique-incidence.md). The normal probe then draws its azimuth, after its
+//! channel and radius, from the channel's [`AzimuthDensity`] at that radius (a defensive
+//! mixture of the guide's shape and the uniform azimuth), and the normal axis's term of
+//! `p_a(x)` carries that density in place of 1/(2π):
+//!
+//! `p_n(x) = (1/3) Σ_c [|x − x_o| < r_max,c] · p_r,c(r_n) · p_φ,c(φ | r_n) / r_n · |n_g(x) · n|`,
+//!
+//! φ the azimuth of x about x_o in its frame. Channels that share a radial density share the
+//! first one's guide. The tangent probes keep the uniform azimuth. `None` is
+//! [`probe_points_within_into`], draw for draw and bit for bit. Test:
+//! `guided_azimuths_keep_the_estimate_unbiased`.
+//!
 //! # The probe radius follows the estimate, not x_o
 //! The estimator may return coefficients far from x_o's own (x_o in a strongly absorbing vein
 //! next to a clear region), and then the BSSRDF reaches further than x_o's profile. A sphere
@@ -151,6 +166,7 @@ use std::cell::Cell;
 use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, RadiusSampler};
 use glam::DVec3;
 
+use crate::azimuth::{AzimuthDensity, AzimuthGuide};
 use crate::frame::orthonormal_basis;
 use crate::{Coefficients, FieldBounds, SurfacePoint, UniformSource};
 
@@ -335,7 +351,11 @@ impl ProbeSampler {
                         ),
                     });
         }
-        Channels { channel, count }
+        Channels {
+            channel,
+            count,
+            first,
+        }
     }
 
     /// The table searches of channel `ch` at coefficients `c` with radius cap `cap` (see
@@ -396,6 +416,8 @@ impl ProbeSampler {
 struct Channels<'a> {
     channel: [Option<ChannelDensity<'a>>; 3],
     count: [u8; 3],
+    /// The channel whose density each channel shares (itself, or an earlier one).
+    first: [usize; 3],
 }
 
 /// One channel's sampling density: its radial density, its probe radius, and, on an object
@@ -540,7 +562,7 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     rng: &mut U,
 ) {
     set.len = 0;
-    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
+    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius, None);
     density.trace(chords, rng, |h, axis| match density.weight(h, axis) {
         Some(weight) => {
             set.hits[set.len] = Some(ProbeHit {
@@ -618,6 +640,10 @@ pub struct ProbeDensity<'s> {
     /// where they went by roulette, else 1 (set by [`ProbeDensity::trace`] once the normal
     /// probe is traced; module docs, "Tangent probes by roulette").
     tangent_rate: Cell<f64>,
+    /// The normal probe's azimuthal guide and the angles of its two directions in x_o's frame
+    /// (from the first tangent toward the second; NaN for a direction left out); `None`: the
+    /// uniform azimuth.
+    guide: Option<(&'s dyn AzimuthGuide, [f64; 2])>,
 }
 
 impl<'s> ProbeDensity<'s> {
@@ -628,8 +654,21 @@ impl<'s> ProbeDensity<'s> {
         coeffs: Coefficients,
         sampler: &'s ProbeSampler,
         max_radius: f64,
+        guide: Option<&'s dyn AzimuthGuide>,
     ) -> Self {
         let channels = sampler.channels(coeffs, max_radius);
+        let frame = Frame::new(x_o.normal());
+        let guide = guide.and_then(|g| {
+            let angles = g.directions().map(|d| {
+                let (x, y) = (d.dot(frame.s), d.dot(frame.t));
+                if x.is_finite() && y.is_finite() && (x != 0.0 || y != 0.0) {
+                    y.atan2(x)
+                } else {
+                    f64::NAN
+                }
+            });
+            angles.iter().any(|a| a.is_finite()).then_some((g, angles))
+        });
         let projection = channels
             .channel
             .iter()
@@ -637,10 +676,11 @@ impl<'s> ProbeDensity<'s> {
             .all(|c| c.r_max <= max_radius);
         Self {
             origin: x_o.position(),
-            frame: Frame::new(x_o.normal()),
+            frame,
             channels,
             projection,
             tangent_rate: Cell::new(1.0),
+            guide,
         }
     }
 
@@ -710,7 +750,15 @@ impl<'s> ProbeDensity<'s> {
             (dl.x * dl.x + dl.y * dl.y).sqrt(),
         ];
         let mut pdf = [0.0; 3];
-        for (channel, &count) in self.channels.channel.iter().zip(&self.channels.count) {
+        // The normal probe's azimuth about x_o in its frame.
+        let guided_phi = self.guide.map(|_| dl.y.atan2(dl.x));
+        for (k, (channel, &count)) in self
+            .channels
+            .channel
+            .iter()
+            .zip(&self.channels.count)
+            .enumerate()
+        {
             let Some(c) = channel else {
                 continue;
             };
@@ -735,6 +783,14 @@ impl<'s> ProbeDensity<'s> {
                             narrow + (1.0 - NARROW_SHARE)
                         }
                         None => 1.0,
+                    };
+                    // The azimuth's density: 1/(2π) in `share`, or the guide's (module docs,
+                    // "Guided azimuths").
+                    let share = match (axis, self.guide, guided_phi) {
+                        (2, Some((g, angles)), Some(phi)) => {
+                            f64::from(count) / 3.0 * guided_density(g, angles, k, r).pdf(phi)
+                        }
+                        _ => share,
                     };
                     pdf[axis] += share * mix * c.radial.pdf_r(r) / r * nl[axis].abs();
                 }
@@ -791,7 +847,13 @@ impl<'s> ProbeDensity<'s> {
             if r.is_nan() || r >= c.r_max {
                 continue;
             }
-            let (sin, cos) = crate::sampling::sin_cos_turn(u_phi);
+            let (sin, cos) = match self.guide {
+                Some((g, angles)) if axis == ProbeAxis::N => {
+                    let first = self.channels.first[ch];
+                    guided_density(g, angles, first, r).sample(u_phi).sin_cos()
+                }
+                _ => crate::sampling::sin_cos_turn(u_phi),
+            };
             let (vx, vy, vz) = self.frame.axes(axis);
             let half = (c.r_max * c.r_max - r * r).sqrt();
             let base = self.origin + r * (cos * vx + sin * vy) - half * vz;
@@ -804,6 +866,18 @@ impl<'s> ProbeDensity<'s> {
             normal_found |= axis == ProbeAxis::N && kept > 0;
         }
     }
+}
+
+/// The guided azimuthal density of channel `channel` at projected radius `r` (length), the
+/// guide's directions at `angles` in x_o's frame.
+fn guided_density(
+    g: &dyn AzimuthGuide,
+    angles: [f64; 2],
+    channel: usize,
+    r: f64,
+) -> AzimuthDensity {
+    let a = g.amplitudes(channel, r);
+    AzimuthDensity::new(&[(angles[0], a[0]), (angles[1], a[1])])
 }
 
 /// [`probe_within_into`] without the weights: the same probes, draw for draw, and every
@@ -824,8 +898,25 @@ pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
     max_radius: f64,
     rng: &mut U,
 ) -> ProbeDensity<'s> {
+    probe_points_guided_into(points, chords, x_o, coeffs, sampler, max_radius, None, rng)
+}
+
+/// [`probe_points_within_into`] with the normal probe's azimuth drawn from `guide`'s
+/// density ([`crate::azimuth`]; module docs, "Guided azimuths"), and the density that weighs
+/// the points with it; `None` is [`probe_points_within_into`], draw for draw and bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn probe_points_guided_into<'s, C: ProbeChords, U: UniformSource>(
+    points: &mut ProbePoints<C::Point>,
+    chords: &C,
+    x_o: &impl SurfacePoint,
+    coeffs: Coefficients,
+    sampler: &'s ProbeSampler,
+    max_radius: f64,
+    guide: Option<&'s dyn AzimuthGuide>,
+    rng: &mut U,
+) -> ProbeDensity<'s> {
     points.len = 0;
-    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius);
+    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius, guide);
     density.trace(chords, rng, |h, axis| {
         points.hits[points.len] = Some(h.clone());
         points.axes[points.len] = axis;
@@ -854,7 +945,7 @@ pub fn probe_density_within(
     max_radius: f64,
     x_i: &impl SurfacePoint,
 ) -> f64 {
-    ProbeDensity::new(x_o, coeffs, sampler, max_radius).density(x_i)
+    ProbeDensity::new(x_o, coeffs, sampler, max_radius, None).density(x_i)
 }
 
 /// The three axes' terms of [`probe_density`] (tangent s, tangent t, normal), each already
@@ -865,7 +956,7 @@ pub fn axis_densities(
     sampler: &ProbeSampler,
     x_i: &impl SurfacePoint,
 ) -> [f64; 3] {
-    ProbeDensity::new(x_o, coeffs, sampler, f64::INFINITY).axis_densities(x_i)
+    ProbeDensity::new(x_o, coeffs, sampler, f64::INFINITY, None).axis_densities(x_i)
 }
 
 /// A probe point's estimator weight and the MIS weight in it ([`ProbeDensity::weigh`]).
@@ -1009,7 +1100,7 @@ mod tests {
             for &(x, w, a) in &weighted {
                 let normal = if x.z > -1e-9 { DVec3::Z } else { DVec3::NEG_Z };
                 LAST_SEARCHES.with(|last| last.iter().for_each(|slot| slot.set(None)));
-                let fresh = ProbeDensity::new(&x_o, c, &sampler, cap);
+                let fresh = ProbeDensity::new(&x_o, c, &sampler, cap, None);
                 // The set's own roulette (whether its tangent probes went by it).
                 fresh.tangent_rate.set(density.tangent_rate.get());
                 let x = P(x, normal);
@@ -1121,6 +1212,100 @@ mod tests {
             "{mean} ± {se}, integral {want}"
         );
         assert!(se < 0.015 * want, "test too weak: {mean} ± {se} of {want}");
+    }
+
+    /// A guide whose amplitudes change with the channel and the radius (strong enough for
+    /// the series to be clamped near x_o).
+    struct TestGuide;
+    impl AzimuthGuide for TestGuide {
+        fn directions(&self) -> [DVec3; 2] {
+            [DVec3::new(0.6, -0.8, 0.3), DVec3::new(-0.8, -0.6, 0.0)]
+        }
+        fn amplitudes(&self, channel: usize, r: f64) -> [[f64; 3]; 2] {
+            let k = 1.0 + channel as f64;
+            [
+                [0.8 + 1.5 * (-r / (4.0 * k)).exp(), 0.6, -0.3 * k],
+                [0.5 * (-r / 8.0).exp(), 0.0, 0.2],
+            ]
+        }
+    }
+
+    /// With the normal probe's azimuth drawn from a guide (`probe_points_guided_into`), the
+    /// weights keep `E[Σ_hits f · weight] = ∫ f dA`: the slab of the test above, with an
+    /// integrand that leans the way the guide does, `f = e^{−r/ℓ}(1 + 0.9 cos φ)` (φ about the
+    /// guide's direction; the cosine integrates to 0, so the closed form is the same), three
+    /// distinct channels and a grey material (channels that share a density). Within 4
+    /// standard errors, of at most 2.5 % of the integral.
+    #[test]
+    fn guided_azimuths_keep_the_estimate_unbiased() {
+        let family =
+            ProfileFamily::new(ProfileModel::Dipole, Scattering::Multiple, 0.0, 1.0).unwrap();
+        for (case, c) in [
+            Coefficients {
+                sigma_a: crate::Rgb::new(0.02, 0.05, 0.2),
+                sigma_s: crate::Rgb::new(1.0, 1.5, 2.0),
+            },
+            Coefficients::grey(0.02, 1.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let sampler = ProbeSampler::new(family, FieldBounds::constant(c));
+            let big_r = sampler.probe_radius(c);
+            let h = 0.4 * big_r;
+            let ell = 1.0 / (3.0 * 0.02 * 1.02f64).sqrt();
+            let e = |x: f64| (1.0 + x / ell) * (-x / ell).exp();
+            let want = std::f64::consts::TAU * ell * ell * ((1.0 - e(big_r)) + (e(h) - e(big_r)));
+            let x_o = P(DVec3::ZERO, DVec3::Z);
+            let g = TestGuide;
+            let toward = DVec3::new(0.6, -0.8, 0.0).normalize();
+            let mut rng = SplitMix64::new(12 + case as u64);
+            let mut points = ProbePoints::new();
+            let (mut unguided, mut guided) = (0.0, 0.0);
+            let mut run = |guide: Option<&dyn AzimuthGuide>, rng: &mut SplitMix64| {
+                mean_se(100_000, || {
+                    let d = probe_points_guided_into(
+                        &mut points,
+                        &Slab(h),
+                        &x_o,
+                        c,
+                        &sampler,
+                        f64::INFINITY,
+                        guide,
+                        rng,
+                    );
+                    points
+                        .found()
+                        .filter_map(|(x, a)| {
+                            let p = x.position();
+                            let r = p.length();
+                            let flat = DVec3::new(p.x, p.y, 0.0);
+                            let cos = if flat.length() > 0.0 {
+                                flat.normalize().dot(toward)
+                            } else {
+                                0.0
+                            };
+                            d.weight(x, a)
+                                .map(|w| (-r / ell).exp() * (1.0 + 0.9 * cos) * w)
+                        })
+                        .sum()
+                })
+            };
+            for (guide, out) in [
+                (None, &mut unguided),
+                (Some(&g as &dyn AzimuthGuide), &mut guided),
+            ] {
+                let (mean, se) = run(guide, &mut rng);
+                assert!(
+                    (mean - want).abs() < 4.0 * se,
+                    "case {case}, guided {}: {mean} ± {se}, integral {want}",
+                    guide.is_some()
+                );
+                assert!(se < 0.025 * want, "test too weak: {mean} ± {se} of {want}");
+                *out = se;
+            }
+            eprintln!("case {case}: standard error {unguided:.3e} uniform, {guided:.3e} guided");
+        }
     }
 
     /// x_o sits in the strongly absorbing part of a two-valued field, and the estimate is the
