@@ -10,6 +10,8 @@ two or more files. A function's length is its lines from `fn` to the closing bra
 indentation.
 
 Usage: python3 scripts/code_shape.py [--max-lines N]   (run from the repository's root)
+
+Exits with status 1 when it finds any of the three (`.ci/run` runs it with the default limit).
 """
 
 import os
@@ -151,7 +153,8 @@ def main():
         print(f"too_many_arguments  {a}")
     print(f"import cycles: {total_cycles}; library functions over {MAX_LINES} lines: {len(longs)}; "
           f"too_many_arguments: {len(allows)}")
+    return 1 if total_cycles or longs or allows else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

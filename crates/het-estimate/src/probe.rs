@@ -83,7 +83,7 @@
 //! of magnitude, and the carried factor `Σ w / w_k` stays near the set's own estimate.
 //!
 //! # Guided azimuths
-//! [`probe_points_guided_into`] takes an optional [`AzimuthGuide`]: the preferred azimuthal
+//! [`ProbeDensity::around`] takes an optional [`AzimuthGuide`]: the preferred azimuthal
 //! shape of the integrand about x_o, per channel and radius (the oblique shape's forward
 //! shift, docs/oblique-incidence.md). The normal probe then draws its azimuth, after its
 //! channel and radius, from the channel's [`AzimuthDensity`] at that radius (a defensive
@@ -562,7 +562,7 @@ pub fn probe_within_into<C: ProbeChords, U: UniformSource>(
     rng: &mut U,
 ) {
     set.len = 0;
-    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius, None);
+    let density = ProbeDensity::around(x_o, coeffs, sampler, max_radius, None);
     density.trace(chords, rng, |h, axis| match density.weight(h, axis) {
         Some(weight) => {
             set.hits[set.len] = Some(ProbeHit {
@@ -648,8 +648,10 @@ pub struct ProbeDensity<'s> {
 
 impl<'s> ProbeDensity<'s> {
     /// The density of the probes around `x_o` with coefficients `coeffs` there, radii capped
-    /// at `max_radius` ([`probe_within`]).
-    fn new(
+    /// at `max_radius` ([`probe_within`]), the normal probe's azimuth drawn from `guide`'s
+    /// density ([`crate::azimuth`]; module docs, "Guided azimuths") or, with `None`,
+    /// uniformly. [`ProbeDensity::trace_into`] traces its probes.
+    pub fn around(
         x_o: &impl SurfacePoint,
         coeffs: Coefficients,
         sampler: &'s ProbeSampler,
@@ -682,6 +684,24 @@ impl<'s> ProbeDensity<'s> {
             tangent_rate: Cell::new(1.0),
             guide,
         }
+    }
+
+    /// Traces this density's probes and keeps every point they find in `points` (replacing
+    /// what it held): [`probe_points_within_into`] with this density's guide; without a guide
+    /// the same draws and points, bit for bit.
+    pub fn trace_into<C: ProbeChords, U: UniformSource>(
+        &self,
+        points: &mut ProbePoints<C::Point>,
+        chords: &C,
+        rng: &mut U,
+    ) {
+        points.len = 0;
+        self.trace(chords, rng, |h, axis| {
+            points.hits[points.len] = Some(h.clone());
+            points.axes[points.len] = axis;
+            points.len += 1;
+            true
+        });
     }
 
     /// `p(x_i)` (1/length²).
@@ -898,31 +918,8 @@ pub fn probe_points_within_into<'s, C: ProbeChords, U: UniformSource>(
     max_radius: f64,
     rng: &mut U,
 ) -> ProbeDensity<'s> {
-    probe_points_guided_into(points, chords, x_o, coeffs, sampler, max_radius, None, rng)
-}
-
-/// [`probe_points_within_into`] with the normal probe's azimuth drawn from `guide`'s
-/// density ([`crate::azimuth`]; module docs, "Guided azimuths"), and the density that weighs
-/// the points with it; `None` is [`probe_points_within_into`], draw for draw and bit for bit.
-#[allow(clippy::too_many_arguments)]
-pub fn probe_points_guided_into<'s, C: ProbeChords, U: UniformSource>(
-    points: &mut ProbePoints<C::Point>,
-    chords: &C,
-    x_o: &impl SurfacePoint,
-    coeffs: Coefficients,
-    sampler: &'s ProbeSampler,
-    max_radius: f64,
-    guide: Option<&'s dyn AzimuthGuide>,
-    rng: &mut U,
-) -> ProbeDensity<'s> {
-    points.len = 0;
-    let density = ProbeDensity::new(x_o, coeffs, sampler, max_radius, guide);
-    density.trace(chords, rng, |h, axis| {
-        points.hits[points.len] = Some(h.clone());
-        points.axes[points.len] = axis;
-        points.len += 1;
-        true
-    });
+    let density = ProbeDensity::around(x_o, coeffs, sampler, max_radius, None);
+    density.trace_into(points, chords, rng);
     density
 }
 
@@ -945,7 +942,7 @@ pub fn probe_density_within(
     max_radius: f64,
     x_i: &impl SurfacePoint,
 ) -> f64 {
-    ProbeDensity::new(x_o, coeffs, sampler, max_radius, None).density(x_i)
+    ProbeDensity::around(x_o, coeffs, sampler, max_radius, None).density(x_i)
 }
 
 /// The three axes' terms of [`probe_density`] (tangent s, tangent t, normal), each already
@@ -956,7 +953,7 @@ pub fn axis_densities(
     sampler: &ProbeSampler,
     x_i: &impl SurfacePoint,
 ) -> [f64; 3] {
-    ProbeDensity::new(x_o, coeffs, sampler, f64::INFINITY, None).axis_densities(x_i)
+    ProbeDensity::around(x_o, coeffs, sampler, f64::INFINITY, None).axis_densities(x_i)
 }
 
 /// A probe point's estimator weight and the MIS weight in it ([`ProbeDensity::weigh`]).
@@ -1100,7 +1097,7 @@ mod tests {
             for &(x, w, a) in &weighted {
                 let normal = if x.z > -1e-9 { DVec3::Z } else { DVec3::NEG_Z };
                 LAST_SEARCHES.with(|last| last.iter().for_each(|slot| slot.set(None)));
-                let fresh = ProbeDensity::new(&x_o, c, &sampler, cap, None);
+                let fresh = ProbeDensity::around(&x_o, c, &sampler, cap, None);
                 // The set's own roulette (whether its tangent probes went by it).
                 fresh.tangent_rate.set(density.tangent_rate.get());
                 let x = P(x, normal);
@@ -1230,7 +1227,7 @@ mod tests {
         }
     }
 
-    /// With the normal probe's azimuth drawn from a guide (`probe_points_guided_into`), the
+    /// With the normal probe's azimuth drawn from a guide (`ProbeDensity::around` with a guide), the
     /// weights keep `E[Σ_hits f · weight] = ∫ f dA`: the slab of the test above, with an
     /// integrand that leans the way the guide does, `f = e^{−r/ℓ}(1 + 0.9 cos φ)` (φ about the
     /// guide's direction; the cosine integrates to 0, so the closed form is the same), three
@@ -1264,16 +1261,8 @@ mod tests {
             let (mut unguided, mut guided) = (0.0, 0.0);
             let mut run = |guide: Option<&dyn AzimuthGuide>, rng: &mut SplitMix64| {
                 mean_se(100_000, || {
-                    let d = probe_points_guided_into(
-                        &mut points,
-                        &Slab(h),
-                        &x_o,
-                        c,
-                        &sampler,
-                        f64::INFINITY,
-                        guide,
-                        rng,
-                    );
+                    let d = ProbeDensity::around(&x_o, c, &sampler, f64::INFINITY, guide);
+                    d.trace_into(&mut points, &Slab(h), rng);
                     points
                         .found()
                         .filter_map(|(x, a)| {
