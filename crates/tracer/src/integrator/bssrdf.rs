@@ -55,6 +55,7 @@ use bssrdf_core::{
     Crossing, ProfileFamily, ProfileModel, Rgb, Scattering, SeparableBssrdf, SlabFace,
 };
 use glam::DVec3;
+use het_estimate::azimuth::AzimuthGuide;
 use het_estimate::{Estimator, PreparedEstimator};
 
 use crate::bsdf::{SMOOTH_ALPHA, TransmittanceTable, alpha_from_roughness};
@@ -204,17 +205,51 @@ impl BssrdfObject {
     }
 
     /// [`BssrdfObject::probe_set`] without the weights: the points into `points`, and
-    /// the density that weights each when the caller needs it.
-    pub(crate) fn probe_points_into<C: het_estimate::probe::ProbeChords<Point = Hit>>(
-        &self,
+    /// the density that weights each when the caller needs it. With a `guide`, the normal
+    /// probe draws its azimuth from it ([`het_estimate::azimuth`]); `None` is the uniform
+    /// azimuth, draw for draw.
+    pub(crate) fn probe_points_into<'a, C: het_estimate::probe::ProbeChords<Point = Hit>>(
+        &'a self,
         points: &mut crate::integrator::probe_gathering::ProbePoints,
         chords: &C,
         x_o: &Hit,
         coeffs: het_estimate::Coefficients,
+        guide: Option<&'a dyn AzimuthGuide>,
         rng: &mut Rng,
-    ) -> het_estimate::probe::ProbeDensity<'_> {
-        self.sampler
-            .probe_points_into(points, chords, x_o, coeffs, self.extent, rng)
+    ) -> het_estimate::probe::ProbeDensity<'a> {
+        let density = self.sampler.density_around(x_o, coeffs, self.extent, guide);
+        density.trace_into(points, chords, rng);
+        density
+    }
+
+    /// The oblique shape's two azimuthal factors as the normal probe's guide around x_o
+    /// (docs/oblique-incidence.md, "Sampling"): the incident side's about the direction
+    /// `toward_light` returns (called only with the shape), from x_o to a light (its exact direction at x_i is not known before x_i is
+    /// found; at x_o it is the best guess, exact for a directional light on a plane), the
+    /// exit side's about the direction of travel of light arriving along −`w_o`. `n` is x_o's
+    /// shading normal. `None` without the oblique shape. A side whose direction lies along
+    /// the normal, or below the surface, is left out.
+    pub(crate) fn shift_guide(
+        &self,
+        coeffs: het_estimate::Coefficients,
+        w_o: DVec3,
+        n: DVec3,
+        toward_light: impl FnOnce() -> Option<DVec3>,
+    ) -> Option<ShiftGuide<'_>> {
+        if !self.bssrdf.has_oblique_shape() {
+            return None;
+        }
+        let mu_o = w_o.dot(n).clamp(0.0, 1.0);
+        let (incident, mu_i) = match toward_light() {
+            Some(w) if w.dot(n) > 0.0 => (w - w.dot(n) * n, w.dot(n).min(1.0)),
+            _ => (DVec3::ZERO, 1.0),
+        };
+        Some(ShiftGuide {
+            bssrdf: &self.bssrdf,
+            coeffs,
+            directions: [incident, n * mu_o - w_o],
+            cosines: (mu_i, mu_o),
+        })
     }
 
     /// The boundary's roughness α at `hit` where it acts as a rough one (α ≥
@@ -492,6 +527,35 @@ pub(crate) fn slab_pair(x_i: &Hit, x_o: &Hit, d: f64) -> Option<(SlabFace, f64)>
     }
 }
 
+/// The oblique shape's forward shifts as an azimuthal guide for the normal probe
+/// ([`BssrdfObject::shift_guide`]): factor 0 the incident side D(μ_i → μ_o), about the
+/// direction toward the light; factor 1 the exit side D(μ_o → μ_i), about the direction of
+/// travel of light arriving along −ω_o. Their amplitudes are the series of
+/// [`SeparableBssrdf::shift_amplitudes`], so the guide leans the way S does.
+pub(crate) struct ShiftGuide<'a> {
+    bssrdf: &'a SeparableBssrdf,
+    coeffs: het_estimate::Coefficients,
+    directions: [DVec3; 2],
+    /// (μ_i, μ_o): the incident side's cosine (the light's at x_o) and the exit side's.
+    cosines: (f64, f64),
+}
+
+impl AzimuthGuide for ShiftGuide<'_> {
+    fn directions(&self) -> [DVec3; 2] {
+        self.directions
+    }
+
+    fn amplitudes(&self, channel: usize, r: f64) -> [[f64; 3]; 2] {
+        let (mu_i, mu_o) = self.cosines;
+        [
+            self.bssrdf
+                .shift_amplitudes(&self.coeffs, channel, r, mu_i, mu_o),
+            self.bssrdf
+                .shift_amplitudes(&self.coeffs, channel, r, mu_o, mu_i),
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -655,6 +719,97 @@ mod tests {
                         bounded.0
                     );
                 }
+            }
+        }
+    }
+
+    /// The oblique shape's probe guide leans the way S does: over 64 azimuths of x_i at a
+    /// fixed distance from x_o, the guided azimuth density (`het_estimate::azimuth`) rises
+    /// and falls with S, for light at 60° with the view along the normal (the incident side's
+    /// factor), the view at 60° with light along the normal (the exit side's) and both
+    /// (correlation above 0.9; a guide about the opposite direction correlates negatively).
+    /// Without the shape there is no guide, and `toward_light` is not called.
+    #[test]
+    fn shift_guide_leans_the_way_s_does() {
+        use het_estimate::azimuth::AzimuthDensity;
+        let c = het_estimate::Coefficients::grey(0.01, 1.0);
+        let medium = MediumField::homogeneous(c).expect("a medium");
+        let make = |shape: bool| {
+            let material = Translucent {
+                oblique_shape: shape,
+                ..Translucent::new("m", medium.clone(), 0.0, 1.0)
+            };
+            BssrdfObject::new(
+                &material,
+                Some(ProfileModel::Tabulated),
+                Scattering::Multiple,
+                Estimator::JensenOut,
+                400.0,
+            )
+            .expect("a BSSRDF")
+        };
+        let plain = make(false);
+        assert!(
+            plain
+                .shift_guide(c, DVec3::Z, DVec3::Z, || panic!("called without the shape"))
+                .is_none()
+        );
+        let b = make(true);
+        let at60 = |x: f64| DVec3::new(x * 60f64.to_radians().sin(), 0.0, 60f64.to_radians().cos());
+        let correlation = |a: &[f64], b: &[f64]| {
+            let n = a.len() as f64;
+            let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+            let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+            let va: f64 = a.iter().map(|x| (x - ma) * (x - ma)).sum();
+            let vb: f64 = b.iter().map(|y| (y - mb) * (y - mb)).sum();
+            cov / (va * vb).sqrt()
+        };
+        for (light, view) in [
+            (at60(1.0), DVec3::Z),
+            (DVec3::Z, at60(-1.0)),
+            (at60(1.0), at60(0.5)),
+        ] {
+            let (light, view) = (light.normalize(), view.normalize());
+            let guide = b
+                .shift_guide(c, view, DVec3::Z, || Some(light))
+                .expect("a guide with the shape");
+            for r in [1.0, 4.0] {
+                let angle = |d: DVec3| d.y.atan2(d.x);
+                let [a0, a1] = guide.amplitudes(0, r);
+                let [d0, d1] = guide.directions();
+                let factors = |flip: f64| {
+                    let mut f = Vec::new();
+                    for (d, a) in [(d0, a0), (d1, a1)] {
+                        if d.length() > 0.0 {
+                            f.push((angle(flip * d), a));
+                        }
+                    }
+                    f
+                };
+                let (guided, opposite) = (
+                    AzimuthDensity::new(&factors(1.0)),
+                    AzimuthDensity::new(&factors(-1.0)),
+                );
+                let phis: Vec<f64> = (0..64)
+                    .map(|k| (k as f64 + 0.5) * std::f64::consts::TAU / 64.0)
+                    .collect();
+                let x_o = Crossing::new(DVec3::ZERO, DVec3::Z, view);
+                let s: Vec<f64> = phis
+                    .iter()
+                    .map(|&phi| {
+                        let x_i = DVec3::new(r * phi.cos(), r * phi.sin(), 0.0);
+                        b.bssrdf
+                            .coupling_between(&c, &Crossing::new(x_i, DVec3::Z, light), &x_o)
+                            .0[0]
+                    })
+                    .collect();
+                let p: Vec<f64> = phis.iter().map(|&phi| guided.pdf(phi)).collect();
+                let q: Vec<f64> = phis.iter().map(|&phi| opposite.pdf(phi)).collect();
+                let (cp, cq) = (correlation(&p, &s), correlation(&q, &s));
+                assert!(
+                    cp > 0.9 && cq < 0.0,
+                    "light {light}, view {view}, r {r}: {cp} {cq}"
+                );
             }
         }
     }

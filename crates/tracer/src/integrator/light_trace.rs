@@ -306,7 +306,7 @@ impl<'s> LightTracer<'s> {
             object: x_i.object,
         };
         let mut set = crate::integrator::probe_gathering::ProbePoints::new();
-        let density = b.probe_points_into(&mut set, &surface, &x_i, at_xi, rng);
+        let density = b.probe_points_into(&mut set, &surface, &x_i, at_xi, None, rng);
         if set.is_empty() {
             counters.probe_misses += 1;
             return;

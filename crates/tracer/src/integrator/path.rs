@@ -37,6 +37,7 @@
 
 use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
+use het_estimate::azimuth::AzimuthGuide;
 use het_estimate::{CoefficientField, Estimator};
 
 use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
@@ -984,6 +985,20 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
+    /// A direction from `p` toward a light, for the oblique shape's probe guide
+    /// ([`BssrdfObject::shift_guide`]): one light chosen as next-event estimation chooses
+    /// surface lights, and one point or direction sampled on it (3 uniform numbers). `None`
+    /// where that light has no sample at `p` (behind a quad, a beam) or there is no light.
+    /// Any choice keeps the render unbiased (the probe density is the one conditioned on
+    /// it); a light the integrand does not lean toward only spends the guided half of the
+    /// azimuths.
+    fn light_direction_guess(&self, p: DVec3, rng: &mut Rng) -> Option<DVec3> {
+        let u = rng.uniform();
+        let u2 = rng.uniform2();
+        let i = self.lights(Vertex::Surface).select(u)?;
+        self.scene.lights()[i].sample_li(p, u2).map(|ls| ls.wi)
+    }
+
     /// Next-event estimation from the vertex `v`: one light chosen uniformly, its sample
     /// weighted by `f(wi)` (BSDF·cos or phase value) and MIS against `pdf(wi)` (the direction
     /// sampler's pdf), times the transmittance per channel of the shadow ray from
@@ -1560,7 +1575,12 @@ impl<'s> PathIntegrator<'s> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);
         let mut set = crate::integrator::probe_gathering::ProbePoints::new();
-        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, st.rng);
+        // Only with the oblique shape: draws 3 numbers, so renders without it are unchanged.
+        let guide = b.shift_guide(at_xo, v.w_o, v.n_o, || {
+            self.light_direction_guess(hit.p, st.rng)
+        });
+        let guide = guide.as_ref().map(|g| g as &dyn AzimuthGuide);
+        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide, st.rng);
         st.counters.probe_sets += 1;
         if set.is_empty() {
             st.counters.probe_misses += 1;

@@ -6,6 +6,7 @@
 use bssrdf_core::ProfileFamily;
 use glam::DVec3;
 use het_estimate::Coefficients;
+use het_estimate::azimuth::AzimuthGuide;
 use het_estimate::probe::{self as lib, ProbeChords};
 
 pub use het_estimate::probe::{MAX_PROBE_HITS, PROBE_ENERGY_FRACTION};
@@ -42,18 +43,18 @@ impl ProbeSampler {
         lib::probe_within(chords, x_o, coeffs, &self.0, max_radius, rng)
     }
 
-    /// The same probes without the weights ([`lib::probe_points_within_into`]): the points
-    /// into `points`, and the density that weights each on demand.
-    pub(crate) fn probe_points_into<C: ProbeChords<Point = Hit>>(
-        &self,
-        points: &mut ProbePoints,
-        chords: &C,
+    /// The same probes without the weights ([`lib::probe_points_within_into`]): the density
+    /// of the probes around `x_o`, radii capped at `max_radius`, the normal probe's azimuth
+    /// drawn from `guide` where there is one ([`lib::ProbeDensity::around`]); its
+    /// `trace_into` traces them and weights each point on demand.
+    pub(crate) fn density_around<'a>(
+        &'a self,
         x_o: &Hit,
         coeffs: Coefficients,
         max_radius: f64,
-        rng: &mut Rng,
-    ) -> lib::ProbeDensity<'_> {
-        lib::probe_points_within_into(points, chords, x_o, coeffs, &self.0, max_radius, rng)
+        guide: Option<&'a dyn AzimuthGuide>,
+    ) -> lib::ProbeDensity<'a> {
+        lib::ProbeDensity::around(x_o, coeffs, &self.0, max_radius, guide)
     }
 }
 
