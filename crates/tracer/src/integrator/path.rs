@@ -987,16 +987,15 @@ impl<'s> PathIntegrator<'s> {
 
     /// A direction from `p` toward a light, for the oblique shape's probe guide
     /// ([`BssrdfObject::shift_guide`]): one light chosen as next-event estimation chooses
-    /// surface lights, and one point or direction sampled on it (3 uniform numbers). `None`
-    /// where that light has no sample at `p` (behind a quad, a beam) or there is no light.
-    /// Any choice keeps the render unbiased (the probe density is the one conditioned on
-    /// it); a light the integrand does not lean toward only spends the guided half of the
-    /// azimuths.
+    /// surface lights (one uniform number), and the direction toward its centre
+    /// ([`Light::centre_direction`]). `None` for a light without a centre (an environment) or
+    /// without light at `p` (behind a quad), and where there is no light. Any choice keeps
+    /// the render unbiased (the probes' density is the one given the guide, and it is
+    /// positive at every azimuth); a guide the integrand does not lean toward only wastes
+    /// the guided half of the azimuths.
     fn light_direction_guess(&self, p: DVec3, rng: &mut Rng) -> Option<DVec3> {
-        let u = rng.uniform();
-        let u2 = rng.uniform2();
-        let i = self.lights(Vertex::Surface).select(u)?;
-        self.scene.lights()[i].sample_li(p, u2).map(|ls| ls.wi)
+        let i = self.lights(Vertex::Surface).select(rng.uniform())?;
+        self.scene.lights()[i].centre_direction(p)
     }
 
     /// Next-event estimation from the vertex `v`: one light chosen uniformly, its sample
@@ -1575,7 +1574,7 @@ impl<'s> PathIntegrator<'s> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);
         let mut set = crate::integrator::probe_gathering::ProbePoints::new();
-        // Only with the oblique shape: draws 3 numbers, so renders without it are unchanged.
+        // Only with the oblique shape: draws a number, so renders without it are unchanged.
         let guide = b.shift_guide(at_xo, v.w_o, v.n_o, || {
             self.light_direction_guess(hit.p, st.rng)
         });
