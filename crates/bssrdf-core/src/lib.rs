@@ -85,7 +85,7 @@ pub use model::{ProfileModel, Scattering};
 pub use profile::RadialProfile;
 pub use rgb::Rgb;
 pub use rgb_profile::RgbProfile;
-pub use separable::{Crossing, SeparableBssrdf};
+pub use separable::{Crossing, SeparableBssrdf, ShiftSeries};
 pub use slab_profile::SlabProfile;
 pub use table::{ProfileTable, RadiusSampler};
 pub use tabulated::SlabFace;

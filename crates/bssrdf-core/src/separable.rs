@@ -109,6 +109,47 @@ impl Crossing {
     }
 }
 
+/// One channel's forward shift ([`SeparableBssrdf::shift_series`]) at the oblique shape's
+/// radial nodes: [`SeparableBssrdf::shift_amplitudes`] is linear in the radius's weight
+/// between the two nodes [`ShiftSeries::node`] names, and [`ShiftSeries::amplitudes_at`]
+/// gives each node's amplitudes, so a caller can read each node once and interpolate itself.
+#[derive(Debug, Clone, Copy)]
+pub struct ShiftSeries<'a> {
+    shape: &'a ObliqueShape,
+    /// The channel's reduced albedo α' (unitless).
+    alpha: f64,
+    /// The channel's reduced extinction σt' (1/length).
+    sigma_tp: f64,
+}
+
+impl ShiftSeries<'_> {
+    /// The radial nodes around distance `r` (length): the lower node k and the weight
+    /// w ∈ [0, 1] of node k + 1 ([`ObliqueShape::radial_node`] at σt' r); k + 1 <
+    /// [`crate::tabulated::oblique_file::N_RADII`]. NaN gives (0, 0).
+    pub fn node(&self, r: f64) -> (usize, f64) {
+        ObliqueShape::radial_node(self.sigma_tp * r)
+    }
+
+    /// Both sides' amplitudes a_n = C_n · sinⁿθ_side (n = 1, 2, 3; unitless, finite) at
+    /// radial node `node`, as [`SeparableBssrdf::shift_amplitudes`] at that node's radius:
+    /// `[incident side, exit side]` of light entering at cosine `cos_i` and leaving at
+    /// `cos_o`. 0 for non-finite cosines.
+    pub fn amplitudes_at(&self, node: usize, cos_i: f64, cos_o: f64) -> [[f64; 3]; 2] {
+        let k = self.shape.shifts_at_node(self.alpha, node, cos_i, cos_o);
+        let scale = |side_cos: f64, k: [f64; 3]| {
+            let q = (1.0 - side_cos * side_cos).max(0.0);
+            let s = q.sqrt();
+            let a = [k[0] * s, k[1] * q, k[2] * q * s];
+            if a.iter().all(|v| v.is_finite()) {
+                a
+            } else {
+                [0.0; 3]
+            }
+        };
+        [scale(cos_i, k[0]), scale(cos_o, k[1])]
+    }
+}
+
 /// A prepared separable BSSRDF (see the module docs): the profile family, the Fresnel
 /// normalisation c and, for the tabulated profile, its angular coupling. Build once per
 /// material (the coupling costs about a millisecond); evaluation allocates nothing.
@@ -337,12 +378,19 @@ impl SeparableBssrdf {
             (incident.normal * cos_i - incident.direction).length_squared(),
             (exitant.normal * cos_o - exitant.direction).length_squared(),
         );
-        Rgb(std::array::from_fn(|ch| {
+        // The product of the two sides' factors, formed before it meets T and M; a channel
+        // whose shift coefficients equal the previous one's reuses its product.
+        let mut sides = [0.0; 3];
+        for ch in 0..3 {
             let p = &pf[ch];
-            // The product of the two sides' factors, formed before it meets T and M.
-            let sides = side_factor(&p.incident, &h_i, q_i) * side_factor(&p.exitant, &h_o, q_o);
-            tt[ch] * p.m * sides
-        }))
+            sides[ch] =
+                if ch > 0 && p.incident == pf[ch - 1].incident && p.exitant == pf[ch - 1].exitant {
+                    sides[ch - 1]
+                } else {
+                    side_factor(&p.incident, &h_i, q_i) * side_factor(&p.exitant, &h_o, q_o)
+                };
+        }
+        Rgb(std::array::from_fn(|ch| tt[ch] * pf[ch].m * sides[ch]))
     }
 
     /// One side's forward-shift amplitudes a_n = C_n(σt' r; α', μ_side → μ_other) · sinⁿθ_side
@@ -382,6 +430,22 @@ impl SeparableBssrdf {
         } else {
             [0.0; 3]
         }
+    }
+
+    /// The forward shift of channel `channel` of `c` read node by node
+    /// ([`ShiftSeries`]): what a probe sampler that draws azimuths from the shift caches
+    /// around one x_o. `None` without the oblique shape, for a channel that does not scatter
+    /// and for invalid coefficients.
+    pub fn shift_series(&self, c: &Coefficients, channel: usize) -> Option<ShiftSeries<'_>> {
+        let shape = self.oblique.as_ref()?;
+        let ch = channel.min(2);
+        let reduced = self.family.reduced_of(c.sigma_a[ch], c.sigma_s[ch]).ok()?;
+        let alpha = reduced.albedo?;
+        (alpha.is_finite() && reduced.sigma_tp.is_finite()).then_some(ShiftSeries {
+            shape,
+            alpha,
+            sigma_tp: reduced.sigma_tp,
+        })
     }
 
     /// S from its parts: the profile value `rd` (1/length², per channel; R(r), or another
@@ -505,6 +569,49 @@ mod tests {
         let plain = b.clone().with_oblique_shape(false);
         assert_eq!(plain.shift_amplitudes(&c, 0, 1.0, c60, 1.0), [0.0; 3]);
         assert_eq!(b.shift_amplitudes(&c, 0, f64::NAN, c60, 1.0), [0.0; 3]);
+    }
+
+    /// A shift series read node by node and interpolated with its node's weight gives
+    /// `shift_amplitudes` at every radius (both sides, every channel, radii from inside the
+    /// first node to beyond the last), to rounding; without the oblique shape there is none.
+    #[test]
+    fn shift_series_interpolates_to_the_shift_amplitudes() {
+        let b = SeparableBssrdf::new(ProfileModel::Tabulated, Scattering::All, 0.2, 1.3).unwrap();
+        let c = Coefficients::new(Rgb::new(0.01, 0.05, 0.3), Rgb::new(2.0, 1.0, 3.0));
+        let (ci, co) = (0.35, 0.8);
+        let mut nodes = std::collections::BTreeSet::new();
+        for ch in 0..3 {
+            let s = b.shift_series(&c, ch).expect("a scattering channel");
+            for k in 0..200 {
+                let r = 1e-3 * 1.06f64.powi(k);
+                let (node, w) = s.node(r);
+                assert!(
+                    node + 1 < crate::tabulated::oblique_file::N_RADII && (0.0..=1.0).contains(&w)
+                );
+                nodes.insert(node);
+                for (side, (this, other)) in [(ci, co), (co, ci)].into_iter().enumerate() {
+                    let (lo, hi) = (
+                        s.amplitudes_at(node, ci, co)[side],
+                        s.amplitudes_at(node + 1, ci, co)[side],
+                    );
+                    let want = b.shift_amplitudes(&c, ch, r, this, other);
+                    for n in 0..3 {
+                        let got = (1.0 - w) * lo[n] + w * hi[n];
+                        assert!(
+                            (got - want[n]).abs() <= 1e-12 * (1.0 + want[n].abs()),
+                            "{ch} {r} {n}: {got} vs {want:?}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(nodes.len() >= 10, "radii cover too few nodes: {nodes:?}");
+        assert!(
+            b.clone()
+                .with_oblique_shape(false)
+                .shift_series(&c, 0)
+                .is_none()
+        );
     }
 
     /// `from_family_with` builds what `from_family` and the `with_*` switches would keep,

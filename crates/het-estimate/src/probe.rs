@@ -83,17 +83,19 @@
 //! of magnitude, and the carried factor `Σ w / w_k` stays near the set's own estimate.
 //!
 //! # Guided azimuths
-//! [`ProbeDensity::around`] takes an optional [`AzimuthGuide`]: the preferred azimuthal
-//! shape of the integrand about x_o, per channel and radius (the oblique shape's forward
-//! shift, docs/oblique-incidence.md). The normal probe then draws its azimuth, after its
-//! channel and radius, from the channel's [`AzimuthDensity`] at that radius (a defensive
-//! mixture of the guide's shape and the uniform azimuth), and the normal axis's term of
-//! `p_a(x)` carries that density in place of 1/(2π):
+//! [`ProbeDensity::around`] takes an optional [`GuidedAzimuths`]: an
+//! [`crate::azimuth::AzimuthGuide`] at x_o, the preferred azimuthal shape of the integrand
+//! about x_o at radial nodes (the oblique shape's forward shift, docs/oblique-incidence.md).
+//! The normal probe then draws its azimuth, after its channel and radius, from the guided
+//! density at that radius (a defensive mixture of the guide's shape and the uniform azimuth;
+//! [`crate::azimuth`]), and the normal axis's term of `p_a(x)` carries that density in place
+//! of 1/(2π):
 //!
-//! `p_n(x) = (1/3) Σ_c [|x − x_o| < r_max,c] · p_r,c(r_n) · p_φ,c(φ | r_n) / r_n · |n_g(x) · n|`,
+//! `p_n(x) = (1/3) Σ_c [|x − x_o| < r_max,c] · p_r,c(r_n) · p_φ(φ | r_n) / r_n · |n_g(x) · n|`,
 //!
-//! φ the azimuth of x about x_o in its frame. Channels that share a radial density share the
-//! first one's guide. The tangent probes keep the uniform azimuth. `None` is
+//! φ the azimuth of x about x_o in its frame. The azimuth's density is the same for every
+//! channel (one guide; the channel chooses the radius), so it is read once per point. The
+//! tangent probes keep the uniform azimuth. `None` is
 //! [`probe_points_within_into`], draw for draw and bit for bit. Test:
 //! `guided_azimuths_keep_the_estimate_unbiased`.
 //!
@@ -166,7 +168,7 @@ use std::cell::Cell;
 use bssrdf_core::{ProfileFamily, ProfileTable, RadialProfile, RadiusSampler};
 use glam::DVec3;
 
-use crate::azimuth::{AzimuthDensity, AzimuthGuide};
+use crate::azimuth::GuidedAzimuths;
 use crate::frame::orthonormal_basis;
 use crate::{Coefficients, FieldBounds, SurfacePoint, UniformSource};
 
@@ -351,11 +353,7 @@ impl ProbeSampler {
                         ),
                     });
         }
-        Channels {
-            channel,
-            count,
-            first,
-        }
+        Channels { channel, count }
     }
 
     /// The table searches of channel `ch` at coefficients `c` with radius cap `cap` (see
@@ -416,8 +414,6 @@ impl ProbeSampler {
 struct Channels<'a> {
     channel: [Option<ChannelDensity<'a>>; 3],
     count: [u8; 3],
-    /// The channel whose density each channel shares (itself, or an earlier one).
-    first: [usize; 3],
 }
 
 /// One channel's sampling density: its radial density, its probe radius, and, on an object
@@ -640,10 +636,8 @@ pub struct ProbeDensity<'s> {
     /// where they went by roulette, else 1 (set by [`ProbeDensity::trace`] once the normal
     /// probe is traced; module docs, "Tangent probes by roulette").
     tangent_rate: Cell<f64>,
-    /// The normal probe's azimuthal guide and the angles of its two directions in x_o's frame
-    /// (from the first tangent toward the second; NaN for a direction left out); `None`: the
-    /// uniform azimuth.
-    guide: Option<(&'s dyn AzimuthGuide, [f64; 2])>,
+    /// The normal probe's azimuthal guide at x_o; `None`: the uniform azimuth.
+    guide: Option<&'s GuidedAzimuths<'s>>,
 }
 
 impl<'s> ProbeDensity<'s> {
@@ -656,21 +650,10 @@ impl<'s> ProbeDensity<'s> {
         coeffs: Coefficients,
         sampler: &'s ProbeSampler,
         max_radius: f64,
-        guide: Option<&'s dyn AzimuthGuide>,
+        guide: Option<&'s GuidedAzimuths<'s>>,
     ) -> Self {
         let channels = sampler.channels(coeffs, max_radius);
         let frame = Frame::new(x_o.normal());
-        let guide = guide.and_then(|g| {
-            let angles = g.directions().map(|d| {
-                let (x, y) = (d.dot(frame.s), d.dot(frame.t));
-                if x.is_finite() && y.is_finite() && (x != 0.0 || y != 0.0) {
-                    y.atan2(x)
-                } else {
-                    f64::NAN
-                }
-            });
-            angles.iter().any(|a| a.is_finite()).then_some((g, angles))
-        });
         let projection = channels
             .channel
             .iter()
@@ -770,15 +753,10 @@ impl<'s> ProbeDensity<'s> {
             (dl.x * dl.x + dl.y * dl.y).sqrt(),
         ];
         let mut pdf = [0.0; 3];
-        // The normal probe's azimuth about x_o in its frame.
-        let guided_phi = self.guide.map(|_| dl.y.atan2(dl.x));
-        for (k, (channel, &count)) in self
-            .channels
-            .channel
-            .iter()
-            .zip(&self.channels.count)
-            .enumerate()
-        {
+        // The normal probe's guided azimuth density at x (the same for every channel), read
+        // when a channel first needs it.
+        let mut guided = None;
+        for (channel, &count) in self.channels.channel.iter().zip(&self.channels.count) {
             let Some(c) = channel else {
                 continue;
             };
@@ -806,9 +784,10 @@ impl<'s> ProbeDensity<'s> {
                     };
                     // The azimuth's density: 1/(2π) in `share`, or the guide's (module docs,
                     // "Guided azimuths").
-                    let share = match (axis, self.guide, guided_phi) {
-                        (2, Some((g, angles)), Some(phi)) => {
-                            f64::from(count) / 3.0 * guided_density(g, angles, k, r).pdf(phi)
+                    let share = match (axis, self.guide) {
+                        (2, Some(g)) => {
+                            let p_phi = *guided.get_or_insert_with(|| g.pdf(r, dl.y.atan2(dl.x)));
+                            f64::from(count) / 3.0 * p_phi
                         }
                         _ => share,
                     };
@@ -868,10 +847,7 @@ impl<'s> ProbeDensity<'s> {
                 continue;
             }
             let (sin, cos) = match self.guide {
-                Some((g, angles)) if axis == ProbeAxis::N => {
-                    let first = self.channels.first[ch];
-                    guided_density(g, angles, first, r).sample(u_phi).sin_cos()
-                }
+                Some(g) if axis == ProbeAxis::N => g.sample(r, u_phi).sin_cos(),
                 _ => crate::sampling::sin_cos_turn(u_phi),
             };
             let (vx, vy, vz) = self.frame.axes(axis);
@@ -886,18 +862,6 @@ impl<'s> ProbeDensity<'s> {
             normal_found |= axis == ProbeAxis::N && kept > 0;
         }
     }
-}
-
-/// The guided azimuthal density of channel `channel` at projected radius `r` (length), the
-/// guide's directions at `angles` in x_o's frame.
-fn guided_density(
-    g: &dyn AzimuthGuide,
-    angles: [f64; 2],
-    channel: usize,
-    r: f64,
-) -> AzimuthDensity {
-    let a = g.amplitudes(channel, r);
-    AzimuthDensity::new(&[(angles[0], a[0]), (angles[1], a[1])])
 }
 
 /// [`probe_within_into`] without the weights: the same probes, draw for draw, and every
@@ -1211,15 +1175,24 @@ mod tests {
         assert!(se < 0.015 * want, "test too weak: {mean} ± {se} of {want}");
     }
 
-    /// A guide whose amplitudes change with the channel and the radius (strong enough for
-    /// the series to be clamped near x_o).
+    /// A guide whose amplitudes change with the radius (strong enough for
+    /// the series to be clamped near x_o): nodes at radii 0.25 · 1.5^k, the nearest in ln r.
     struct TestGuide;
-    impl AzimuthGuide for TestGuide {
+    impl TestGuide {
+        fn node_radius(node: usize) -> f64 {
+            0.25 * 1.5f64.powi(node as i32)
+        }
+    }
+    impl crate::azimuth::AzimuthGuide for TestGuide {
         fn directions(&self) -> [DVec3; 2] {
             [DVec3::new(0.6, -0.8, 0.3), DVec3::new(-0.8, -0.6, 0.0)]
         }
-        fn amplitudes(&self, channel: usize, r: f64) -> [[f64; 3]; 2] {
-            let k = 1.0 + channel as f64;
+        fn radial_node(&self, r: f64) -> usize {
+            ((r / 0.25).ln() / 1.5f64.ln()).round().max(0.0) as usize
+        }
+        fn amplitudes(&self, node: usize) -> [[f64; 3]; 2] {
+            let k = 2.0;
+            let r = Self::node_radius(node);
             [
                 [0.8 + 1.5 * (-r / (4.0 * k)).exp(), 0.6, -0.3 * k],
                 [0.5 * (-r / 8.0).exp(), 0.0, 0.2],
@@ -1255,11 +1228,12 @@ mod tests {
             let want = std::f64::consts::TAU * ell * ell * ((1.0 - e(big_r)) + (e(h) - e(big_r)));
             let x_o = P(DVec3::ZERO, DVec3::Z);
             let g = TestGuide;
+            let g = GuidedAzimuths::new(&g, &x_o).expect("the guide's directions project");
             let toward = DVec3::new(0.6, -0.8, 0.0).normalize();
             let mut rng = SplitMix64::new(12 + case as u64);
             let mut points = ProbePoints::new();
             let (mut unguided, mut guided) = (0.0, 0.0);
-            let mut run = |guide: Option<&dyn AzimuthGuide>, rng: &mut SplitMix64| {
+            let mut run = |guide: Option<&GuidedAzimuths>, rng: &mut SplitMix64| {
                 mean_se(100_000, || {
                     let d = ProbeDensity::around(&x_o, c, &sampler, f64::INFINITY, guide);
                     d.trace_into(&mut points, &Slab(h), rng);
@@ -1280,10 +1254,7 @@ mod tests {
                         .sum()
                 })
             };
-            for (guide, out) in [
-                (None, &mut unguided),
-                (Some(&g as &dyn AzimuthGuide), &mut guided),
-            ] {
+            for (guide, out) in [(None, &mut unguided), (Some(&g), &mut guided)] {
                 let (mean, se) = run(guide, &mut rng);
                 assert!(
                     (mean - want).abs() < 4.0 * se,

@@ -250,6 +250,52 @@ impl ObliqueShape {
         self.pair([alpha], [x], mu_i, mu_o)[0].incident
     }
 
+    /// Where `x` mean free paths (σt' r) falls among the forward shift's radial nodes: the
+    /// lower node k and the weight w ∈ [0, 1] of node k + 1, k + 1 < [`N_RADII`]; [`Self::shift`]
+    /// is linear in w between the two nodes' values ([`Self::shifts_at_node`]) and constant
+    /// beyond the outer nodes. NaN and x ≤ 0 give (0, 0).
+    pub fn radial_node(x: f64) -> (usize, f64) {
+        radial_position(x.max(0.0).ln())
+    }
+
+    /// Both sides' C_n at radial node `node` (clamped to the last): `(shift(α, x, μ_i, μ_o),
+    /// shift(α, x, μ_o, μ_i))` at that node's radius x (unitless, finite, |C_n| ≤ [`C_MAX`]),
+    /// the row and cells found once. What a caller that reads the shift node by node needs
+    /// (the probes' azimuthal guide). Non-finite arguments give 0.
+    pub fn shifts_at_node(
+        &self,
+        alpha: f64,
+        node: usize,
+        mu_i: f64,
+        mu_o: f64,
+    ) -> [[f64; N_HARMONICS]; 2] {
+        if !(alpha.is_finite() && mu_i.is_finite() && mu_o.is_finite()) {
+            return [[0.0; N_HARMONICS]; 2];
+        }
+        let node = node.min(N_RADII - 1);
+        let (ci, co) = (cell(mu_i), cell(mu_o));
+        let (r0, fr) = row_position(alpha, N_ROWS);
+        let mut out = [[0.0; N_HARMONICS]; 2];
+        for (r, wr) in [(r0, 1.0 - fr), (r0 + 1, fr)] {
+            if wr == 0.0 {
+                continue;
+            }
+            let base = r * N_MU * N_MU;
+            for (side, ((j, fj), (k, fk))) in [(ci, co), (co, ci)].into_iter().enumerate() {
+                for (a, wa) in [(j, 1.0 - fj), (j + 1, fj)] {
+                    for (c, wc) in [(k, 1.0 - fk), (k + 1, fk)] {
+                        let at = ((base + a * N_MU + c) * N_RADII + node) * N_HARMONICS;
+                        let w = wr * wa * wc;
+                        for (h, o) in out[side].iter_mut().enumerate() {
+                            *o += w * f64::from(self.c[at + h]);
+                        }
+                    }
+                }
+            }
+        }
+        out.map(clean_shift)
+    }
+
     /// M and both sides' shift coefficients for several channels (albedo and optical radius
     /// each) at the same pair of cosines: the cells are found once, each channel's row and
     /// radial position once, and a channel equal to the previous one reuses its values.
@@ -299,19 +345,10 @@ impl ObliqueShape {
                         exitant[h] += wr * b[h];
                     }
                 }
-                let clean = |c: [f64; N_HARMONICS]| {
-                    c.map(|v| {
-                        if v.is_finite() {
-                            v.clamp(-C_MAX, C_MAX)
-                        } else {
-                            0.0
-                        }
-                    })
-                };
                 PairFactors {
                     m: if m.is_finite() { m.max(0.0) } else { 1.0 },
-                    incident: clean(incident),
-                    exitant: clean(exitant),
+                    incident: clean_shift(incident),
+                    exitant: clean_shift(exitant),
                 }
             } else {
                 PairFactors::NEUTRAL
@@ -345,6 +382,17 @@ impl ObliqueShape {
         }
         out
     }
+}
+
+/// Shift coefficients clamped to ±[`C_MAX`], a non-finite one 0.
+fn clean_shift(c: [f64; N_HARMONICS]) -> [f64; N_HARMONICS] {
+    c.map(|v| {
+        if v.is_finite() {
+            v.clamp(-C_MAX, C_MAX)
+        } else {
+            0.0
+        }
+    })
 }
 
 /// The mass of the unordered incidence/exit pair {j, k} at `data_row` (`(data_row, j, k)`)

@@ -37,7 +37,7 @@
 
 use bssrdf_core::{ProfileModel, Rgb, Scattering};
 use glam::DVec3;
-use het_estimate::azimuth::AzimuthGuide;
+use het_estimate::azimuth::GuidedAzimuths;
 use het_estimate::{CoefficientField, Estimator};
 
 use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
@@ -1578,8 +1578,8 @@ impl<'s> PathIntegrator<'s> {
         let guide = b.shift_guide(at_xo, v.w_o, v.n_o, || {
             self.light_direction_guess(hit.p, st.rng)
         });
-        let guide = guide.as_ref().map(|g| g as &dyn AzimuthGuide);
-        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide, st.rng);
+        let guide = guide.as_ref().and_then(|g| GuidedAzimuths::new(g, hit));
+        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide.as_ref(), st.rng);
         st.counters.probe_sets += 1;
         if set.is_empty() {
             st.counters.probe_misses += 1;

@@ -6,7 +6,7 @@
 use bssrdf_core::ProfileFamily;
 use glam::DVec3;
 use het_estimate::Coefficients;
-use het_estimate::azimuth::AzimuthGuide;
+use het_estimate::azimuth::GuidedAzimuths;
 use het_estimate::probe::{self as lib, ProbeChords};
 
 pub use het_estimate::probe::{MAX_PROBE_HITS, PROBE_ENERGY_FRACTION};
@@ -52,7 +52,7 @@ impl ProbeSampler {
         x_o: &Hit,
         coeffs: Coefficients,
         max_radius: f64,
-        guide: Option<&'a dyn AzimuthGuide>,
+        guide: Option<&'a GuidedAzimuths<'a>>,
     ) -> lib::ProbeDensity<'a> {
         lib::ProbeDensity::around(x_o, coeffs, &self.0, max_radius, guide)
     }
