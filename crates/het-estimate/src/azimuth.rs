@@ -50,8 +50,8 @@ pub trait AzimuthGuide {
 }
 
 /// An [`AzimuthGuide`] at one x_o, ready for the probes ([`crate::probe::ProbeDensity::around`]):
-/// the guide's directions as angles in x_o's frame, and the last few node shapes it was read
-/// at, each with its normalisation (a probe set samples one node's azimuth and
+/// the cosines of each bin's midpoint about the guide's directions in x_o's frame, and the
+/// last few node shapes it was read at, each with its normalisation (a probe set samples one node's azimuth and
 /// then reads its density at the point found: one shape per set where the normal probe finds
 /// one point). Built by the caller once per x_o, on its stack (under 1 KB).
 pub struct GuidedAzimuths<'g> {
