@@ -18,8 +18,9 @@ fn an_interrupted_study_keeps_the_runs_it_finished() {
     let scene = dir.path().join("s.toml");
     std::fs::write(&scene, common::MINIMAL).unwrap();
     let out = dir.path().join("conv");
-    // A long study: path tracing at doubling budgets up to 2^22 spp (many minutes; it is
-    // stopped after its first runs).
+    // A long study: path tracing at doubling budgets up to 2^30 spp (over an hour on this
+    // 8 × 8 scene; it is stopped after its first runs). Up to 2^22, as before, it took 20 s
+    // in all, so on a loaded machine it could finish before the signal arrived.
     let mut child = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"))
         .arg("converge")
         .arg(&scene)
@@ -29,7 +30,7 @@ fn an_interrupted_study_keeps_the_runs_it_finished() {
             "--reference-spp",
             "2",
             "--max-spp",
-            "4194304",
+            "1073741824",
         ])
         .arg("--cache-dir")
         .arg(dir.path().join("cache"))
@@ -50,6 +51,10 @@ fn an_interrupted_study_keeps_the_runs_it_finished() {
         std::thread::sleep(Duration::from_millis(50));
     }
     let kept = rows(&csv);
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the study ended before it was interrupted"
+    );
     Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()
