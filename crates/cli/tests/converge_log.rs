@@ -55,8 +55,11 @@ fn an_interrupted_study_keeps_the_runs_it_finished() {
         child.try_wait().unwrap().is_none(),
         "the study ended before it was interrupted"
     );
+    // SIGTERM, not SIGINT: a shell without job control starts background commands with
+    // SIGINT ignored, and the child inherits that, so under `cmd &` (a CI script run in the
+    // background) a SIGINT never reached the study, which then ran to its end.
     Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args(["-TERM", &child.id().to_string()])
         .status()
         .unwrap();
     let status = child.wait().unwrap();
