@@ -136,17 +136,20 @@ impl ShiftSeries<'_> {
     /// `cos_o`. 0 for non-finite cosines.
     pub fn amplitudes_at(&self, node: usize, cos_i: f64, cos_o: f64) -> [[f64; 3]; 2] {
         let k = self.shape.shifts_at_node(self.alpha, node, cos_i, cos_o);
-        let scale = |side_cos: f64, k: [f64; 3]| {
-            let q = (1.0 - side_cos * side_cos).max(0.0);
-            let s = q.sqrt();
-            let a = [k[0] * s, k[1] * q, k[2] * q * s];
-            if a.iter().all(|v| v.is_finite()) {
-                a
-            } else {
-                [0.0; 3]
-            }
-        };
-        [scale(cos_i, k[0]), scale(cos_o, k[1])]
+        [side_amplitudes(cos_i, k[0]), side_amplitudes(cos_o, k[1])]
+    }
+}
+
+/// One side's amplitudes a_n = C_n · sinⁿθ (n = 1, 2, 3) from its shift coefficients `c` and
+/// cosine `side_cos`; 0 where any is not finite.
+fn side_amplitudes(side_cos: f64, c: [f64; 3]) -> [f64; 3] {
+    let q = (1.0 - side_cos * side_cos).max(0.0);
+    let s = q.sqrt();
+    let a = [c[0] * s, c[1] * q, c[2] * q * s];
+    if a.iter().all(|v| v.is_finite()) {
+        a
+    } else {
+        [0.0; 3]
     }
 }
 
@@ -421,15 +424,10 @@ impl SeparableBssrdf {
         let Some(alpha) = reduced.albedo else {
             return [0.0; 3];
         };
-        let q = (1.0 - side_cos * side_cos).max(0.0);
-        let s = q.sqrt();
-        let k = m.shift(alpha, reduced.sigma_tp * r, side_cos, other_cos);
-        let a = [k[0] * s, k[1] * q, k[2] * q * s];
-        if a.iter().all(|v| v.is_finite()) {
-            a
-        } else {
-            [0.0; 3]
-        }
+        side_amplitudes(
+            side_cos,
+            m.shift(alpha, reduced.sigma_tp * r, side_cos, other_cos),
+        )
     }
 
     /// The forward shift of channel `channel` of `c` read node by node

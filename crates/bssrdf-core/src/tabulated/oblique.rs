@@ -260,7 +260,7 @@ impl ObliqueShape {
 
     /// Both sides' C_n at radial node `node` (clamped to the last): `(shift(α, x, μ_i, μ_o),
     /// shift(α, x, μ_o, μ_i))` at that node's radius x (unitless, finite, |C_n| ≤ 8),
-    /// the row and cells found once. What a caller that reads the shift node by node needs
+    /// the row and cells found once (the cells read by [`Self::pair`]'s own lookup). What a caller that reads the shift node by node needs
     /// (the probes' azimuthal guide). Non-finite arguments give 0.
     pub fn shifts_at_node(
         &self,
@@ -272,7 +272,13 @@ impl ObliqueShape {
         if !(alpha.is_finite() && mu_i.is_finite() && mu_o.is_finite()) {
             return [[0.0; N_HARMONICS]; 2];
         }
-        let node = node.min(N_RADII - 1);
+        // shift_cells interpolates between radial nodes i and i + 1 with weight w: node k is
+        // (k, 0), the last node (N − 2, 1).
+        let (i, w) = if node + 1 < N_RADII {
+            (node, 0.0)
+        } else {
+            (N_RADII - 2, 1.0)
+        };
         let (ci, co) = (cell(mu_i), cell(mu_o));
         let (r0, fr) = row_position(alpha, N_ROWS);
         let mut out = [[0.0; N_HARMONICS]; 2];
@@ -281,15 +287,10 @@ impl ObliqueShape {
                 continue;
             }
             let base = r * N_MU * N_MU;
-            for (side, ((j, fj), (k, fk))) in [(ci, co), (co, ci)].into_iter().enumerate() {
-                for (a, wa) in [(j, 1.0 - fj), (j + 1, fj)] {
-                    for (c, wc) in [(k, 1.0 - fk), (k + 1, fk)] {
-                        let at = ((base + a * N_MU + c) * N_RADII + node) * N_HARMONICS;
-                        let w = wr * wa * wc;
-                        for (h, o) in out[side].iter_mut().enumerate() {
-                            *o += w * f64::from(self.c[at + h]);
-                        }
-                    }
+            for (side, (j, k)) in [(ci, co), (co, ci)].into_iter().enumerate() {
+                let c = self.shift_cells(base, j, k, i, w);
+                for (o, c) in out[side].iter_mut().zip(c) {
+                    *o += wr * c;
                 }
             }
         }

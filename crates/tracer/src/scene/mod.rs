@@ -155,7 +155,7 @@ pub struct Translucent {
     /// docs/oblique-incidence.md). Scene key `oblique_shape`; default false: with the shape on,
     /// renders under a local light are noisier at equal samples (the probes draw their radii
     /// from the normal-incidence profile; only their azimuths follow the shape) and take
-    /// 1.3–1.4 times as long.
+    /// about 1.2 times as long on a flat surface (docs/oblique-incidence.md).
     pub oblique_shape: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
     pub unit_scale: f64,
