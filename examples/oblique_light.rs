@@ -52,7 +52,13 @@ enum Lighting {
 const FAR: f64 = 100.0;
 const FAR_WIDTH: f64 = 30.0;
 
-fn scene(light: Lighting, sigma: (f64, f64), eta: f64) -> (Scene, f64) {
+fn scene(
+    light: Lighting,
+    sigma: (f64, f64),
+    eta: f64,
+    view_deg: Option<f64>,
+    shape: bool,
+) -> (Scene, f64) {
     let (sa, ss) = sigma;
     let field = MediumField::homogeneous(Coefficients::grey(sa, ss)).unwrap();
     let (camera, light, outside) = match light {
@@ -61,7 +67,12 @@ fn scene(light: Lighting, sigma: (f64, f64), eta: f64) -> (Scene, f64) {
             let towards = DVec3::new(t.sin(), 0.0, t.cos()); // from the surface to the light
             // Seen along the normal; at 0° with η ≠ 1, 20° off it, so that the distant quad's
             // mirror image (3 times the signal, and noisy in both renderers) is out of view.
-            let view = if deg == 0.0 && eta != 1.0 {
+            // `--view D`: seen D° off the normal, on the light's side for D > 0 (light leaving
+            // back toward where it came from) and on the far side for D < 0.
+            let view = if let Some(v) = view_deg {
+                let a = v.to_radians();
+                DVec3::new(-a.sin(), 0.0, -a.cos())
+            } else if deg == 0.0 && eta != 1.0 {
                 let a = 20f64.to_radians();
                 DVec3::new(-a.sin(), 0.0, -a.cos())
             } else {
@@ -113,7 +124,7 @@ fn scene(light: Lighting, sigma: (f64, f64), eta: f64) -> (Scene, f64) {
             primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
             // The oblique shape is opt-in (`oblique_shape = true` in a scene).
             Material::Translucent(Translucent {
-                oblique_shape: true,
+                oblique_shape: shape,
                 ..Translucent::new("m", field, 0.0, eta)
             }),
         )
@@ -172,6 +183,9 @@ fn main() {
         .map(|s| s.parse().expect("--pt-scale takes a factor"))
         .unwrap_or(1);
     let scale = if quick { 4 } else { 1 };
+    let view_deg: Option<f64> = arg("--view").map(|s| s.parse().expect("--view takes degrees"));
+    // `--shape both` adds a column with the oblique shape off (same seeds).
+    let both = arg("--shape").as_deref() == Some("both");
     let mut cases: Vec<(Lighting, f64, (f64, f64))> = Vec::new();
     if only.as_deref() != Some("quad") {
         let angles: Vec<f64> = arg("--angles")
@@ -186,12 +200,21 @@ fn main() {
     if only.as_deref() != Some("distant") {
         cases.push((Lighting::Quad, 1.0 / 1.01, (0.01, 1.0)));
     }
-    println!("| light | η | ϖ | PT | BSSRDF | BSSRDF/PT |");
-    println!("|---|---:|---:|---:|---:|---:|");
+    if both {
+        println!("| light | η | ϖ | PT | BSSRDF | BSSRDF/PT | shape off: BSSRDF/PT |");
+        println!("|---|---:|---:|---:|---:|---:|---:|");
+    } else {
+        println!("| light | η | ϖ | PT | BSSRDF | BSSRDF/PT |");
+        println!("|---|---:|---:|---:|---:|---:|");
+    }
     for &eta in &etas {
         for &(light, albedo, sigma) in &cases {
             let t0 = std::time::Instant::now();
-            let (scene, outside) = scene(light, sigma, eta);
+            let view = match light {
+                Lighting::Distant(_) => view_deg,
+                Lighting::Quad => None,
+            };
+            let (scene, outside) = scene(light, sigma, eta, view, true);
             let (spp_pt, spp_b) = match light {
                 Lighting::Distant(_) if eta == 1.0 => (4096, 1024),
                 Lighting::Distant(_) => (16384, 1024),
@@ -214,12 +237,29 @@ fn main() {
                 100..100 + seeds,
             );
             let (q, se) = ratio(b, pt);
+            let off = both.then(|| {
+                let (plain, _) = self::scene(light, sigma, eta, view, false);
+                let b = measure(
+                    &plain,
+                    bssrdf(ProfileModel::Tabulated),
+                    scattering,
+                    outside,
+                    spp_b / scale,
+                    100..100 + seeds,
+                );
+                ratio(b, pt)
+            });
             let label = match light {
                 Lighting::Distant(d) => format!("distant {d}°"),
                 Lighting::Quad => "4 × 4 quad".into(),
             };
+            let label = match view {
+                Some(v) => format!("{label}, seen at {v}°"),
+                None => label,
+            };
+            let off = off.map_or(String::new(), |(q, se)| format!(" {q:.3} ± {se:.3} |"));
             println!(
-                "| {label} | {eta} | {albedo:.3} | {:.5} ± {:.5} | {:.5} ± {:.5} | {q:.3} ± {se:.3} |",
+                "| {label} | {eta} | {albedo:.3} | {:.5} ± {:.5} | {:.5} ± {:.5} | {q:.3} ± {se:.3} |{off}",
                 pt.0, pt.1, b.0, b.1
             );
             eprintln!("  ({:.1} s)", t0.elapsed().as_secs_f64());
