@@ -1,7 +1,7 @@
 //! `het-bssrdf compare`: error metrics of a test image against a reference (relative L2, RMSE,
 //! mean |log10(T/R)|), and a false-colour image of log10(T/R).
 
-use crate::diag::say;
+use crate::diag::{report, say};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -138,12 +138,12 @@ fn finish(args: &Args, test: &Film, reference: &Film, m: Metrics) -> anyhow::Res
         },
     )?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&m)?);
+        report(&serde_json::to_string_pretty(&m)?)?;
     } else {
-        println!("rel_l2 {:.6e}", m.rel_l2);
-        println!("rmse {:.6e}", m.rmse);
-        println!("mean_abs_log10 {:.6e}", m.mean_abs_log10);
-        println!("values {} (log metric over {})", m.values, m.log_values);
+        report(&format!(
+            "rel_l2 {:.6e}\nrmse {:.6e}\nmean_abs_log10 {:.6e}\nvalues {} (log metric over {})",
+            m.rel_l2, m.rmse, m.mean_abs_log10, m.values, m.log_values
+        ))?;
     }
     say!("wrote {}", diff.display());
     Ok(())

@@ -5,7 +5,7 @@
 //! writes the slab table instead (`crates/bssrdf-core/data/slab-profile-v1.bin`, made with
 //! `--slab --photons 4000000`); `--angular` writes the angular coupling
 //! (`crates/bssrdf-core/data/angular-coupling-v1.bin`); `--oblique` the coupling's radial part
-//! (`crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 98304`).
+//! (`crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 131072`).
 
 use std::path::PathBuf;
 
@@ -18,6 +18,7 @@ use bssrdf_core::tabulated::slab::{SLAB_ETAS, SLAB_THICKNESSES};
 use bssrdf_core::tabulated::slab_file::tabulate_slab;
 
 use crate::common::{check_writable, parse_positive};
+use crate::diag::report;
 
 /// Arguments of `het-bssrdf tabulate`.
 #[derive(Debug, clap::Args)]
@@ -42,7 +43,7 @@ pub struct Args {
     angular: bool,
     /// Simulate the angular coupling's radial part, the oblique shape
     /// (`bssrdf_core::tabulated::oblique`, built in as
-    /// `crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 98304`;
+    /// `crates/bssrdf-core/data/oblique-shape-v1.bin`, made with `--oblique --photons 131072`;
     /// photons per incidence bin and plane) instead of the half-space table.
     #[arg(long)]
     oblique: bool,
@@ -102,12 +103,11 @@ fn simulate_and_write(
     bar.finish_and_clear();
     tracer::output::write_atomic(&args.out, &bytes)
         .with_context(|| format!("cannot write `{}`", args.out.display()))?;
-    println!(
+    report(&format!(
         "wrote {} ({planes} {what} x {} photons, seed {}, {capped} paths cut at the event cap) in {:.1} s",
         args.out.display(),
         args.photons,
         args.seed,
         start.elapsed().as_secs_f64()
-    );
-    Ok(())
+    ))
 }

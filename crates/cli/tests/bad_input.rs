@@ -590,3 +590,34 @@ fn unknown_method_names_the_accepted_ones() {
     needles.extend(accepted);
     s.assert_rejected(RENDER, 1, &needles);
 }
+
+/// A reader that stops early (`het-bssrdf compare a.exr b.exr | head -1`) is not a failure:
+/// the command exits 0 without a panic (`println!` used to panic on the closed pipe, exit
+/// 101), and still writes its difference image.
+#[test]
+fn compare_into_a_closed_pipe_succeeds() {
+    use std::process::{Command, Stdio};
+    let s = Scratch::new();
+    write_exr(&gradient(64, 64), &s.join("a.exr")).unwrap();
+    write_exr(&gradient(64, 64), &s.join("b.exr")).unwrap();
+    for json in [false, true] {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_het-bssrdf"));
+        cmd.args(["compare", "a.exr", "b.exr", "--diff", "d.png"])
+            .current_dir(s.path())
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        if json {
+            cmd.arg("--json");
+        }
+        let mut child = cmd.spawn().expect("run het-bssrdf");
+        // Close the reading end before the command has read its images and written its map.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().expect("wait");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "json {json}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(s.join("d.png").exists());
+        std::fs::remove_file(s.join("d.png")).unwrap();
+    }
+}
