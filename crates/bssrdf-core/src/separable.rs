@@ -329,17 +329,17 @@ impl SeparableBssrdf {
     /// ([`Self::with_oblique_shape`], [`crate::tabulated::oblique`]), its radial part
     /// M(σt' r; α', cos_i, cos_o) and the forward shift, a product of one factor per side,
     ///
-    /// max(0, 1 + Σ_n C_n(σt' r; α', μ_i → μ_o) sinⁿθ_i cos nφ_i) / N_i
-    ///   · max(0, 1 + Σ_n C_n(σt' r; α', μ_o → μ_i) sinⁿθ_o cos nφ_o) / N_o,   n = 1, 2, 3,
+    /// max(0, 1 + Σ_n C_n(σt' r; α', μ_i → μ_o) sinⁿθ_i cos nφ_i)
+    ///   · max(0, 1 + Σ_n C_n(σt' r; α', μ_o → μ_i) sinⁿθ_o cos nφ_o) / N,   n = 1, 2, 3,
     ///
-    /// (N the azimuthal mean of each clamped series, 1 where it cannot go negative),
-    /// r = |x_o − x_i|, φ_i the angle between x_o − x_i and t_i = −(ω_i − (ω_i·n_i) n_i), the
+    /// (N the mean of the product over the chord's azimuth, so that the totals stay T's:
+    /// `sides_factor`), r = |x_o − x_i|, φ_i the angle between x_o − x_i and t_i = −(ω_i − (ω_i·n_i) n_i), the
     /// incident light's direction of travel along the surface (|t_i| = sin θ_i), and φ_o the
     /// angle between x_i − x_o and t_o, the same for light arriving along −ω_o at x_o (α' and
     /// σt' the reduced albedo and extinction per channel, at which the tabulated profile reads
     /// its shape; C_n from [`ObliqueShape::shift`]). 1 without a coupling. Symmetric under
-    /// `incident` ↔ `exitant` bit for bit (the two sides' factors swap, and their product
-    /// commutes).
+    /// `incident` ↔ `exitant` bit for bit (the two sides' factors swap, their product
+    /// commutes, and N is symmetric in them).
     pub fn coupling_between(
         &self,
         c: &Coefficients,
@@ -402,7 +402,7 @@ impl SeparableBssrdf {
     /// One side's forward-shift amplitudes a_n = C_n(σt' r; α', μ_side → μ_other) · sinⁿθ_side
     /// (n = 1, 2, 3; unitless) for channel `channel` of `c` at distance `r` (length; σt' and
     /// α' the channel's reduced extinction and albedo): the coefficients of cos nφ in that
-    /// side's factor max(0, 1 + Σ_n a_n cos nφ) / N of [`Self::coupling_between`], φ measured
+    /// side's factor max(0, 1 + Σ_n a_n cos nφ) of [`Self::coupling_between`], φ measured
     /// at the side's own end of the chord from its light's direction of travel along the
     /// surface (docs/oblique-incidence.md; C_n from [`ObliqueShape::shift`]). The exit side of
     /// a pair is `shift_amplitudes(c, ch, r, cos_o, cos_i)`, the incident side
