@@ -16,7 +16,11 @@
 //! quad's Fresnel reflection, F(1)·L_e at every pixel under it; nothing for the distant
 //! lights, whose mirror images are out of view). Ratios BSSRDF/PT ± 1 SE over the seeds.
 //!
-//!     cargo run --release --example oblique_light -- [--quick] [--scattering all] [--only distant|quad] [--eta 1.3] [--pt-scale K] [--seeds N] [--angles 0,30]
+//!     cargo run --release --example oblique_light -- [--quick] [--scattering all] [--only distant|quad] [--eta 1.3] [--pt-scale K] [--seeds N] [--angles 0,30] [--view D] [--shape both]
+//!
+//! `--view D` sees the distant light's patch D° off the normal (D > 0 on the light's side,
+//! D < 0 on the far side); `--shape both` adds a column with the oblique shape off, from the
+//! BSSRDF's same seeds.
 //!
 //! `--quick` quarters the samples and halves the seeds (4 by default); `--pt-scale K`
 //! multiplies the path tracer's samples by K (the distant quad at η ≠ 1 is found by the path
@@ -228,26 +232,23 @@ fn main() {
                 spp_pt * pt_scale / scale,
                 0..seeds,
             );
-            let b = measure(
-                &scene,
-                bssrdf(ProfileModel::Tabulated),
-                scattering,
-                outside,
-                spp_b / scale,
-                100..100 + seeds,
-            );
-            let (q, se) = ratio(b, pt);
-            let off = both.then(|| {
-                let (plain, _) = self::scene(light, sigma, eta, view, false);
-                let b = measure(
-                    &plain,
+            let bssrdf_mean = |scene: &Scene| {
+                measure(
+                    scene,
                     bssrdf(ProfileModel::Tabulated),
                     scattering,
                     outside,
                     spp_b / scale,
                     100..100 + seeds,
-                );
-                ratio(b, pt)
+                )
+            };
+            let b = bssrdf_mean(&scene);
+            let (q, se) = ratio(b, pt);
+            let off = both.then(|| {
+                ratio(
+                    bssrdf_mean(&self::scene(light, sigma, eta, view, false).0),
+                    pt,
+                )
             });
             let label = match light {
                 Lighting::Distant(d) => format!("distant {d}°"),

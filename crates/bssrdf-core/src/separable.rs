@@ -143,14 +143,34 @@ impl ShiftSeries<'_> {
 /// One side's amplitudes a_n = C_n · sinⁿθ (n = 1, 2, 3) from its shift coefficients `c` and
 /// cosine `side_cos`; 0 where any is not finite.
 fn side_amplitudes(side_cos: f64, c: [f64; 3]) -> [f64; 3] {
-    let q = (1.0 - side_cos * side_cos).max(0.0);
-    let s = q.sqrt();
-    let a = [c[0] * s, c[1] * q, c[2] * q * s];
+    let a = amplitudes(&c, 1.0 - side_cos * side_cos);
     if a.iter().all(|v| v.is_finite()) {
         a
     } else {
         [0.0; 3]
     }
+}
+
+/// The amplitudes C_n sinⁿθ of cos nφ (n = 1, 2, 3) from the coefficients `c` and q = sin²θ
+/// (a negative q is 0).
+#[inline]
+fn amplitudes(c: &[f64; 3], q: f64) -> [f64; 3] {
+    let q = q.max(0.0);
+    let s = q.sqrt();
+    [c[0] * s, c[1] * q, c[2] * q * s]
+}
+
+/// Whether the series 1 + Σ_n a_n cos nφ cannot go negative (Σ |a_n| ≤ 1), so needs no clamp.
+#[inline]
+fn cannot_go_negative(a: &[f64; 3]) -> bool {
+    a.iter().map(|v| v.abs()).sum::<f64>() <= 1.0
+}
+
+/// 1 + Σ_n a_n x_n, unclamped: a series at the harmonics `x` (cos nφ, or sinⁿθ cos nφ with
+/// the bare coefficients).
+#[inline]
+fn series(a: &[f64; 3], x: &[f64; 3]) -> f64 {
+    1.0 + a[0] * x[0] + a[1] * x[1] + a[2] * x[2]
 }
 
 /// A prepared separable BSSRDF (see the module docs): the profile family, the Fresnel
@@ -333,8 +353,9 @@ impl SeparableBssrdf {
     ///   · max(0, 1 + Σ_n C_n(σt' r; α', μ_o → μ_i) sinⁿθ_o cos nφ_o) / N,   n = 1, 2, 3,
     ///
     /// (N the mean of the product over the chord's azimuth, so that the totals stay T's:
-    /// `sides_factor`), r = |x_o − x_i|, φ_i the angle between x_o − x_i and t_i = −(ω_i − (ω_i·n_i) n_i), the
-    /// incident light's direction of travel along the surface (|t_i| = sin θ_i), and φ_o the
+    /// `sides_factor`), r = |x_o − x_i|, φ_i the angle between x_o − x_i and
+    /// t_i = −(ω_i − (ω_i·n_i) n_i), the incident light's direction of travel along the
+    /// surface (|t_i| = sin θ_i), and φ_o the
     /// angle between x_i − x_o and t_o, the same for light arriving along −ω_o at x_o (α' and
     /// σt' the reduced albedo and extinction per channel, at which the tabulated profile reads
     /// its shape; C_n from [`ObliqueShape::shift`]). 1 without a coupling. Symmetric under
@@ -517,17 +538,9 @@ fn sides_factor(
     q_o: f64,
     w: f64,
 ) -> f64 {
-    let series =
-        |c: &[f64; 3], h: &[f64; 3]| (1.0 + c[0] * h[0] + c[1] * h[1] + c[2] * h[2]).max(0.0);
-    let value = series(c_i, h_i) * series(c_o, h_o);
-    // The amplitudes C_n sinⁿθ of cos nφ.
-    let amplitudes = |c: &[f64; 3], q: f64| {
-        let s = q.max(0.0).sqrt();
-        [c[0] * s, c[1] * q, c[2] * q * s]
-    };
+    let value = series(c_i, h_i).max(0.0) * series(c_o, h_o).max(0.0);
     let (a, b) = (amplitudes(c_i, q_i), amplitudes(c_o, q_o));
-    let bounded = |a: &[f64; 3]| a.iter().map(|v| v.abs()).sum::<f64>() <= 1.0;
-    let mean = if bounded(&a) && bounded(&b) {
+    let mean = if cannot_go_negative(&a) && cannot_go_negative(&b) {
         let s = q_i.max(0.0) * q_o.max(0.0);
         1.0 + 0.5
             * (-(c_i[0] * c_o[0]) * w + c_i[1] * c_o[1] * (2.0 * w * w - s)
@@ -574,11 +587,13 @@ fn clamped_product_mean(a: [f64; 3], b: [f64; 3], s: f64, w: f64) -> f64 {
     // cos nβ, sin nβ, with the (−1)ⁿ of φ_o = φ + π − β folded in.
     let cn = [-cb, 2.0 * cb * cb - 1.0, -((4.0 * cb * cb - 3.0) * cb)];
     let sn = [-sb, 2.0 * sb * cb, -((3.0 - 4.0 * sb * sb) * sb)];
-    let series = |a: &[f64; 3], c: &[f64; 3]| 1.0 + a[0] * c[0] + a[1] * c[1] + a[2] * c[2];
-    let bounded = |x: &[f64; 3]| x.iter().map(|v| v.abs()).sum::<f64>() <= 1.0;
-    if bounded(&a) || bounded(&b) {
+    if cannot_go_negative(&a) || cannot_go_negative(&b) {
         // f the clamped series, the other one's cosine moments against it.
-        let (f, g) = if bounded(&b) { (a, b) } else { (b, a) };
+        let (f, g) = if cannot_go_negative(&b) {
+            (a, b)
+        } else {
+            (b, a)
+        };
         let g = [g[0] * cn[0], g[1] * cn[1], g[2] * cn[2]];
         let total: f64 = trig[..K / 2]
             .iter()

@@ -259,9 +259,10 @@ impl ObliqueShape {
     }
 
     /// Both sides' C_n at radial node `node` (clamped to the last): `(shift(α, x, μ_i, μ_o),
-    /// shift(α, x, μ_o, μ_i))` at that node's radius x (unitless, finite, |C_n| ≤ 8),
-    /// the row and cells found once (the cells read by [`Self::pair`]'s own lookup). What a caller that reads the shift node by node needs
-    /// (the probes' azimuthal guide). Non-finite arguments give 0.
+    /// shift(α, x, μ_o, μ_i))` at that node's radius x (unitless, finite, |C_n| ≤ 8), the row
+    /// and cells found once (the cells read by [`Self::pair`]'s own lookup). What a caller
+    /// that reads the shift node by node needs (the probes' azimuthal guide). Non-finite
+    /// arguments give 0.
     pub fn shifts_at_node(
         &self,
         alpha: f64,
