@@ -222,13 +222,20 @@ impl BssrdfObject {
         density
     }
 
+    /// Whether this BSSRDF has the oblique shape (`oblique_shape`), whose probes a guide
+    /// leans toward the light ([`Self::shift_guide`]).
+    pub(crate) fn has_oblique_shape(&self) -> bool {
+        self.bssrdf.has_oblique_shape()
+    }
+
     /// The oblique shape's two azimuthal factors as the normal probe's guide around x_o
     /// (docs/oblique-incidence.md, "Sampling"): the incident side's about the direction
-    /// `toward_light` returns (called only with the shape), from x_o to a light (its exact direction at x_i is not known before x_i is
-    /// found; at x_o it is the best guess, exact for a directional light on a plane), the
-    /// exit side's about the direction of travel of light arriving along −`w_o`. `n` is x_o's
-    /// shading normal. `None` without the oblique shape. A side whose direction lies along
-    /// the normal, or below the surface, is left out.
+    /// `toward_light` returns (called only with the shape): from x_o toward the light sample
+    /// next-event estimation then takes at every x_i, the same direction at x_i for a distant
+    /// light or an environment and the same point on a quad (seen from x_i it differs by the
+    /// parallax). The exit side's is about the direction of travel of light arriving along
+    /// −`w_o`. `n` is x_o's shading normal. `None` without the oblique shape. A side whose
+    /// direction lies along the normal, or below the surface, is left out.
     pub(crate) fn shift_guide(
         &self,
         coeffs: het_estimate::Coefficients,

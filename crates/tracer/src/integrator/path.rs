@@ -340,6 +340,25 @@ struct Direct {
     wi: DVec3,
 }
 
+/// Next-event estimation's random choices, a light and a point on it: drawn by
+/// [`PathIntegrator::direct`] itself, or beforehand where something else must lean toward
+/// the light sample first (the oblique shape's probe guide, [`PathIntegrator::gather`]).
+#[derive(Debug, Clone, Copy)]
+struct LightPick {
+    /// Chooses the light.
+    u: f64,
+    /// Chooses the sample on it.
+    u2: [f64; 2],
+}
+
+impl LightPick {
+    fn draw(rng: &mut Rng) -> Self {
+        let u = rng.uniform();
+        let u2 = rng.uniform2();
+        Self { u, u2 }
+    }
+}
+
 impl Direct {
     const NONE: Direct = Direct {
         l: Rgb::ZERO,
@@ -985,17 +1004,12 @@ impl<'s> PathIntegrator<'s> {
         }
     }
 
-    /// A direction from `p` toward a light, for the oblique shape's probe guide
-    /// ([`BssrdfObject::shift_guide`]): one light chosen as next-event estimation chooses
-    /// surface lights (one uniform number), and the direction toward its centre
-    /// ([`Light::centre_direction`]). `None` for a light without a centre (an environment) or
-    /// without light at `p` (behind a quad), and where there is no light. Any choice keeps
-    /// the render unbiased (the probes' density is the one given the guide, and it is
-    /// positive at every azimuth); a guide the integrand does not lean toward only wastes
-    /// the guided half of the azimuths.
-    fn light_direction_guess(&self, p: DVec3, rng: &mut Rng) -> Option<DVec3> {
-        let i = self.lights(Vertex::Surface).select(rng.uniform())?;
-        self.scene.lights()[i].centre_direction(p)
+    /// The direction from `p` toward the light sample `pick` (NEE's choice of a surface light
+    /// and its point), for the oblique shape's probe guide ([`BssrdfObject::shift_guide`]).
+    /// `None` where there is no light or no light at `p` (behind a quad, a beam).
+    fn light_direction(&self, p: DVec3, pick: LightPick) -> Option<DVec3> {
+        let i = self.lights(Vertex::Surface).select(pick.u)?;
+        Some(self.scene.lights()[i].sample_li(p, pick.u2)?.wi)
     }
 
     /// Next-event estimation from the vertex `v`: one light chosen uniformly, its sample
@@ -1011,8 +1025,21 @@ impl<'s> PathIntegrator<'s> {
         rng: &mut Rng,
         counters: &mut PathCounters,
     ) -> Direct {
-        let u = rng.uniform();
-        let u2 = rng.uniform2();
+        let pick = LightPick::draw(rng);
+        self.direct_with(v, pick, origin_for, f_and_pdf, rng, counters)
+    }
+
+    /// [`Self::direct`] with the light and its sample drawn beforehand (`pick`).
+    fn direct_with(
+        &self,
+        v: LightVertex,
+        pick: LightPick,
+        origin_for: impl Fn(DVec3) -> DVec3,
+        f_and_pdf: impl Fn(DVec3) -> (f64, f64),
+        rng: &mut Rng,
+        counters: &mut PathCounters,
+    ) -> Direct {
+        let LightPick { u, u2 } = pick;
         if self.strategy == LightStrategy::DirectionOnly {
             return Direct::NONE;
         }
@@ -1574,9 +1601,11 @@ impl<'s> PathIntegrator<'s> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);
         let mut set = crate::integrator::probe_gathering::ProbePoints::new();
-        // Only with the oblique shape: draws a number, so renders without it are unchanged.
+        // Only with the oblique shape: the light sample every x_i gathers from is drawn first,
+        // and the probes lean toward its direction (renders without the shape are unchanged).
+        let pick = b.has_oblique_shape().then(|| LightPick::draw(st.rng));
         let guide = b.shift_guide(at_xo, v.w_o, v.n_o, || {
-            self.light_direction_guess(hit.p, st.rng)
+            pick.and_then(|pick| self.light_direction(hit.p, pick))
         });
         let guide = guide.as_ref().and_then(|g| GuidedAzimuths::new(g, hit));
         let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide.as_ref(), st.rng);
@@ -1595,12 +1624,13 @@ impl<'s> PathIntegrator<'s> {
                 continue;
             };
             let alpha_i = b.alpha_at(&x_i);
-            let ld = self.direct(
+            let ld = self.direct_with(
                 LightVertex {
                     p: x_i.p,
                     medium: None,
                     at: Vertex::Surface,
                 },
+                pick.unwrap_or_else(|| LightPick::draw(st.rng)),
                 |wi| x_i.spawn_origin(wi),
                 |wi| {
                     // S_w · cos against the continuation's pdf (cosine about the shading

@@ -447,23 +447,6 @@ impl Light {
         )
     }
 
-    /// The unit direction from `p` toward the light's centre: for a directional light the
-    /// reverse of its travel, for a point light its position, for a quad its centre where
-    /// `p` is on its emitting side. `None` for the lights without one (an environment, a
-    /// beam) and where `p` is at the light. A deterministic stand-in for "where the light
-    /// comes from" (the oblique shape's probe guide, `integrator::bssrdf::ShiftGuide`).
-    pub fn centre_direction(&self, p: DVec3) -> Option<DVec3> {
-        let toward = |y: DVec3| (y - p).try_normalize();
-        match self {
-            Light::Directional(l) => Some(-l.direction),
-            Light::Point(l) => toward(l.position),
-            Light::Quad(q) => {
-                toward(q.corner + 0.5 * (q.edge_u + q.edge_v)).filter(|w| -w.dot(q.normal) > 0.0)
-            }
-            Light::Environment(_) | Light::Beam(_) => None,
-        }
-    }
-
     /// Samples incident light at `p` with the uniforms `u ∈ [0, 1)²`:
     /// * directional: `wi = −direction`, `li = irradiance`;
     /// * point: `li = intensity / dist²`;
@@ -615,30 +598,6 @@ mod tests {
     /// The direction toward a light's centre: the quad's centre from its emitting side and
     /// nothing from behind it, a point light's position, the reverse of a directional light's
     /// travel; none for an environment.
-    #[test]
-    fn centre_directions() {
-        let quad = Light::quad(
-            DVec3::new(-1.0, -1.0, 3.0),
-            DVec3::new(0.0, 2.0, 0.0),
-            DVec3::new(2.0, 0.0, 0.0),
-            Rgb::ONE,
-        )
-        .unwrap();
-        let close = |a: Option<DVec3>, b: DVec3| a.is_some_and(|a| (a - b).length() < 1e-12);
-        assert!(close(
-            quad.centre_direction(DVec3::new(4.0, 0.0, 0.0)),
-            DVec3::new(-0.8, 0.0, 0.6)
-        ));
-        assert_eq!(quad.centre_direction(DVec3::new(0.0, 0.0, 5.0)), None);
-        let point = Light::point(DVec3::new(0.0, 3.0, 0.0), Rgb::ONE).unwrap();
-        assert!(close(point.centre_direction(DVec3::ZERO), DVec3::Y));
-        assert_eq!(point.centre_direction(DVec3::new(0.0, 3.0, 0.0)), None);
-        let sun = Light::directional(DVec3::new(0.0, 0.0, -2.0), Rgb::ONE).unwrap();
-        assert!(close(sun.centre_direction(DVec3::ONE), DVec3::Z));
-        let sky = Light::environment(Rgb::ONE).unwrap();
-        assert_eq!(sky.centre_direction(DVec3::ZERO), None);
-    }
-
     #[test]
     fn delta_lights() {
         let d = Light::directional(DVec3::new(0.0, 0.0, -2.0), Rgb::splat(3.0)).unwrap();
