@@ -27,10 +27,14 @@ use crate::frame::orthonormal_basis;
 /// Equal bins of the guided part's piecewise-constant density over [0, 2π).
 pub const AZIMUTH_BINS: usize = 32;
 /// The share β of the azimuths drawn from the guided part (the rest uniform): a defensive
-/// mixture, so that the density is at least (1 − β)/(2π) everywhere. On the scenes of
-/// docs/oblique-incidence.md ("Sampling") β = 0.9 was quieter than ½ where the guide was
-/// good and noisier where it was a rough proxy; ½ is the safe choice.
-pub const GUIDED_SHARE: f64 = 0.5;
+/// mixture, so that the density is at least (1 − β)/(2π) everywhere. With a perfect guide
+/// a share β leaves the variance that guiding by the same density adds to a flat integrand,
+/// which vanishes as β → 1; with a rough guide the uniform share bounds the weights. The
+/// renderer's guides are exact for the directions its light arrives by (the light sample
+/// and the continuation, each drawn before the probes), and on the scenes of
+/// docs/oblique-incidence.md ("Two guides") 0.9 was quieter than ½ everywhere and as quiet
+/// as 0.8 and 0.95.
+pub const GUIDED_SHARE: f64 = 0.9;
 
 /// What the caller knows at x_o: the preferred azimuthal shape of the points around it, a
 /// product of up to two clamped Fourier series Π_j max(0, 1 + Σ_n a_jn cos n(φ − φ_j)),
@@ -65,6 +69,9 @@ pub struct GuidedAzimuths<'g> {
     shapes: [Cell<Option<(usize, NodeShape)>>; SHAPES_KEPT],
     /// The slot of `shapes` the next new shape goes to.
     next: Cell<usize>,
+    /// A second guide whose own shape takes the given part of the guided share
+    /// ([`GuidedAzimuths::mixed_with`]).
+    other: Option<(&'g GuidedAzimuths<'g>, f64)>,
 }
 
 /// How many node shapes a [`GuidedAzimuths`] keeps.
@@ -104,6 +111,7 @@ impl<'g> GuidedAzimuths<'g> {
             used,
             shapes: Default::default(),
             next: Cell::new(0),
+            other: None,
         })
     }
 
@@ -161,25 +169,32 @@ impl<'g> GuidedAzimuths<'g> {
             * series(&shape.amplitudes[1], self.cosines[1][m])
     }
 
-    /// p(φ | r) (1/radian) of the azimuth at projected radius `r` (length), whatever the
-    /// probe's channel: (1 − β)/(2π) + β g(φ), `phi` any angle in x_o's frame.
-    pub fn pdf(&self, r: f64, phi: f64) -> f64 {
-        let shape = self.shape(r, None);
-        let g = match shape.scale {
-            Some(scale) => self.value(&shape, bin_of(phi)) * scale,
-            None => 1.0 / TAU,
+    /// This guide with `other`'s shape mixed into its guided part, which becomes
+    /// (1 − s) g + s g_other, s = `share` (clamped to [0, 1]; NaN gives 0): for an integrand
+    /// that is a sum of two parts, each leaning its own way (light arriving by two sampled
+    /// directions). Only `other`'s own shape counts, not what is mixed into it.
+    pub fn mixed_with(mut self, other: &'g GuidedAzimuths<'g>, share: f64) -> Self {
+        let s = if share.is_nan() {
+            0.0
+        } else {
+            share.clamp(0.0, 1.0)
         };
-        (1.0 - GUIDED_SHARE) / TAU + GUIDED_SHARE * g
+        self.other = Some((other, s));
+        self
     }
 
-    /// An azimuth in [0, 2π) at projected radius `r` from one uniform number `u` in [0, 1):
-    /// below 1 − β uniform, else by inverting g's cumulative distribution.
-    pub fn sample(&self, r: f64, u: f64) -> f64 {
-        let beta = GUIDED_SHARE;
-        if u < 1.0 - beta {
-            return TAU * u / (1.0 - beta);
+    /// This guide's own shape g(φ | r) (1/radian) at `phi`.
+    fn own_pdf(&self, r: f64, phi: f64) -> f64 {
+        let shape = self.shape(r, None);
+        match shape.scale {
+            Some(scale) => self.value(&shape, bin_of(phi)) * scale,
+            None => 1.0 / TAU,
         }
-        let v = ((u - (1.0 - beta)) / beta).clamp(0.0, 1.0);
+    }
+
+    /// An azimuth drawn from this guide's own shape at fraction `v` ∈ [0, 1] of its
+    /// cumulative distribution.
+    fn own_sample(&self, r: f64, v: f64) -> f64 {
         let mut cum = [0.0; AZIMUTH_BINS + 1];
         let shape = self.shape(r, Some(&mut cum));
         if shape.scale.is_none() {
@@ -187,6 +202,33 @@ impl<'g> GuidedAzimuths<'g> {
             cum.iter_mut().enumerate().for_each(|(m, c)| *c = m as f64);
         }
         invert_bins(&cum, v)
+    }
+
+    /// p(φ | r) (1/radian) of the azimuth at projected radius `r` (length), whatever the
+    /// probe's channel: (1 − β)/(2π) + β g(φ), `phi` any angle in x_o's frame, g the guided
+    /// part (with a second guide mixed in, [`Self::mixed_with`]).
+    pub fn pdf(&self, r: f64, phi: f64) -> f64 {
+        let g = match self.other {
+            Some((o, s)) => (1.0 - s) * self.own_pdf(r, phi) + s * o.own_pdf(r, phi),
+            None => self.own_pdf(r, phi),
+        };
+        (1.0 - GUIDED_SHARE) / TAU + GUIDED_SHARE * g
+    }
+
+    /// An azimuth in [0, 2π) at projected radius `r` from one uniform number `u` in [0, 1):
+    /// below 1 − β uniform, else by inverting g's cumulative distribution (with a second
+    /// guide, the one the remainder of `u` falls to, in proportion to their parts).
+    pub fn sample(&self, r: f64, u: f64) -> f64 {
+        let beta = GUIDED_SHARE;
+        if u < 1.0 - beta {
+            return TAU * u / (1.0 - beta);
+        }
+        let v = ((u - (1.0 - beta)) / beta).clamp(0.0, 1.0);
+        match self.other {
+            Some((o, s)) if v >= 1.0 - s => o.own_sample(r, ((v - (1.0 - s)) / s).min(1.0)),
+            Some((_, s)) => self.own_sample(r, (v / (1.0 - s)).min(1.0)),
+            None => self.own_sample(r, v),
+        }
     }
 }
 
@@ -270,34 +312,45 @@ mod tests {
         }
     }
 
-    /// At every radius (six nodes, one uniform) and for every guide, read in turns that
-    /// overflow the shapes kept, p(φ | r) integrates to 1 and is at least (1 − β)/(2π); its
-    /// samples follow it (χ² over twice its bins, fixed seed). Directions that do not project
+    /// At every radius (six nodes, one uniform) and for every guide, alone or mixed with
+    /// another, read in turns that overflow the shapes kept, p(φ | r) integrates to 1 and is at
+    /// least (1 − β)/(2π); its samples follow it (χ² over twice its bins, fixed seed). Directions that do not project
     /// give no guide.
     #[test]
     fn guided_azimuths_are_normalised_defensive_and_sampled_by_their_density() {
         let x_o = At(DVec3::new(0.1, -0.2, 1.0).normalize());
         let radii = [0.0, 2.0, 3.4, 7.75, 12.5, 40.0];
-        let test = ChiSquareTest::family(1e-4, 3 * radii.len() as u32);
+        let test = ChiSquareTest::family(1e-4, 5 * radii.len() as u32);
         let mut rng = SplitMix64::new(44);
-        for guide in [Nodes(0), Nodes(1), Nodes(2)] {
-            let g = GuidedAzimuths::new(&guide, &x_o).expect("directions project");
+        let guides = [Nodes(0), Nodes(1), Nodes(2)];
+        let plain = |k: usize| GuidedAzimuths::new(&guides[k], &x_o).expect("directions project");
+        let (second, third) = (plain(2), plain(0));
+        // Each guide alone, and mixed with another (a part of 0.3 of the guided share, and
+        // all of it).
+        let cases = [
+            ("0", plain(0)),
+            ("1", plain(1)),
+            ("2", plain(2)),
+            ("0 + 0.3 of 2", plain(0).mixed_with(&second, 0.3)),
+            ("1 + all of 0", plain(1).mixed_with(&third, 1.0)),
+        ];
+        for (name, g) in &cases {
             for r in radii {
                 let n = 100 * AZIMUTH_BINS;
                 let sum: f64 = (0..n)
                     .map(|k| g.pdf(r, TAU * (k as f64 + 0.5) / n as f64) * TAU / n as f64)
                     .sum();
-                assert!((sum - 1.0).abs() < 1e-12, "{} {r}: {sum}", guide.0);
+                assert!((sum - 1.0).abs() < 1e-12, "{name} {r}: {sum}");
                 for k in 0..n {
                     let p = g.pdf(r, TAU * k as f64 / n as f64 - 5.0 * TAU);
-                    assert!(p >= (1.0 - GUIDED_SHARE) / TAU - 1e-15, "{} {r}", guide.0);
+                    assert!(p >= (1.0 - GUIDED_SHARE) / TAU - 1e-15, "{name} {r}");
                 }
                 let samples = 100_000;
                 let bins = 2 * AZIMUTH_BINS;
                 let mut observed = vec![0u64; bins];
                 for _ in 0..samples {
                     let phi = g.sample(r, rng.next_f64());
-                    assert!((0.0..TAU).contains(&phi), "{} {r}: {phi}", guide.0);
+                    assert!((0.0..TAU).contains(&phi), "{name} {r}: {phi}");
                     observed[((phi / TAU * bins as f64) as usize).min(bins - 1)] += 1;
                 }
                 let expected: Vec<f64> = (0..bins)
@@ -307,7 +360,7 @@ mod tests {
                     })
                     .collect();
                 let chi = test.check(&observed, &expected).expect("a test");
-                assert!(chi.passes(), "{} {r}: {chi}", guide.0);
+                assert!(chi.passes(), "{name} {r}: {chi}");
             }
         }
         // Read back after the shapes kept were replaced: the same density.

@@ -44,7 +44,7 @@ use crate::bsdf::{Frame, RoughDielectric, TransmittanceTable, oren_nayar};
 use crate::correction::factors::ShapeCorrection;
 use crate::geometry::{Hit, OFFSET_REL, ObjectSurface, Ray};
 use crate::integrator::RenderError;
-use crate::integrator::bssrdf::{BssrdfObject, PairEnd, PairWeight, facing_normal};
+use crate::integrator::bssrdf::{BssrdfObject, PairEnd, PairWeight, ShiftGuide, facing_normal};
 use crate::integrator::counters::PathCounters;
 use crate::integrator::lighting::{LightSet, Vertex, power_heuristic};
 use crate::integrator::preparation::PrepareObserver;
@@ -268,7 +268,11 @@ impl std::ops::Deref for MaterialOf<'_> {
 /// the `cos = √u` inversion) and its cosine; `None` at grazing (`cos = 0`), where the pdf
 /// vanishes. The continuation of both a diffuse bounce and a BSSRDF's incident side.
 fn cosine_continuation(n: DVec3, rng: &mut Rng) -> Option<(DVec3, f64)> {
-    let u = rng.uniform2();
+    cosine_direction(n, rng.uniform2())
+}
+
+/// [`cosine_continuation`] from the uniforms `u` ∈ [0, 1)².
+fn cosine_direction(n: DVec3, u: [f64; 2]) -> Option<(DVec3, f64)> {
     let cos = u[0].sqrt();
     (cos > 0.0).then(|| (direction_about(n, cos, std::f64::consts::TAU * u[1]), cos))
 }
@@ -359,6 +363,36 @@ impl LightPick {
     }
 }
 
+/// What a BSSRDF vertex with the oblique shape draws before its probes, so that the probes
+/// can lean the way S does for the directions its light then arrives by
+/// ([`PathIntegrator::gather`]): next-event estimation's light sample, which every x_i
+/// gathers from, and the uniforms of the continuation's cosine-distributed direction, which
+/// the carrier x_i takes about its own normal ([`cosine_direction`]).
+#[derive(Debug, Clone, Copy)]
+struct DrawnFirst {
+    light: LightPick,
+    continuation: [f64; 2],
+}
+
+impl DrawnFirst {
+    fn draw(rng: &mut Rng) -> Self {
+        let light = LightPick::draw(rng);
+        let continuation = rng.uniform2();
+        Self {
+            light,
+            continuation,
+        }
+    }
+}
+
+/// The point of a BSSRDF vertex's probe set the path continues from, its weight, and the
+/// continuation's uniforms where they were drawn before the probes ([`DrawnFirst`]).
+struct Carrier {
+    x_i: Hit,
+    weight: CarrierWeight,
+    continuation: Option<[f64; 2]>,
+}
+
 impl Direct {
     const NONE: Direct = Direct {
         l: Rgb::ZERO,
@@ -437,6 +471,10 @@ pub struct PathIntegrator<'s> {
     objects: Vec<ObjectKind<'s>>,
     /// The lights next-event estimation samples on surfaces and in media ([`LightSet::at`]).
     surface_lights: LightSet,
+    /// Whether some light reaches surfaces by direction sampling alone (a constant sky that
+    /// [`LightSet::at`] leaves out of the surface lights): the oblique shape's probes then
+    /// lean the continuation's way too ([`PathIntegrator::gather`]).
+    sky_by_continuation: bool,
     medium_lights: LightSet,
     warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
@@ -727,12 +765,14 @@ impl<'s> PathIntegrator<'s> {
         }
         let warnings = crate::integrator::warnings::scene_warnings(scene, method);
         let shadows_cross_objects = objects.iter().any(ObjectKind::passes_shadow_rays);
+        let surface_lights = LightSet::at(scene.lights(), Vertex::Surface);
         Ok(Self {
             scene,
             method,
             options,
             objects,
-            surface_lights: LightSet::at(scene.lights(), Vertex::Surface),
+            sky_by_continuation: surface_lights.left_out(scene.lights()),
+            surface_lights,
             medium_lights: LightSet::at(scene.lights(), Vertex::Medium),
             warnings,
             strategy: LightStrategy::Mis,
@@ -1585,10 +1625,10 @@ impl<'s> PathIntegrator<'s> {
             n_o,
             alpha_o,
         };
-        let Some((x_i, carried)) = self.gather(&v, st) else {
+        let Some(carrier) = self.gather(&v, st) else {
             return Step::Stop;
         };
-        self.continue_from(&v, x_i, carried, st)
+        self.continue_from(&v, carrier, st)
     }
 
     /// The incident points x_i of the BSSRDF vertex `v`, from probe rays
@@ -1597,18 +1637,28 @@ impl<'s> PathIntegrator<'s> {
     /// angular coupling), added to the path; and the carrier, the point the path continues from
     /// ([`Gathering`]), with its weight. `None` when the probes found no point or none carries
     /// the path.
-    fn gather(&self, v: &BssrdfVertex<'_>, st: &mut PathState<'_>) -> Option<(Hit, CarrierWeight)> {
+    fn gather(&self, v: &BssrdfVertex<'_>, st: &mut PathState<'_>) -> Option<Carrier> {
         let (material, b, hit) = (v.material, v.b, v.x_o);
         let at_xo = material.medium.coefficients(hit);
         let mut set = crate::integrator::probe_gathering::ProbePoints::new();
-        // Only with the oblique shape: the light sample every x_i gathers from is drawn first,
-        // and the probes lean toward its direction (renders without the shape are unchanged).
-        let pick = b.has_oblique_shape().then(|| LightPick::draw(st.rng));
-        let guide = b.shift_guide(at_xo, v.w_o, v.n_o, || {
-            pick.and_then(|pick| self.light_direction(hit.p, pick))
-        });
-        let guide = guide.as_ref().and_then(|g| GuidedAzimuths::new(g, hit));
-        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide.as_ref(), st.rng);
+        // Only with the oblique shape: the light sample every x_i gathers from and the
+        // continuation's direction are drawn first, and the probes lean the way S does for
+        // them (renders without the shape are unchanged).
+        let first = b.has_oblique_shape().then(|| DrawnFirst::draw(st.rng));
+        let pick = first.map(|f| f.light);
+        let [light, continuation] = self.shift_guides(v, at_xo, first);
+        let continuation = continuation
+            .as_ref()
+            .and_then(|g| GuidedAzimuths::new(g, hit));
+        let guide = match (
+            light.as_ref().and_then(|g| GuidedAzimuths::new(g, hit)),
+            &continuation,
+        ) {
+            (Some(l), Some(c)) => Some(l.mixed_with(c, 0.5)),
+            (l, _) => l,
+        };
+        let guide = guide.as_ref().or(continuation.as_ref());
+        let density = b.probe_points_into(&mut set, &v.surface, hit, at_xo, guide, st.rng);
         st.counters.probe_sets += 1;
         if set.is_empty() {
             st.counters.probe_misses += 1;
@@ -1674,7 +1724,33 @@ impl<'s> PathIntegrator<'s> {
                 next = Some((x_i, CarrierWeight::Evaluated(w * scale, pw)));
             }
         }
-        next
+        next.map(|(x_i, weight)| Carrier {
+            x_i,
+            weight,
+            continuation: first.map(|f| f.continuation),
+        })
+    }
+
+    /// The oblique shape's probe guides at the BSSRDF vertex `v` (x_o's coefficients
+    /// `at_xo`) for what was drawn `first`: the light sample's, and the continuation's where
+    /// direct light arrives by it too (a constant sky left to direction sampling,
+    /// [`LightSet::at`]). `[None, None]` without the shape.
+    fn shift_guides<'b>(
+        &self,
+        v: &BssrdfVertex<'b>,
+        at_xo: het_estimate::Coefficients,
+        first: Option<DrawnFirst>,
+    ) -> [Option<ShiftGuide<'b>>; 2] {
+        let (b, hit) = (v.b, v.x_o);
+        let light = b.shift_guide(at_xo, v.w_o, v.n_o, || {
+            first.and_then(|f| self.light_direction(hit.p, f.light))
+        });
+        let continuation = first.filter(|_| self.sky_by_continuation).and_then(|f| {
+            b.shift_guide(at_xo, v.w_o, v.n_o, || {
+                cosine_direction(hit.ns, f.continuation).map(|(w, _)| w)
+            })
+        });
+        [light, continuation]
     }
 
     /// The path's continuation from the carrier `x_i` of the BSSRDF vertex `v`, whose weight is
@@ -1684,12 +1760,11 @@ impl<'s> PathIntegrator<'s> {
     fn continue_from(
         &self,
         v: &BssrdfVertex<'_>,
-        x_i: Hit,
-        carried: CarrierWeight,
+        carrier: Carrier,
         st: &mut PathState<'_>,
     ) -> Step {
-        let b = v.b;
-        let carried = match carried {
+        let (b, x_i) = (v.b, carrier.x_i);
+        let carried = match carrier.weight {
             CarrierWeight::Evaluated(w, pw) => {
                 st.beta *= w;
                 Ok(pw)
@@ -1704,7 +1779,11 @@ impl<'s> PathIntegrator<'s> {
         if st.beta.is_zero() {
             return Step::Stop;
         }
-        let Some((wi, cos)) = cosine_continuation(x_i.ns, st.rng) else {
+        let continuation = match carrier.continuation {
+            Some(u) => cosine_direction(x_i.ns, u),
+            None => cosine_continuation(x_i.ns, st.rng),
+        };
+        let Some((wi, cos)) = continuation else {
             return Step::Stop;
         };
         if facing_normal(&x_i, wi).is_none() {
