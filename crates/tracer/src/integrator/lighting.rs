@@ -70,14 +70,6 @@ impl LightSet {
         let n = self.indices.len();
         (n > 0).then(|| self.indices[((u * n as f64) as usize).min(n - 1)])
     }
-    /// Whether some light of `lights` (the list this set was made from) other than a beam
-    /// is not in the set: light that reaches its vertices by direction sampling alone.
-    pub fn left_out(&self, lights: &[Light]) -> bool {
-        lights
-            .iter()
-            .enumerate()
-            .any(|(i, l)| !matches!(l, Light::Beam(_)) && !self.contains(i))
-    }
     /// True when light `i` is in the set.
     pub fn contains(&self, i: usize) -> bool {
         self.indices.contains(&i)

@@ -471,9 +471,12 @@ pub struct PathIntegrator<'s> {
     objects: Vec<ObjectKind<'s>>,
     /// The lights next-event estimation samples on surfaces and in media ([`LightSet::at`]).
     surface_lights: LightSet,
-    /// Whether some light reaches surfaces by direction sampling alone (a constant sky that
-    /// [`LightSet::at`] leaves out of the surface lights): the oblique shape's probes then
-    /// lean the continuation's way too ([`PathIntegrator::gather`]).
+    /// Whether much of the direct light at surfaces arrives by the continuation's sampled
+    /// direction: an environment, which next-event estimation either leaves to direction
+    /// sampling ([`LightSet::at`]) or shares with it by MIS, where the cosine-distributed
+    /// continuation takes most of it near the normal. The oblique shape's probes then lean
+    /// the continuation's way too ([`PathIntegrator::gather`]). Not for delta lights, which
+    /// only next-event estimation reaches, nor for quads, which the continuation seldom hits.
     sky_by_continuation: bool,
     medium_lights: LightSet,
     warnings: Vec<crate::integrator::warnings::Warning>,
@@ -771,7 +774,10 @@ impl<'s> PathIntegrator<'s> {
             method,
             options,
             objects,
-            sky_by_continuation: surface_lights.left_out(scene.lights()),
+            sky_by_continuation: scene
+                .lights()
+                .iter()
+                .any(|l| matches!(l, Light::Environment(_))),
             surface_lights,
             medium_lights: LightSet::at(scene.lights(), Vertex::Medium),
             warnings,
@@ -1733,8 +1739,8 @@ impl<'s> PathIntegrator<'s> {
 
     /// The oblique shape's probe guides at the BSSRDF vertex `v` (x_o's coefficients
     /// `at_xo`) for what was drawn `first`: the light sample's, and the continuation's where
-    /// direct light arrives by it too (a constant sky left to direction sampling,
-    /// [`LightSet::at`]). `[None, None]` without the shape.
+    /// direct light arrives by it too (an environment: `sky_by_continuation`). `[None, None]`
+    /// without the shape.
     fn shift_guides<'b>(
         &self,
         v: &BssrdfVertex<'b>,
