@@ -126,7 +126,7 @@ fn scene(
         .object(
             "half-space",
             primitives::half_space(0.0, [0.0, 0.0], 400.0, 200.0, 40),
-            // The oblique shape is opt-in (`oblique_shape = true` in a scene).
+            // With and without the oblique shape (on by default; `oblique_shape` in a scene).
             Material::Translucent(Translucent {
                 oblique_shape: shape,
                 ..Translucent::new("m", field, 0.0, eta)

@@ -1,6 +1,6 @@
 //! Light arriving at an angle (docs/oblique-incidence.md): under the 4 × 4 quad of
 //! docs/shapes.md, 3 units above a half-space (σa 0.01, σs 1, η 1), most of the light the
-//! view receives entered obliquely. With the oblique shape (`oblique_shape = true`, opt-in
+//! view receives entered obliquely. With the oblique shape (`oblique_shape`, on by default
 //! beside the angular coupling) the BSSRDF render must be within 3 % (+ 3 SE) of the path
 //! tracer; without the coupling and the shape it is 1.15× (docs/tabulated-profile.md), which
 //! the test must tell apart. Under a distant light with the view oblique too, both sides'

@@ -665,7 +665,7 @@ pub struct TranslucentDesc {
     /// With the tabulated profile, scale it by the half-space's angular coupling (default
     /// true; `Translucent::angular_coupling`).
     pub angular_coupling: Option<bool>,
-    /// With the angular coupling, also its oblique shape (default false;
+    /// With the angular coupling, also its oblique shape (default true;
     /// `Translucent::oblique_shape`).
     pub oblique_shape: Option<bool>,
     /// Coefficients in the file × unit_scale = coefficients per scene unit (default 1), e.g.

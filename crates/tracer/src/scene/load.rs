@@ -655,7 +655,7 @@ impl Cx {
                 .shape_correction_seed
                 .unwrap_or(Translucent::DEFAULT_CORRECTION_SEED),
             angular_coupling: d.angular_coupling.unwrap_or(true),
-            oblique_shape: d.oblique_shape.unwrap_or(false),
+            oblique_shape: d.oblique_shape.unwrap_or(true),
             unit_scale: d.unit_scale,
             key: key.to_string(),
             line: self.loc.line_of_key(key),
