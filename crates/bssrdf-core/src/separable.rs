@@ -750,7 +750,7 @@ mod tests {
         ] {
             for r in [0.03, 0.3, 1.0, 4.0] {
                 let (ci, co) = (dir(theta_i, 0.0).z, dir(theta_o, 0.0).z);
-                let over = |a: [f64; 3]| a.iter().map(|v| v.abs()).sum::<f64>() > 1.0;
+                let over = |a: [f64; 3]| !cannot_go_negative(&a);
                 let sides: [[bool; 2]; 3] = std::array::from_fn(|ch| {
                     [
                         over(b.shift_amplitudes(&c, ch, r, ci, co)),

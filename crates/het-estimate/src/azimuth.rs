@@ -8,13 +8,16 @@
 //! estimate stays unbiased whatever the guide says.
 //!
 //! The shape is the caller's ([`AzimuthGuide`]): one for all colour channels (the probe's
-//! channel only chooses its radius), at radial nodes the guide chooses, up to two factors max(0, 1 + Σ_n a_n cos n(φ − φ_j)), n = 1, 2, 3, each
-//! about its own direction in x_o's tangent plane. At a projected radius r the guided part g
+//! channel only chooses its radius), at radial nodes the guide chooses, up to two factors
+//! max(0, 1 + Σ_n a_n cos n(φ − φ_j)), n = 1, 2, 3, each about its own direction in x_o's
+//! tangent plane. At a projected radius r the guided part g
 //! is the shape of the node the guide names for r (the nearest of its own): piecewise
 //! constant over [`AZIMUTH_BINS`] equal bins, its value in a bin the product at the bin's
 //! midpoint divided by the sum over the bins. A probe set reads a node's shape once, when it
 //! samples the normal probe's azimuth, and its density again at the point found
-//! ([`GuidedAzimuths`] keeps the last few).
+//! ([`GuidedAzimuths`] keeps the last few). Where the integrand is a sum of parts that lean
+//! different ways (light arriving by two sampled directions), a second guide's shape can take
+//! a share of the guided part ([`GuidedAzimuths::mixed_with`]).
 
 use std::cell::Cell;
 use std::f64::consts::TAU;
@@ -313,9 +316,10 @@ mod tests {
     }
 
     /// At every radius (six nodes, one uniform) and for every guide, alone or mixed with
-    /// another, read in turns that overflow the shapes kept, p(φ | r) integrates to 1 and is at
-    /// least (1 − β)/(2π); its samples follow it (χ² over twice its bins, fixed seed). Directions that do not project
-    /// give no guide.
+    /// another, read in turns that overflow the shapes kept, p(φ | r) integrates to 1 and is
+    /// at least (1 − β)/(2π); its samples follow it (χ² over twice its bins, fixed seed; a
+    /// mixture sampled half and half instead of by its share fails at χ² ≈ 10⁴). Directions
+    /// that do not project give no guide.
     #[test]
     fn guided_azimuths_are_normalised_defensive_and_sampled_by_their_density() {
         let x_o = At(DVec3::new(0.1, -0.2, 1.0).normalize());

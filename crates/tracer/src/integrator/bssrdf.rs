@@ -230,11 +230,12 @@ impl BssrdfObject {
 
     /// The oblique shape's two azimuthal factors as the normal probe's guide around x_o
     /// (docs/oblique-incidence.md, "Sampling"): the incident side's about the direction
-    /// `toward_light` returns (called only with the shape): from x_o toward the light sample
-    /// next-event estimation then takes at every x_i, the same direction at x_i for a distant
-    /// light or an environment and the same point on a quad (seen from x_i it differs by the
-    /// parallax). The exit side's is about the direction of travel of light arriving along
-    /// −`w_o`. `n` is x_o's shading normal. `None` without the oblique shape. A side whose
+    /// `toward_light` returns (called only with the shape): a direction light arrives by that
+    /// was drawn before x_i, from x_o toward the light sample next-event estimation then
+    /// takes at every x_i (the same direction at x_i for a distant light or an environment,
+    /// the same point on a quad, seen from x_i up to the parallax), or the continuation's
+    /// direction (`integrator::path`, "two guides"). The exit side's is about the direction
+    /// of travel of light arriving along −`w_o`. `n` is x_o's shading normal. `None` without the oblique shape. A side whose
     /// direction lies along the normal, or below the surface, is left out.
     pub(crate) fn shift_guide(
         &self,

@@ -356,10 +356,13 @@ struct LightPick {
 }
 
 impl LightPick {
+    /// The light's number, then the sample's (struct fields are evaluated in the order
+    /// written).
     fn draw(rng: &mut Rng) -> Self {
-        let u = rng.uniform();
-        let u2 = rng.uniform2();
-        Self { u, u2 }
+        Self {
+            u: rng.uniform(),
+            u2: rng.uniform2(),
+        }
     }
 }
 
@@ -375,12 +378,11 @@ struct DrawnFirst {
 }
 
 impl DrawnFirst {
+    /// The light sample, then the continuation's uniforms.
     fn draw(rng: &mut Rng) -> Self {
-        let light = LightPick::draw(rng);
-        let continuation = rng.uniform2();
         Self {
-            light,
-            continuation,
+            light: LightPick::draw(rng),
+            continuation: rng.uniform2(),
         }
     }
 }
@@ -477,7 +479,7 @@ pub struct PathIntegrator<'s> {
     /// continuation takes most of it near the normal. The oblique shape's probes then lean
     /// the continuation's way too ([`PathIntegrator::gather`]). Not for delta lights, which
     /// only next-event estimation reaches, nor for quads, which the continuation seldom hits.
-    sky_by_continuation: bool,
+    guide_continuation: bool,
     medium_lights: LightSet,
     warnings: Vec<crate::integrator::warnings::Warning>,
     strategy: LightStrategy,
@@ -774,7 +776,7 @@ impl<'s> PathIntegrator<'s> {
             method,
             options,
             objects,
-            sky_by_continuation: scene
+            guide_continuation: scene
                 .lights()
                 .iter()
                 .any(|l| matches!(l, Light::Environment(_))),
@@ -1660,6 +1662,7 @@ impl<'s> PathIntegrator<'s> {
             light.as_ref().and_then(|g| GuidedAzimuths::new(g, hit)),
             &continuation,
         ) {
+            // Half each: which of the two carries more light is not known at x_o.
             (Some(l), Some(c)) => Some(l.mixed_with(c, 0.5)),
             (l, _) => l,
         };
@@ -1739,7 +1742,7 @@ impl<'s> PathIntegrator<'s> {
 
     /// The oblique shape's probe guides at the BSSRDF vertex `v` (x_o's coefficients
     /// `at_xo`) for what was drawn `first`: the light sample's, and the continuation's where
-    /// direct light arrives by it too (an environment: `sky_by_continuation`). `[None, None]`
+    /// direct light arrives by it too (an environment: `guide_continuation`). `[None, None]`
     /// without the shape.
     fn shift_guides<'b>(
         &self,
@@ -1751,7 +1754,7 @@ impl<'s> PathIntegrator<'s> {
         let light = b.shift_guide(at_xo, v.w_o, v.n_o, || {
             first.and_then(|f| self.light_direction(hit.p, f.light))
         });
-        let continuation = first.filter(|_| self.sky_by_continuation).and_then(|f| {
+        let continuation = first.filter(|_| self.guide_continuation).and_then(|f| {
             b.shift_guide(at_xo, v.w_o, v.n_o, || {
                 cosine_direction(hit.ns, f.continuation).map(|(w, _)| w)
             })
