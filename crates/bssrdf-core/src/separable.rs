@@ -68,6 +68,7 @@ use crate::family::{FamilyOptions, ProfileFamily};
 use crate::fresnel::{dielectric, fresnel_moment};
 use crate::model::{ProfileModel, Scattering};
 use crate::rgb::Rgb;
+use crate::tabulated::half_space::AlbedoRow;
 use crate::tabulated::{AngularCoupling, ObliqueShape};
 
 /// Where light crosses the boundary: the surface point, the normal there (unit, out of the
@@ -130,6 +131,13 @@ impl ShiftSeries<'_> {
         ObliqueShape::radial_node(self.sigma_tp * r)
     }
 
+    /// The radial node nearest distance `r` (length) in ln r ([`ObliqueShape::nearest_node`]
+    /// at σt' r: [`Self::node`]'s k where its weight is below ½, else k + 1), without the
+    /// logarithm [`Self::node`] takes.
+    pub fn nearest_node(&self, r: f64) -> usize {
+        ObliqueShape::nearest_node(self.sigma_tp * r)
+    }
+
     /// Both sides' amplitudes a_n = C_n · sinⁿθ_side (n = 1, 2, 3; unitless, finite) at
     /// radial node `node`, as [`SeparableBssrdf::shift_amplitudes`] at that node's radius:
     /// `[incident side, exit side]` of light entering at cosine `cos_i` and leaving at
@@ -176,7 +184,8 @@ fn series(a: &[f64; 3], x: &[f64; 3]) -> f64 {
 /// A prepared separable BSSRDF (see the module docs): the profile family, the Fresnel
 /// normalisation c and, for the tabulated profile, its angular coupling. Build once per
 /// material (the coupling costs about a millisecond); evaluation allocates nothing.
-/// `Send + Sync`, cheap to clone (about 10 KB with the coupling).
+/// `Send + Sync`; a clone copies its tables (about 10 KB with the coupling, 470 KB with the
+/// oblique shape).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeparableBssrdf {
     family: ProfileFamily,
@@ -383,8 +392,10 @@ impl SeparableBssrdf {
                 x[ch] = reduced.sigma_tp * r;
             }
         }
-        let tt = t.factors(alpha, cos_i, cos_o);
-        let pf = m.pair(alpha, x, cos_i, cos_o);
+        // Each albedo's place on the tables' grids, found once for T and M.
+        let rows = AlbedoRow::of_each(alpha);
+        let tt = t.factors_on(rows, cos_i, cos_o);
+        let pf = m.pair_on(rows, x, cos_i, cos_o);
         // Each side's harmonics sinⁿθ cos nφ, φ the angle between the chord (from that side)
         // and its light's direction of travel along the surface t (|t| = sin θ), both in that
         // side's tangent plane: with x̂ the chord's projection on it, normalised, u = x̂·t and

@@ -57,20 +57,23 @@ pub trait AzimuthGuide {
 }
 
 /// An [`AzimuthGuide`] at one x_o, ready for the probes ([`crate::probe::ProbeDensity::around`]):
-/// the cosines of each bin's midpoint about the guide's directions in x_o's frame, and the
-/// last few node shapes it was read at, each with its normalisation (a probe set samples one node's azimuth and
-/// then reads its density at the point found: one shape per set where the normal probe finds
-/// one point). Built by the caller once per x_o, on its stack (under 1 KB).
+/// the directions of the guide's factors in x_o's frame, and the last few node shapes it was
+/// read at, each with its normalisation (a probe set samples one node's azimuth and then reads
+/// its density at the point found: one shape per set where the normal probe finds one point).
+/// Built by the caller once per x_o, on its stack (about 350 bytes).
 pub struct GuidedAzimuths<'g> {
     guide: &'g dyn AzimuthGuide,
-    /// cos(φ_m − φ_j) at every bin midpoint φ_m for each factor j (0 for a factor left out,
-    /// whose amplitudes are then 0 too, so that it is 1 everywhere).
-    cosines: [[f64; AZIMUTH_BINS]; 2],
+    /// (cos φ_j, sin φ_j) of each factor's direction j in x_o's frame ((0, 0) for a factor
+    /// left out, whose amplitudes are then 0 too, so that it is 1 everywhere).
+    axes: [(f64, f64); 2],
     /// Whether each factor's direction projects on the tangent plane.
     used: [bool; 2],
-    /// The shapes read last, keyed by node; replaced in turn.
-    shapes: [Cell<Option<(usize, NodeShape)>>; SHAPES_KEPT],
-    /// The slot of `shapes` the next new shape goes to.
+    /// The nodes of the shapes read last (`usize::MAX`: an empty slot), looked through before
+    /// `shapes` is read.
+    nodes: [Cell<usize>; SHAPES_KEPT],
+    /// The shapes of `nodes`, slot for slot; replaced in turn.
+    shapes: [Cell<NodeShape>; SHAPES_KEPT],
+    /// The slot the next new shape goes to.
     next: Cell<usize>,
     /// A second guide whose own shape takes the given part of the guided share
     /// ([`GuidedAzimuths::mixed_with`]).
@@ -80,12 +83,42 @@ pub struct GuidedAzimuths<'g> {
 /// How many node shapes a [`GuidedAzimuths`] keeps.
 const SHAPES_KEPT: usize = 4;
 
-/// One node's guided shape: the factors' amplitudes (a factor left out has 0) and the
-/// piecewise density's scale, `AZIMUTH_BINS / (2π Σ_bins value)`; `None`: g uniform.
+/// One node's guided shape: each factor's series as a cubic in u = cos(φ − φ_j)
+/// ([`Cubic`]; a factor left out is 1) and the piecewise density's scale,
+/// `AZIMUTH_BINS / (2π Σ_bins value)`; `None`: g uniform.
 #[derive(Debug, Clone, Copy)]
 struct NodeShape {
-    amplitudes: [[f64; 3]; 2],
+    factors: [Cubic; 2],
     scale: Option<f64>,
+}
+
+impl NodeShape {
+    /// No amplitudes: the uniform azimuth (what an empty slot holds).
+    const UNIFORM: NodeShape = NodeShape {
+        factors: [Cubic::ONE; 2],
+        scale: None,
+    };
+}
+
+/// A series 1 + Σ_n a_n cos nθ (n = 1, 2, 3) as the cubic in u = cos θ it is (cos 2θ =
+/// 2u² − 1, cos 3θ = 4u³ − 3u): coefficients of 1, u, u², u³.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cubic([f64; 4]);
+
+impl Cubic {
+    /// The series with no harmonics.
+    const ONE: Cubic = Cubic([1.0, 0.0, 0.0, 0.0]);
+
+    fn of(a: &[f64; 3]) -> Self {
+        Self([1.0 - a[1], a[0] - 3.0 * a[2], 2.0 * a[1], 4.0 * a[2]])
+    }
+
+    /// The series at u = cos θ, clamped at 0.
+    #[inline]
+    fn at(&self, u: f64) -> f64 {
+        let p = &self.0;
+        (p[0] + u * (p[1] + u * (p[2] + u * p[3]))).max(0.0)
+    }
 }
 
 impl<'g> GuidedAzimuths<'g> {
@@ -94,39 +127,41 @@ impl<'g> GuidedAzimuths<'g> {
     /// the guide's directions projects on the tangent plane: the azimuth is then uniform.
     pub fn new(guide: &'g dyn AzimuthGuide, x_o: &impl SurfacePoint) -> Option<Self> {
         let (fs, ft) = orthonormal_basis(x_o.normal());
-        let mid = midpoint_angles();
         let mut used = [false; 2];
-        let mut cosines = [[0.0; AZIMUTH_BINS]; 2];
+        let mut axes = [(0.0, 0.0); 2];
         for (j, d) in guide.directions().into_iter().enumerate() {
             let (x, y) = (d.dot(fs), d.dot(ft));
             if x.is_finite() && y.is_finite() && (x != 0.0 || y != 0.0) {
-                let l = x.hypot(y);
-                let (c0, s0) = (x / l, y / l);
+                // The library's hypot only where the squares overflow or underflow.
+                let l = match (x * x + y * y).sqrt() {
+                    l if l.is_normal() => l,
+                    _ => x.hypot(y),
+                };
                 used[j] = true;
-                for (u, &(s, c)) in cosines[j].iter_mut().zip(mid) {
-                    *u = c * c0 + s * s0;
-                }
+                axes[j] = (x / l, y / l);
             }
         }
         (used[0] || used[1]).then(|| Self {
             guide,
-            cosines,
+            axes,
             used,
-            shapes: Default::default(),
+            nodes: std::array::from_fn(|_| Cell::new(usize::MAX)),
+            shapes: std::array::from_fn(|_| Cell::new(NodeShape::UNIFORM)),
             next: Cell::new(0),
             other: None,
         })
     }
 
-    /// The shape at radius `r`, from the ones kept or read from the guide; with `cum`, also
-    /// the cumulative sums of its bin values (`cum[m]` the sum of the first m).
-    fn shape(&self, r: f64, cum: Option<&mut [f64; AZIMUTH_BINS + 1]>) -> NodeShape {
+    /// The shape at radius `r`, from the ones kept or read from the guide; with `values`, also
+    /// its bins' values (unnormalised; all 1 where it is uniform).
+    fn shape(&self, r: f64, values: Option<&mut [f64; AZIMUTH_BINS]>) -> NodeShape {
         let node = self.guide.radial_node(r);
-        let kept = self.shapes.iter().find_map(|c| match c.get() {
-            Some((k, s)) if k == node => Some(s),
-            _ => None,
-        });
-        if let (Some(shape), None) = (kept, &cum) {
+        let kept = self
+            .nodes
+            .iter()
+            .position(|k| k.get() == node)
+            .map(|slot| self.shapes[slot].get());
+        if let (Some(shape), None) = (kept, &values) {
             return shape;
         }
         let shape = kept.unwrap_or_else(|| {
@@ -137,39 +172,43 @@ impl<'g> GuidedAzimuths<'g> {
                 }
             }
             NodeShape {
-                amplitudes,
+                factors: amplitudes.map(|a| Cubic::of(&a)),
                 scale: None,
             }
         });
-        let mut sums = [0.0; AZIMUTH_BINS + 1];
-        let cum = cum.unwrap_or(&mut sums);
-        if shape.amplitudes == [[0.0; 3]; 2] {
-            cum.iter_mut().enumerate().for_each(|(m, c)| *c = m as f64);
+        let mut own = [0.0; AZIMUTH_BINS];
+        let values = values.unwrap_or(&mut own);
+        let flat = shape.factors == [Cubic::ONE; 2];
+        if flat {
+            values.fill(1.0);
         } else {
-            for m in 0..AZIMUTH_BINS {
-                cum[m + 1] = cum[m] + self.value(&shape, m);
+            for (m, v) in values.iter_mut().enumerate() {
+                *v = self.value(&shape, m);
             }
         }
         if kept.is_some() {
             return shape;
         }
-        let total = cum[AZIMUTH_BINS];
+        let total = sum_of(values);
         let shape = NodeShape {
-            scale: (shape.amplitudes != [[0.0; 3]; 2] && total > 0.0 && total.is_finite())
+            scale: (!flat && total > 0.0 && total.is_finite())
                 .then(|| AZIMUTH_BINS as f64 / (TAU * total)),
             ..shape
         };
         let slot = self.next.get();
-        self.shapes[slot].set(Some((node, shape)));
+        self.nodes[slot].set(node);
+        self.shapes[slot].set(shape);
         self.next.set((slot + 1) % SHAPES_KEPT);
         shape
     }
 
-    /// The product of the shape's factors at bin `m`'s midpoint (unnormalised, ≥ 0).
+    /// The product of the shape's factors at bin `m`'s midpoint φ_m (unnormalised, ≥ 0), each
+    /// at cos(φ_m − φ_j).
     #[inline]
     fn value(&self, shape: &NodeShape, m: usize) -> f64 {
-        series(&shape.amplitudes[0], self.cosines[0][m])
-            * series(&shape.amplitudes[1], self.cosines[1][m])
+        let (s, c) = midpoint_angles()[m];
+        let [(c0, s0), (c1, s1)] = self.axes;
+        shape.factors[0].at(c * c0 + s * s0) * shape.factors[1].at(c * c1 + s * s1)
     }
 
     /// This guide with `other`'s shape mixed into its guided part, which becomes
@@ -186,34 +225,42 @@ impl<'g> GuidedAzimuths<'g> {
         self
     }
 
-    /// This guide's own shape g(φ | r) (1/radian) at `phi`.
-    fn own_pdf(&self, r: f64, phi: f64) -> f64 {
+    /// This guide's own shape g(φ | r) (1/radian) in bin `bin`.
+    fn own_pdf(&self, r: f64, bin: usize) -> f64 {
         let shape = self.shape(r, None);
         match shape.scale {
-            Some(scale) => self.value(&shape, bin_of(phi)) * scale,
+            Some(scale) => self.value(&shape, bin) * scale,
             None => 1.0 / TAU,
         }
     }
 
-    /// An azimuth drawn from this guide's own shape at fraction `v` ∈ [0, 1] of its
+    /// An azimuth (in turns) drawn from this guide's own shape at fraction `v` ∈ [0, 1] of its
     /// cumulative distribution.
     fn own_sample(&self, r: f64, v: f64) -> f64 {
-        let mut cum = [0.0; AZIMUTH_BINS + 1];
-        let shape = self.shape(r, Some(&mut cum));
-        if shape.scale.is_none() {
-            // Uniform: the bins' sums are 0, 1, …, AZIMUTH_BINS.
-            cum.iter_mut().enumerate().for_each(|(m, c)| *c = m as f64);
+        let mut values = [0.0; AZIMUTH_BINS];
+        if self.shape(r, Some(&mut values)).scale.is_none() {
+            values.fill(1.0); // uniform
         }
-        invert_bins(&cum, v)
+        invert_bins(&values, v)
     }
 
     /// p(φ | r) (1/radian) of the azimuth at projected radius `r` (length), whatever the
     /// probe's channel: (1 − β)/(2π) + β g(φ), `phi` any angle in x_o's frame, g the guided
     /// part (with a second guide mixed in, [`Self::mixed_with`]).
     pub fn pdf(&self, r: f64, phi: f64) -> f64 {
+        self.pdf_in_bin(r, bin_of(phi))
+    }
+
+    /// [`Self::pdf`] at the azimuth of the offset (`x`, `y`) in x_o's frame (the angle
+    /// atan2(y, x), its bin found from the signs and comparisons, without the arctangent).
+    pub fn pdf_toward(&self, r: f64, x: f64, y: f64) -> f64 {
+        self.pdf_in_bin(r, bin_toward(x, y))
+    }
+
+    fn pdf_in_bin(&self, r: f64, bin: usize) -> f64 {
         let g = match self.other {
-            Some((o, s)) => (1.0 - s) * self.own_pdf(r, phi) + s * o.own_pdf(r, phi),
-            None => self.own_pdf(r, phi),
+            Some((o, s)) => (1.0 - s) * self.own_pdf(r, bin) + s * o.own_pdf(r, bin),
+            None => self.own_pdf(r, bin),
         };
         (1.0 - GUIDED_SHARE) / TAU + GUIDED_SHARE * g
     }
@@ -222,9 +269,16 @@ impl<'g> GuidedAzimuths<'g> {
     /// below 1 − β uniform, else by inverting g's cumulative distribution (with a second
     /// guide, the one the remainder of `u` falls to, in proportion to their parts).
     pub fn sample(&self, r: f64, u: f64) -> f64 {
+        let phi = TAU * self.sample_turn(r, u);
+        if phi < TAU { phi } else { 0.0 }
+    }
+
+    /// [`Self::sample`] in turns (φ / 2π ∈ [0, 1)): what `crate::sampling::sin_cos_turn`
+    /// takes.
+    pub fn sample_turn(&self, r: f64, u: f64) -> f64 {
         let beta = GUIDED_SHARE;
         if u < 1.0 - beta {
-            return TAU * u / (1.0 - beta);
+            return u / (1.0 - beta);
         }
         let v = ((u - (1.0 - beta)) / beta).clamp(0.0, 1.0);
         match self.other {
@@ -235,12 +289,6 @@ impl<'g> GuidedAzimuths<'g> {
     }
 }
 
-/// 1 + Σ_n a_n cos nθ clamped at 0, from u = cos θ (cos 2θ, cos 3θ by Chebyshev).
-#[inline]
-fn series(a: &[f64; 3], u: f64) -> f64 {
-    (1.0 + a[0] * u + a[1] * (2.0 * u * u - 1.0) + a[2] * (4.0 * u * u - 3.0) * u).max(0.0)
-}
-
 /// The bin of angle `phi` (any angle; taken modulo 2π).
 #[inline]
 fn bin_of(phi: f64) -> usize {
@@ -248,27 +296,77 @@ fn bin_of(phi: f64) -> usize {
     (t as usize).min(AZIMUTH_BINS - 1)
 }
 
-/// The angle in [0, 2π) at fraction `v` ∈ [0, 1] of the piecewise-constant density whose
-/// cumulative bin values are `cum` (positive total).
-fn invert_bins(cum: &[f64; AZIMUTH_BINS + 1], v: f64) -> f64 {
-    let target = v * cum[AZIMUTH_BINS];
-    // The bin holding `target`: the last k with cum[k] ≤ target, moved down past empty
-    // bins at the top.
-    let mut k = cum
-        .partition_point(|&c| c <= target)
-        .saturating_sub(1)
-        .min(AZIMUTH_BINS - 1);
-    while k > 0 && cum[k + 1] - cum[k] <= 0.0 {
-        k -= 1;
-    }
-    let w = cum[k + 1] - cum[k];
-    let f = if w > 0.0 {
-        ((target - cum[k]) / w).clamp(0.0, 1.0)
+/// The bin of the angle atan2(`y`, `x`) (as [`bin_of`] would give it): the quadrant from the
+/// signs, then within it the number of the quadrant's inner bin edges β_k = kπ/16 the angle
+/// has passed (y' cos β_k ≥ x' sin β_k, both rotated into the first quadrant). NaN and the
+/// offset (0, 0) give bin 0.
+#[inline]
+fn bin_toward(x: f64, y: f64) -> usize {
+    const PER_QUADRANT: usize = AZIMUTH_BINS / 4;
+    let (quadrant, xr, yr) = if x > 0.0 && y >= 0.0 {
+        (0, x, y)
+    } else if x <= 0.0 && y > 0.0 {
+        (1, y, -x)
+    } else if x < 0.0 && y <= 0.0 {
+        (2, -x, -y)
+    } else if x >= 0.0 && y < 0.0 {
+        (3, -y, x)
     } else {
-        0.5
+        return 0;
     };
-    let phi = TAU * (k as f64 + f) / AZIMUTH_BINS as f64;
-    if phi < TAU { phi } else { 0.0 }
+    let edges = quadrant_edges();
+    let passed = edges.iter().filter(|&&(s, c)| yr * c >= xr * s).count();
+    quadrant * PER_QUADRANT + passed
+}
+
+/// (sin β_k, cos β_k) of the inner bin edges β_k = 2πk / [`AZIMUTH_BINS`] of the first
+/// quadrant, k = 1, …, AZIMUTH_BINS/4 − 1.
+fn quadrant_edges() -> &'static [(f64, f64); AZIMUTH_BINS / 4 - 1] {
+    static EDGES: std::sync::OnceLock<[(f64, f64); AZIMUTH_BINS / 4 - 1]> =
+        std::sync::OnceLock::new();
+    EDGES.get_or_init(|| {
+        std::array::from_fn(|k| (TAU * (k + 1) as f64 / AZIMUTH_BINS as f64).sin_cos())
+    })
+}
+
+/// The sum of the bins' values, in four running sums (independent, so that they overlap).
+#[inline]
+fn sum_of(values: &[f64; AZIMUTH_BINS]) -> f64 {
+    let mut part = [0.0; 4];
+    for chunk in values.chunks_exact(4) {
+        for (p, v) in part.iter_mut().zip(chunk) {
+            *p += v;
+        }
+    }
+    (part[0] + part[1]) + (part[2] + part[3])
+}
+
+/// The angle in turns, in [0, 1), at fraction `v` ∈ [0, 1] of the piecewise-constant density
+/// whose bins' values are `values` (non-negative, positive total): the first non-empty bin
+/// whose running sum passes v × total, and the fraction of it that reaches v × total (where
+/// rounding leaves v × total beyond every running sum, the end of the last non-empty bin).
+fn invert_bins(values: &[f64; AZIMUTH_BINS], v: f64) -> f64 {
+    let target = v * sum_of(values);
+    let mut below = 0.0;
+    let mut last = 0;
+    for (k, &w) in values.iter().enumerate() {
+        if w > 0.0 {
+            if below + w > target {
+                let f = ((target - below) / w).clamp(0.0, 1.0);
+                return turn_of(k, f);
+            }
+            last = k;
+        }
+        below += w;
+    }
+    turn_of(last, 1.0)
+}
+
+/// The angle in turns at fraction `f` of bin `k`, in [0, 1) (1 wraps to 0).
+#[inline]
+fn turn_of(k: usize, f: f64) -> f64 {
+    let turn = (k as f64 + f) / AZIMUTH_BINS as f64;
+    if turn < 1.0 { turn } else { 0.0 }
 }
 
 /// sin and cos of every bin's midpoint angle.
@@ -302,6 +400,39 @@ mod tests {
                 1 => [[0.3 * k, 0.0, 0.0], [f64::NAN, 0.0, 0.0]],
                 _ => [[0.0; 3], [-1.5, 0.2 * k, 0.3]],
             }
+        }
+    }
+
+    /// The bin found without the arctangent is atan2's: on 10⁵ random directions at every
+    /// scale, on the bins' edges and the axes (±0 included), and for NaN (bin 0, as `bin_of`
+    /// gives NaN). The offset (0, 0), which has no angle, is bin 0 whatever its zeros' signs.
+    #[test]
+    fn the_bin_toward_a_direction_is_the_bin_of_its_angle() {
+        let mut rng = SplitMix64::new(9);
+        for (x, y) in [(0.0, 0.0), (-0.0, -0.0), (0.0, -0.0), (-0.0, 0.0)] {
+            assert_eq!(bin_toward(x, y), 0);
+        }
+        let mut cases = vec![(f64::NAN, 1.0), (1.0, f64::NAN)];
+        for (x, y) in [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)] {
+            for z in [0.0, -0.0] {
+                cases.push((x, if y == 0.0 { z } else { y }));
+                cases.push((if x == 0.0 { z } else { x }, y));
+            }
+        }
+        for k in 0..AZIMUTH_BINS {
+            // Just inside each bin, on both sides of its lower edge.
+            for d in [1e-9, -1e-9] {
+                let (s, c) = (TAU * k as f64 / AZIMUTH_BINS as f64 + d).sin_cos();
+                cases.push((c, s));
+            }
+        }
+        for _ in 0..100_000 {
+            let phi = TAU * rng.next_f64();
+            let scale = 10f64.powf(12.0 * rng.next_f64() - 6.0);
+            cases.push((scale * phi.cos(), scale * phi.sin()));
+        }
+        for (x, y) in cases {
+            assert_eq!(bin_toward(x, y), bin_of(y.atan2(x)), "({x}, {y})");
         }
     }
 

@@ -786,7 +786,7 @@ impl<'s> ProbeDensity<'s> {
                     // "Guided azimuths").
                     let share = match (axis, self.guide) {
                         (2, Some(g)) => {
-                            let p_phi = *guided.get_or_insert_with(|| g.pdf(r, dl.y.atan2(dl.x)));
+                            let p_phi = *guided.get_or_insert_with(|| g.pdf_toward(r, dl.x, dl.y));
                             f64::from(count) / 3.0 * p_phi
                         }
                         _ => share,
@@ -847,7 +847,9 @@ impl<'s> ProbeDensity<'s> {
                 continue;
             }
             let (sin, cos) = match self.guide {
-                Some(g) if axis == ProbeAxis::N => g.sample(r, u_phi).sin_cos(),
+                Some(g) if axis == ProbeAxis::N => {
+                    crate::sampling::sin_cos_turn(g.sample_turn(r, u_phi))
+                }
                 _ => crate::sampling::sin_cos_turn(u_phi),
             };
             let (vx, vy, vz) = self.frame.axes(axis);

@@ -30,7 +30,7 @@ use std::sync::OnceLock;
 
 use super::angular_file::{ANGULAR_ETAS, AngularData, N_MU, index};
 use super::grid::N_ALBEDO;
-use super::half_space::{row_position, table};
+use super::half_space::{AlbedoRow, table};
 use crate::fresnel::{dielectric, fresnel_moment};
 use crate::model::Scattering;
 
@@ -153,26 +153,35 @@ impl AngularCoupling {
     /// pair of cosines: the cosines' cells are found once, and a channel whose albedo equals the
     /// previous one's reuses its value.
     pub fn factors<const N: usize>(&self, alpha: [f64; N], mu_i: f64, mu_o: f64) -> [f64; N] {
+        self.factors_on(AlbedoRow::of_each(alpha), mu_i, mu_o)
+    }
+
+    /// [`AngularCoupling::factors`] at albedos already placed on the grid (`None`: a
+    /// non-finite albedo, which reads 1).
+    pub(crate) fn factors_on<const N: usize>(
+        &self,
+        rows: [Option<AlbedoRow>; N],
+        mu_i: f64,
+        mu_o: f64,
+    ) -> [f64; N] {
         let mut out = [1.0; N];
         if !(mu_i.is_finite() && mu_o.is_finite()) {
             return out;
         }
         let cells = Cells::new(mu_i, mu_o);
         for ch in 0..N {
-            out[ch] = if ch > 0 && alpha[ch].to_bits() == alpha[ch - 1].to_bits() {
-                out[ch - 1]
-            } else if alpha[ch].is_finite() {
-                self.at(&cells, alpha[ch])
-            } else {
-                1.0
+            out[ch] = match rows[ch] {
+                _ if ch > 0 && rows[ch] == rows[ch - 1] => out[ch - 1],
+                Some(row) => self.at(&cells, row),
+                None => 1.0,
             };
         }
         out
     }
 
-    /// T at a finite `alpha` and the cosines' `cells`.
-    fn at(&self, cells: &Cells, alpha: f64) -> f64 {
-        let (r0, fr) = row_position(alpha, N_ALBEDO);
+    /// T at an albedo's `row` and the cosines' `cells`.
+    fn at(&self, cells: &Cells, row: AlbedoRow) -> f64 {
+        let (r0, fr) = row.position(N_ALBEDO);
         let row = |r: usize| {
             let m = &self.t[r * N_MU * N_MU..(r + 1) * N_MU * N_MU];
             cells.eval(|j, k| f64::from(m[j * N_MU + k]))
@@ -211,6 +220,19 @@ impl Cells {
         };
         let ((j, fj), (k, fk)) = (cell(a), cell(b));
         Self { j, fj, k, fk }
+    }
+
+    /// The four corners `(j, k)` of the cell (j the lower cosine's bin) with their bilinear
+    /// weights, in a fixed order.
+    #[inline]
+    pub(super) fn corners(&self) -> [((usize, usize), f64); 4] {
+        let Self { j, fj, k, fk } = *self;
+        [
+            ((j, k), (1.0 - fj) * (1.0 - fk)),
+            ((j, k + 1), (1.0 - fj) * fk),
+            ((j + 1, k), fj * (1.0 - fk)),
+            ((j + 1, k + 1), fj * fk),
+        ]
     }
 
     /// The matrix `m(j, k)` (values at the bins' centres) interpolated at the two cosines.

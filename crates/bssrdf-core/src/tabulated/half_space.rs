@@ -315,7 +315,9 @@ pub(crate) fn row_totals() -> &'static [RowTotals] {
 /// Integer part and fraction of a grid position `p ∈ [0, n − 1]`, with the integer part at
 /// most `n − 2` (so that `i + 1` is a valid index).
 fn split(p: f64, n: usize) -> (usize, f64) {
-    let i = (p.floor() as usize).min(n - 2);
+    // `p as usize` is ⌊p⌋ for p ≥ 0 and 0 below (as `p.floor() as usize`), without the
+    // library call `floor` is on the baseline x86-64 target.
+    let i = (p as usize).min(n - 2);
     (i, (p - i as f64).clamp(0.0, 1.0))
 }
 
@@ -374,11 +376,53 @@ pub(crate) fn row_position(alpha: f64, rows: usize) -> (usize, f64) {
 /// The position of `alpha` on a grid of `rows` albedo rows ([`row_position`]): a real in
 /// [0, rows − 1], linear in log √(1 − α).
 pub(crate) fn row_coordinate(alpha: f64, rows: usize) -> f64 {
+    unit_coordinate(alpha) * (rows - 1) as f64
+}
+
+/// The fraction u ∈ [0, 1] of the way from the first albedo row to the last that `alpha` lies
+/// at, on every grid linear in log √(1 − α) from [`S_MIN`] to 1 (a grid of n rows has it at
+/// u (n − 1)).
+fn unit_coordinate(alpha: f64) -> f64 {
     let s = (1.0 - alpha.clamp(0.0, 1.0)).sqrt();
     if s <= S_MIN {
         0.0
     } else {
-        ((s / S_MIN).ln() / (1.0 / S_MIN).ln() * (rows - 1) as f64).clamp(0.0, (rows - 1) as f64)
+        ((s / S_MIN).ln() / (1.0 / S_MIN).ln()).clamp(0.0, 1.0)
+    }
+}
+
+/// A finite albedo's place on the albedo grids ([`row_position`]), found once for the several
+/// tables one pair reads (the angular coupling's rows and the oblique shape's): the square
+/// root and logarithm are taken once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct AlbedoRow(f64);
+
+impl AlbedoRow {
+    /// `alpha`'s place; `None` for a non-finite albedo.
+    #[inline]
+    pub(crate) fn of(alpha: f64) -> Option<Self> {
+        alpha.is_finite().then(|| Self(unit_coordinate(alpha)))
+    }
+
+    /// [`AlbedoRow::of`] for several albedos (a pair's channels); one equal to the previous
+    /// one, bit for bit, reuses its place.
+    #[inline]
+    pub(crate) fn of_each<const N: usize>(alpha: [f64; N]) -> [Option<Self>; N] {
+        let mut out = [None; N];
+        for ch in 0..N {
+            out[ch] = if ch > 0 && alpha[ch].to_bits() == alpha[ch - 1].to_bits() {
+                out[ch - 1]
+            } else {
+                Self::of(alpha[ch])
+            };
+        }
+        out
+    }
+
+    /// [`row_position`] on a grid of `rows` rows, bit for bit.
+    #[inline]
+    pub(crate) fn position(self, rows: usize) -> (usize, f64) {
+        split(self.0 * (rows - 1) as f64, rows)
     }
 }
 

@@ -561,10 +561,7 @@ impl AzimuthGuide for ShiftGuide<'_> {
 
     /// The table's radial node nearest σt' r in ln x.
     fn radial_node(&self, r: f64) -> usize {
-        self.series.map_or(0, |s| {
-            let (k, w) = s.node(r);
-            if w < 0.5 { k } else { k + 1 }
-        })
+        self.series.map_or(0, |s| s.nearest_node(r))
     }
 
     fn amplitudes(&self, node: usize) -> [[f64; 3]; 2] {
