@@ -5,8 +5,10 @@
 //!
 //! Run: `cargo bench --bench render`. Ids are `render/<method>` (`<estimator>-tabulated`: the
 //! same scene with the tabulated profile instead of the scene's dipole, without the oblique
-//! shape; `… oblique` with it, as by default); criterion reports the time per 1024 camera samples and the
-//! throughput in samples/s. Compare methods as ratios.
+//! shape; `… oblique` with it, as by default; `… sphere`: the slab's material on a sphere of
+//! radius 10 (10 mean free paths) filling the same view, a curved surface); criterion reports
+//! the time per 1024 camera samples and the throughput in samples/s. Compare methods as
+//! ratios.
 //!
 //! `render/sone eta=1.3` and `render/sone eta=1.3 roughness=0.3` render the same slab with a
 //! refractive boundary, smooth and rough (docs/lighting-and-surfaces.md): their ratio is the
@@ -24,7 +26,20 @@ use het_bssrdf::tracer::scene::Scene;
 /// The built-in checker slab at 32 × 32, its material's `eta = 1.0` line replaced by
 /// `material` (the material's other keys stay).
 fn slab(material: &str) -> Scene {
+    built_in(CHECKER_SLAB.replace("eta = 1.0", material))
+}
+
+/// [`slab`] with the box replaced by a sphere of radius 10 whose top is the slab's top
+/// (z = 0), under the same light and camera: the same material on a curved surface.
+fn sphere(material: &str) -> Scene {
     let text = CHECKER_SLAB.replace("eta = 1.0", material);
+    let box_at = text.find("[[shape]]").expect("the slab's shape");
+    let ball = "[[shape]]\ntype = \"sphere\"\nname = \"ball\"\nmaterial = \"checker\"\n\
+                centre = [0.0, 0.0, -10.0]\nradius = 10.0\n";
+    built_in(format!("{}{ball}", &text[..box_at]))
+}
+
+fn built_in(text: String) -> Scene {
     Scene::from_toml_str(&text, std::path::Path::new("."), "checker-slab")
         .expect("built-in scene")
         .with_resolution(32, 32)
@@ -73,6 +88,15 @@ fn renders(c: &mut Criterion) {
             format!("{name}-tabulated oblique"),
             slab("eta = 1.0\noblique_shape = true"),
             tabulated(name),
+        ));
+    }
+    // The same on a curved surface, with the estimator whose cost the shape raises most.
+    for shape in [false, true] {
+        let on = if shape { " oblique" } else { "" };
+        cases.push((
+            format!("endpoints-tabulated sphere{on}"),
+            sphere(&format!("eta = 1.0\noblique_shape = {shape}")),
+            tabulated("endpoints"),
         ));
     }
     for (id, scene, method) in &cases {

@@ -235,8 +235,9 @@ impl BssrdfObject {
     /// takes at every x_i (the same direction at x_i for a distant light or an environment,
     /// the same point on a quad, seen from x_i up to the parallax), or the continuation's
     /// direction (`integrator::path`, "two guides"). The exit side's is about the direction
-    /// of travel of light arriving along −`w_o`. `n` is x_o's shading normal. `None` without the oblique shape. A side whose
-    /// direction lies along the normal, or below the surface, is left out.
+    /// of travel of light arriving along −`w_o`. `n` is x_o's shading normal. `None` without
+    /// the oblique shape. A side whose direction lies along the normal, or below the surface,
+    /// is left out.
     pub(crate) fn shift_guide(
         &self,
         coeffs: het_estimate::Coefficients,

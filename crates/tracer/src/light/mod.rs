@@ -595,9 +595,6 @@ pub fn uniform_sphere(u: [f64; 2]) -> DVec3 {
 mod tests {
     use super::*;
 
-    /// The direction toward a light's centre: the quad's centre from its emitting side and
-    /// nothing from behind it, a point light's position, the reverse of a directional light's
-    /// travel; none for an environment.
     #[test]
     fn delta_lights() {
         let d = Light::directional(DVec3::new(0.0, 0.0, -2.0), Rgb::splat(3.0)).unwrap();

@@ -154,8 +154,8 @@ pub struct Translucent {
     /// forward shift of light entering at an angle (`bssrdf_core::tabulated::oblique`,
     /// docs/oblique-incidence.md). Scene key `oblique_shape`; default true. Without it, a
     /// half-space under a large quad light renders 1.19 times the path tracer; with it,
-    /// renders take up to 1.2 times as long per sample and have 3–18 % more noise at equal
-    /// samples where the shape hardly moves light (the probes follow its azimuthal shape for
+    /// renders take 1.09–1.12 times as long on the marble examples and have 3–18 % more noise
+    /// at equal samples where the shape hardly moves light (the probes follow its azimuthal shape for
     /// the light's two sampled directions; docs/oblique-incidence.md, "On by default").
     pub oblique_shape: bool,
     /// The `unit_scale` that was applied to the file's coefficients.
